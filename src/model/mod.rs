@@ -1,0 +1,351 @@
+//! What a run is: the grid, the particles (structure of arrays), node
+//! constraints, loads and solver settings, built from a checked `Scene`.
+//! Everything here is backend-neutral; `cpu::` and `gpu::` step it.
+
+mod grid;
+mod particles;
+
+pub use grid::Grid;
+pub use particles::Particles;
+
+use crate::error::SceneError;
+use crate::material::Material;
+use crate::scene::{Fix, IntegratorKind, NpcPosition, Ramp, Scene, seed};
+use crate::shape::Shape;
+
+/// Bit of `Constraints::fix` for a node fixed in x.
+pub const FIX_X: u8 = 1;
+/// Bit of `Constraints::fix` for a node fixed in y.
+pub const FIX_Y: u8 = 2;
+
+/// One named constraint: its nodes and directions (reactions are summed per constraint).
+#[derive(Debug, Clone)]
+pub struct ConstraintGroup {
+    pub name: String,
+    pub nodes: Vec<u32>,
+    /// `FIX_X`, `FIX_Y` or both.
+    pub fix: u8,
+}
+
+/// Dirichlet (zero-velocity) nodes.
+#[derive(Debug, Clone, Default)]
+pub struct Constraints {
+    /// Per node: `FIX_X | FIX_Y` bits (0 = free).
+    pub fix: Vec<u8>,
+    pub groups: Vec<ConstraintGroup>,
+}
+
+/// Gravity with its time history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gravity {
+    /// Full value (m/s²).
+    pub g: [f64; 2],
+    pub ramp: Ramp,
+    /// T of eq. 45 (s); unused without a ramp.
+    pub period: f64,
+}
+
+impl Gravity {
+    /// Gravity at time `t` (m/s²): paper eq. 45 with a sine ramp.
+    pub fn at(&self, t: f64) -> [f64; 2] {
+        let f = match self.ramp {
+            Ramp::None => 1.0,
+            Ramp::Sine if t <= 0.5 * self.period => {
+                0.5 * ((2.0 * std::f64::consts::PI * t / self.period - std::f64::consts::FRAC_PI_2)
+                    .sin()
+                    + 1.0)
+            }
+            Ramp::Sine => 1.0,
+        };
+        [f * self.g[0], f * self.g[1]]
+    }
+}
+
+/// Time integrator with its parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integrator {
+    Fe,
+    Npc { gamma: f64, position: NpcPosition },
+}
+
+impl Integrator {
+    pub fn kind(&self) -> IntegratorKind {
+        match self {
+            Integrator::Fe => IntegratorKind::Fe,
+            Integrator::Npc { .. } => IntegratorKind::Npc,
+        }
+    }
+}
+
+/// A tracked particle.
+#[derive(Debug, Clone)]
+pub struct Probe {
+    pub name: String,
+    /// Requested point (m).
+    pub point: [f64; 2],
+    /// Index of the particle nearest to `point` at t = 0.
+    pub particle: usize,
+}
+
+/// Everything a backend needs to run a scene.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub grid: Grid,
+    pub shape: Shape,
+    pub particles: Particles,
+    /// Materials in scene order; `body_material[b]` indexes this.
+    pub materials: Vec<Material>,
+    pub body_material: Vec<u32>,
+    pub body_names: Vec<String>,
+    pub constraints: Constraints,
+    pub gravity: Option<Gravity>,
+    pub integrator: Integrator,
+    /// Courant number.
+    pub cfl: f64,
+    /// End time (s).
+    pub t_end: f64,
+    pub probes: Vec<Probe>,
+}
+
+impl Model {
+    /// Builds grid and particles. Fails (with the key to fix) on bodies that
+    /// yield no particles, bodies outside an explicit grid and constraints
+    /// that match no node.
+    pub fn new(scene: &Scene) -> Result<Model, SceneError> {
+        let f = &scene.file;
+        let h = f.grid.h;
+        let bbox = seed::bodies_bbox(scene);
+        let anchor = f.grid.origin.unwrap_or([bbox[0], bbox[1]]);
+        let seeds = seed::seed_particles(scene, anchor, h);
+
+        let body_names: Vec<String> = scene.bodies().map(|(n, _)| n.clone()).collect();
+        for (bi, name) in body_names.iter().enumerate() {
+            if !seeds.iter().any(|s| s.body == bi as u32) {
+                return Err(SceneError::invalid(
+                    format!("bodies.{name}"),
+                    format!(
+                        "is empty: its shapes hold no particle point at h = {h} (shapes smaller than a cell?)"
+                    ),
+                ));
+            }
+        }
+        let ppc = scene.bodies().next().map(|(_, b)| b.ppc).unwrap_or(2);
+        let shape = Shape::new(scene.solver(), h, ppc, f.grid.perturb);
+
+        // Grid extent on the lattice through `anchor`.
+        let snap = |v: f64, a: f64, up: bool| {
+            let q = (v - a) / h;
+            let q = if (q - q.round()).abs() < 1e-9 {
+                q.round()
+            } else {
+                q
+            };
+            a + h * if up { q.ceil() } else { q.floor() }
+        };
+        let (lo, hi) = match (f.grid.min, f.grid.max) {
+            (Some(lo), Some(hi)) => (lo, hi),
+            _ => {
+                let pad = scene.margin + shape.reach_cells() as f64 * h;
+                let mut lo = [bbox[0] - pad, bbox[1] - pad];
+                let mut hi = [bbox[2] + pad, bbox[3] + pad];
+                // A wall stops the grid: nothing moves into it, and nodes
+                // inside it would only pin the body over the support width.
+                let ghost = shape.wall_ghost_cells() as f64 * h;
+                for (axis, upper, at) in walls(scene, bbox) {
+                    if upper {
+                        hi[axis] = hi[axis].min(at + ghost);
+                    } else {
+                        lo[axis] = lo[axis].max(at - ghost);
+                    }
+                }
+                (lo, hi)
+            }
+        };
+        let lo = [snap(lo[0], anchor[0], false), snap(lo[1], anchor[1], false)];
+        let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
+        let nx = ((hi[0] - lo[0]) / h).round() as usize + 1;
+        let ny = ((hi[1] - lo[1]) / h).round() as usize + 1;
+        if nx < 2 || ny < 2 {
+            return Err(SceneError::invalid(
+                "grid.max",
+                "the grid must span at least one cell",
+            ));
+        }
+        if (nx as u64) * (ny as u64) > u32::MAX as u64 / 2 {
+            return Err(SceneError::invalid(
+                "grid.h",
+                format!(
+                    "gives {nx} x {ny} nodes, more than 2^31: use a larger h or a smaller grid"
+                ),
+            ));
+        }
+        let grid = Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed);
+
+        let margin = shape.edge_margin();
+        if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
+            return Err(SceneError::invalid(
+                format!("bodies.{}", body_names[s.body as usize]),
+                format!(
+                    "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
+                     enlarge grid.min/grid.max or drop them to derive the extent",
+                    s.x[0],
+                    s.x[1],
+                    grid.min[0],
+                    grid.min[1],
+                    grid.max()[0],
+                    grid.max()[1],
+                    if margin > 0.0 {
+                        format!(" or within {margin:.6} m of its edge")
+                    } else {
+                        String::new()
+                    }
+                ),
+            ));
+        }
+
+        let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
+        let body_material: Vec<u32> = scene
+            .bodies()
+            .map(|(_, b)| scene.material_index(&b.material) as u32)
+            .collect();
+        let velocities: Vec<[f64; 2]> = scene.bodies().map(|(_, b)| b.velocity).collect();
+        let integrator = match f.solver.integrator {
+            IntegratorKind::Fe => Integrator::Fe,
+            IntegratorKind::Npc => Integrator::Npc {
+                gamma: f.solver.npc_gamma,
+                position: f.solver.npc_position,
+            },
+        };
+        let particles = Particles::from_seeds(
+            &seeds,
+            |b| materials[body_material[b as usize] as usize].density(),
+            |b| velocities[b as usize],
+            matches!(integrator, Integrator::Npc { .. }),
+            matches!(shape, Shape::Lme(_)),
+        );
+
+        let constraints = build_constraints(scene, &grid)?;
+        let gravity = f.gravity.as_ref().map(|g| Gravity {
+            g: g.g,
+            ramp: g.ramp,
+            period: g.ramp_period.unwrap_or(0.0),
+        });
+        let probes = f
+            .output
+            .probes
+            .iter()
+            .map(|(name, &point)| Probe {
+                name: name.clone(),
+                point,
+                particle: particles.nearest(point),
+            })
+            .collect();
+
+        Ok(Model {
+            grid,
+            shape,
+            particles,
+            materials,
+            body_material,
+            body_names,
+            constraints,
+            gravity,
+            integrator,
+            cfl: f.solver.cfl,
+            t_end: f.solver.t_end,
+            probes,
+        })
+    }
+
+    /// Material of particle `p`.
+    #[inline]
+    pub fn material_of(&self, p: usize) -> &Material {
+        &self.materials[self.body_material[self.particles.body[p] as usize] as usize]
+    }
+}
+
+/// Constraints that are walls: a half-plane region beyond the bodies
+/// (e.g. `min = [L, -inf], max = [inf, inf]`) fixing its normal direction.
+/// Yields (axis, on the upper side, position of the wall).
+fn walls(scene: &Scene, bbox: [f64; 4]) -> Vec<(usize, bool, f64)> {
+    let mut out = Vec::new();
+    for c in scene.file.constraints.values() {
+        let fixes = |axis: usize| match c.fix {
+            Fix::X => axis == 0,
+            Fix::Y => axis == 1,
+            Fix::Xy => true,
+        };
+        for axis in 0..2 {
+            let other = 1 - axis;
+            let spans_other = c.min[other] == f64::NEG_INFINITY && c.max[other] == f64::INFINITY;
+            if !spans_other || !fixes(axis) {
+                continue;
+            }
+            let tol = 1e-9 * scene.file.grid.h;
+            if c.max[axis] == f64::INFINITY
+                && c.min[axis].is_finite()
+                && c.min[axis] >= bbox[axis + 2] - tol
+            {
+                out.push((axis, true, c.min[axis]));
+            }
+            if c.min[axis] == f64::NEG_INFINITY
+                && c.max[axis].is_finite()
+                && c.max[axis] <= bbox[axis] + tol
+            {
+                out.push((axis, false, c.max[axis]));
+            }
+        }
+    }
+    out
+}
+
+fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneError> {
+    let mut c = Constraints {
+        fix: vec![0; grid.n_nodes()],
+        groups: Vec::new(),
+    };
+    // Membership is tested on the unperturbed lattice position, so a
+    // perturbed grid fixes the same nodes as the regular one.
+    let eps = 1e-9 * grid.h;
+    for (name, spec) in &scene.file.constraints {
+        let bits = match spec.fix {
+            Fix::X => FIX_X,
+            Fix::Y => FIX_Y,
+            Fix::Xy => FIX_X | FIX_Y,
+        };
+        let mut nodes = Vec::new();
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let p = grid.lattice_pos(i, j);
+                if p[0] >= spec.min[0] - eps
+                    && p[0] <= spec.max[0] + eps
+                    && p[1] >= spec.min[1] - eps
+                    && p[1] <= spec.max[1] + eps
+                {
+                    let n = grid.index(i, j);
+                    c.fix[n] |= bits;
+                    nodes.push(n as u32);
+                }
+            }
+        }
+        if nodes.is_empty() {
+            return Err(SceneError::invalid(
+                format!("constraints.{name}"),
+                format!(
+                    "matches no node: the grid spans ({:.6}, {:.6}) to ({:.6}, {:.6}) with spacing {}",
+                    grid.min[0],
+                    grid.min[1],
+                    grid.max()[0],
+                    grid.max()[1],
+                    grid.h
+                ),
+            ));
+        }
+        c.groups.push(ConstraintGroup {
+            name: name.clone(),
+            nodes,
+            fix: bits,
+        });
+    }
+    Ok(c)
+}

@@ -1,0 +1,294 @@
+//! The scene file as written (TOML, read with serde): every key, its unit and
+//! its default. `docs/scenes.md` documents the same keys for users; keep the
+//! two in step. Validation of values happens in `scene::validate`.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A whole scene file.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Name used for the default output folder `out/<name>`. Default: file stem.
+    pub name: Option<String>,
+    /// Free text shown by `lme-mpm check`.
+    #[serde(default)]
+    pub description: String,
+    /// Exact solution the run is scored against, if any.
+    pub exact: Option<ExactKind>,
+    pub grid: GridSpec,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Bodies by name (their order in the file does not matter: sorted by name).
+    pub bodies: BTreeMap<String, BodySpec>,
+    /// Node constraints by name; reactions are reported per constraint.
+    #[serde(default)]
+    pub constraints: BTreeMap<String, ConstraintSpec>,
+    pub gravity: Option<GravitySpec>,
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// Background grid. The extent is derived from the bodies unless `min`/`max` are given.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Node spacing h (m). Required.
+    pub h: f64,
+    /// A point that is a node (m). Default: lower-left corner of the bodies' bounding box.
+    pub origin: Option<[f64; 2]>,
+    /// Room left beyond the bodies for their motion (m). Default: max |v0| · t_end.
+    pub margin: Option<f64>,
+    /// Explicit lower-left corner of the grid (m); snapped outward to the node lattice.
+    pub min: Option<[f64; 2]>,
+    /// Explicit upper-right corner of the grid (m); snapped outward to the node lattice.
+    pub max: Option<[f64; 2]>,
+    /// Largest random displacement of each interior node coordinate, as a fraction of h.
+    /// 0 = regular grid. Allowed: [0, 0.25). Default 0.
+    #[serde(default)]
+    pub perturb: f64,
+    /// Seed of the node perturbation. Default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// Constitutive model of a material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModel {
+    /// Small-strain increments, plane strain, Hooke's law.
+    LinearElastic,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub model: MaterialModel,
+    /// Initial mass density ρ0 (kg/m³).
+    pub density: f64,
+    /// Young's modulus E (Pa).
+    #[serde(rename = "E")]
+    pub youngs_modulus: f64,
+    /// Poisson's ratio ν, in [0, 0.5).
+    pub nu: f64,
+}
+
+/// How particles are placed inside each grid cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Layout {
+    /// Gauss-Legendre points of the cell (volume = quadrature weight).
+    Gauss,
+    /// Centres of equal sub-cells (the uGIMP layout: voxels neither overlap nor leave gaps).
+    Uniform,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Name of a material in `[materials]`.
+    pub material: String,
+    /// Particles per cell per direction. Default 2.
+    #[serde(default = "default_ppc")]
+    pub ppc: u32,
+    /// Initial velocity (m/s). Default [0, 0].
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Particle layout. Default: `uniform` for uGIMP, `gauss` otherwise.
+    pub layout: Option<Layout>,
+    /// Rectangles `[xmin, ymin, xmax, ymax]` (m).
+    #[serde(default)]
+    pub rects: Vec<[f64; 4]>,
+    /// Disks `[cx, cy, r]` (m).
+    #[serde(default)]
+    pub disks: Vec<[f64; 3]>,
+    /// Simple polygons, each a list of `[x, y]` vertices (m).
+    #[serde(default)]
+    pub polygons: Vec<Vec<[f64; 2]>>,
+}
+
+fn default_ppc() -> u32 {
+    2
+}
+
+/// Directions a constraint fixes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fix {
+    X,
+    Y,
+    Xy,
+}
+
+/// Nodes whose (unperturbed) position lies in the box `[min, max]` have their
+/// velocity and acceleration set to zero in the fixed directions.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Lower-left corner of the region (m); `-inf` allowed.
+    pub min: [f64; 2],
+    /// Upper-right corner of the region (m); `inf` allowed.
+    pub max: [f64; 2],
+    pub fix: Fix,
+}
+
+/// Time history of gravity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ramp {
+    /// Full gravity from t = 0.
+    None,
+    /// The paper's eq. 45: 0.5 g (sin(2πt/T − π/2) + 1) for t ≤ T/2, then g.
+    Sine,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySpec {
+    /// Gravitational acceleration (m/s²), e.g. [0, -9.81].
+    pub g: [f64; 2],
+    /// Default `none`.
+    #[serde(default = "default_ramp")]
+    pub ramp: Ramp,
+    /// T of eq. 45 (s): full gravity is reached at T/2. Required with `ramp = "sine"`.
+    pub ramp_period: Option<f64>,
+}
+
+fn default_ramp() -> Ramp {
+    Ramp::None
+}
+
+/// Shape functions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// Bilinear Q4 (isoparametric on perturbed grids).
+    Linear,
+    /// Uniform GIMP, particle half-width h/(2 ppc).
+    Ugimp,
+    /// Local max-ent (Arroyo & Ortiz), β = γ/h².
+    Lme,
+}
+
+/// Time integrators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorKind {
+    /// Forward Euler in the Zhang et al. (2016) form (paper eqs. 22–23).
+    Fe,
+    /// Newmark predictor-corrector (paper Algorithm 1).
+    Npc,
+}
+
+/// Which nodal velocity moves the particles in the NPC particle update.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NpcPosition {
+    /// x += Δt Σ N v_I(corrected) + ½Δt² a_p (the authors' code).
+    Corrected,
+    /// x += Δt Σ N v_I(predicted) + ½Δt² a_p (the paper's printed eq. 30).
+    Predicted,
+    /// x += Δt Σ N v_I(predicted): Newmark's explicit displacement predictor
+    /// (β = 0), the same displacement the strain increment was computed from.
+    Newmark,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Default `lme`.
+    #[serde(default = "default_shape")]
+    pub shape: ShapeKind,
+    /// Dimensionless LME locality γ (β = γ/h²). Default 4.
+    #[serde(default = "default_lme_gamma")]
+    pub lme_gamma: f64,
+    /// LME support truncation: nodes with exp(−β r²) < tol are dropped. Default 1e-6.
+    #[serde(default = "default_lme_tol")]
+    pub lme_tol: f64,
+    /// Default `npc`.
+    #[serde(default = "default_integrator")]
+    pub integrator: IntegratorKind,
+    /// Newmark γ of the predictor-corrector, in (0, 1]. Default 0.5.
+    #[serde(default = "default_npc_gamma")]
+    pub npc_gamma: f64,
+    /// Default `newmark` (docs/methods.md gives the test that chose it).
+    #[serde(default = "default_npc_position")]
+    pub npc_position: NpcPosition,
+    /// Courant number in (0, 1]: Δt = cfl · h / max(|v_p|, c_p). Default 0.1.
+    #[serde(default = "default_cfl")]
+    pub cfl: f64,
+    /// End time (s). Required.
+    pub t_end: f64,
+}
+
+fn default_shape() -> ShapeKind {
+    ShapeKind::Lme
+}
+fn default_lme_gamma() -> f64 {
+    4.0
+}
+fn default_lme_tol() -> f64 {
+    1e-6
+}
+fn default_integrator() -> IntegratorKind {
+    IntegratorKind::Npc
+}
+fn default_npc_gamma() -> f64 {
+    0.5
+}
+fn default_npc_position() -> NpcPosition {
+    NpcPosition::Newmark
+}
+fn default_cfl() -> f64 {
+    0.1
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Interval between samples of probes, energy and reactions (s). Default: t_end / 500.
+    pub sample_interval: Option<f64>,
+    /// Interval between VTK snapshots (s). Default: none (only the final state, if `vtk_final`).
+    pub vtk_interval: Option<f64>,
+    /// Write a VTK snapshot of the final state. Default true.
+    #[serde(default = "default_true")]
+    pub vtk_final: bool,
+    /// Write `particles.csv` at the end. Default true.
+    #[serde(default = "default_true")]
+    pub particles_csv: bool,
+    /// Named points (m); the particle nearest to each at t = 0 is tracked.
+    #[serde(default)]
+    pub probes: BTreeMap<String, [f64; 2]>,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            sample_interval: None,
+            vtk_interval: None,
+            vtk_final: true,
+            particles_csv: true,
+            probes: BTreeMap::new(),
+        }
+    }
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// Exact solutions known to the code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExactKind {
+    /// 1D bar, free at its left end, fixed at its right end, piecewise-constant
+    /// initial velocity (Dyka's bar, paper appendix A).
+    DykaBar,
+    /// Elastic column on a fixed base under (ramped) gravity (Andersen's block).
+    ElasticColumn,
+}

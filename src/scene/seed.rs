@@ -1,0 +1,308 @@
+//! Particle seeding: reads the bodies' shapes, writes particle positions and
+//! volumes on the cells of the node lattice (spacing h, through `anchor`).
+//!
+//! Rectangles are clipped to each cell and the points placed in the clipped
+//! part, so mass and the body's edges are exact even where an edge does not
+//! fall on a grid line. Disks and polygons keep the cell's points that fall
+//! inside them (volume = the point's share of the cell), so their mass is
+//! exact only as h → 0. A point already inside a rectangle or an earlier disk
+//! or polygon is not seeded twice.
+
+use super::Scene;
+use super::schema::Layout;
+
+/// One particle before it becomes part of `model::Particles`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Seed {
+    /// Position (m).
+    pub x: [f64; 2],
+    /// Initial volume (m² per unit thickness).
+    pub volume: f64,
+    /// Index of the body in `Scene::bodies()` order.
+    pub body: u32,
+}
+
+/// Points and weights on [0, 1] for `n` per direction: Gauss-Legendre, or
+/// equal sub-cell centres. Weights sum to 1.
+pub fn points_1d(layout: Layout, n: u32) -> Vec<(f64, f64)> {
+    match layout {
+        Layout::Uniform => (0..n)
+            .map(|k| ((2 * k + 1) as f64 / (2 * n) as f64, 1.0 / n as f64))
+            .collect(),
+        Layout::Gauss => gauss_legendre(n as usize)
+            .into_iter()
+            .map(|(x, w)| (0.5 * (x + 1.0), 0.5 * w))
+            .collect(),
+    }
+}
+
+/// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n, Golub-Welsch
+/// initial guesses), accurate to round-off for the small n used here.
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            // Three-term recurrence for P_n(x) and its derivative.
+            // After the loop pn = P_n(x) and pn1 = P_{n-1}(x).
+            let (mut pn1, mut pn) = (1.0, x);
+            for k in 2..=n {
+                let next = ((2 * k - 1) as f64 * x * pn - (k - 1) as f64 * pn1) / k as f64;
+                pn1 = pn;
+                pn = next;
+            }
+            dp = n as f64 * (x * pn - pn1) / (x * x - 1.0);
+            let dx = pn / dp;
+            x -= dx;
+            if dx.abs() < 1e-15 {
+                break;
+            }
+        }
+        out.push((x, 2.0 / ((1.0 - x * x) * dp * dp)));
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out
+}
+
+/// Signed area of a polygon (shoelace), positive when counter-clockwise.
+pub fn polygon_area(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        * 0.5
+}
+
+fn inside_polygon(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    let n = poly.len();
+    let mut j = n - 1;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+        {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+fn inside_rect(r: &[f64; 4], p: [f64; 2]) -> bool {
+    p[0] >= r[0] && p[0] <= r[2] && p[1] >= r[1] && p[1] <= r[3]
+}
+
+fn inside_disk(d: &[f64; 3], p: [f64; 2]) -> bool {
+    (p[0] - d[0]).hypot(p[1] - d[1]) <= d[2]
+}
+
+/// Lattice coordinate of `v` on an axis through `anchor` with spacing `h`,
+/// snapped to the nearest integer when within round-off of it.
+fn lattice(v: f64, anchor: f64, h: f64) -> f64 {
+    let q = (v - anchor) / h;
+    if (q - q.round()).abs() < 1e-9 {
+        q.round()
+    } else {
+        q
+    }
+}
+
+/// Seeds every body of `scene` on the lattice through `anchor` with spacing
+/// `h`. Particles come out sorted by cell (row-major) for memory locality.
+pub fn seed_particles(scene: &Scene, anchor: [f64; 2], h: f64) -> Vec<Seed> {
+    let mut seeds: Vec<([i64; 2], Seed)> = Vec::new();
+    let all_rects: Vec<[f64; 4]> = scene
+        .bodies()
+        .flat_map(|(_, b)| b.rects.iter().copied())
+        .collect();
+    // Disks and polygons seeded so far, so later ones skip claimed points.
+    let mut curved: Vec<Curved> = Vec::new();
+
+    for (bi, (_, body)) in scene.bodies().enumerate() {
+        let pts = points_1d(scene.layout(body), body.ppc);
+        let body_id = bi as u32;
+        for r in &body.rects {
+            let (kx0, kx1) = (
+                lattice(r[0], anchor[0], h).floor() as i64,
+                lattice(r[2], anchor[0], h).ceil() as i64,
+            );
+            let (ky0, ky1) = (
+                lattice(r[1], anchor[1], h).floor() as i64,
+                lattice(r[3], anchor[1], h).ceil() as i64,
+            );
+            for ky in ky0..ky1 {
+                let y0 = (anchor[1] + ky as f64 * h).max(r[1]);
+                let y1 = (anchor[1] + (ky + 1) as f64 * h).min(r[3]);
+                if y1 - y0 <= 1e-12 * h {
+                    continue;
+                }
+                for kx in kx0..kx1 {
+                    let x0 = (anchor[0] + kx as f64 * h).max(r[0]);
+                    let x1 = (anchor[0] + (kx + 1) as f64 * h).min(r[2]);
+                    if x1 - x0 <= 1e-12 * h {
+                        continue;
+                    }
+                    for &(sy, wy) in &pts {
+                        for &(sx, wx) in &pts {
+                            let x = [x0 + sx * (x1 - x0), y0 + sy * (y1 - y0)];
+                            let volume = wx * wy * (x1 - x0) * (y1 - y0);
+                            seeds.push((
+                                [ky, kx],
+                                Seed {
+                                    x,
+                                    volume,
+                                    body: body_id,
+                                },
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        let shapes = body
+            .disks
+            .iter()
+            .map(|d| Curved::Disk(*d))
+            .chain(body.polygons.iter().map(|p| Curved::Polygon(p.clone())));
+        for shape in shapes {
+            let bb = shape.bbox();
+            let (kx0, kx1) = (
+                lattice(bb[0], anchor[0], h).floor() as i64,
+                lattice(bb[2], anchor[0], h).ceil() as i64,
+            );
+            let (ky0, ky1) = (
+                lattice(bb[1], anchor[1], h).floor() as i64,
+                lattice(bb[3], anchor[1], h).ceil() as i64,
+            );
+            for ky in ky0..ky1 {
+                for kx in kx0..kx1 {
+                    let (x0, y0) = (anchor[0] + kx as f64 * h, anchor[1] + ky as f64 * h);
+                    for &(sy, wy) in &pts {
+                        for &(sx, wx) in &pts {
+                            let x = [x0 + sx * h, y0 + sy * h];
+                            let claimed = all_rects.iter().any(|r| inside_rect(r, x))
+                                || curved.iter().any(|c| c.contains(x));
+                            if shape.contains(x) && !claimed {
+                                seeds.push((
+                                    [ky, kx],
+                                    Seed {
+                                        x,
+                                        volume: wx * wy * h * h,
+                                        body: body_id,
+                                    },
+                                ));
+                            }
+                        }
+                    }
+                }
+            }
+            curved.push(shape);
+        }
+    }
+    // Stable sort: within a cell, particles keep their seeding order.
+    seeds.sort_by_key(|(cell, _)| *cell);
+    seeds.into_iter().map(|(_, s)| s).collect()
+}
+
+enum Curved {
+    Disk([f64; 3]),
+    Polygon(Vec<[f64; 2]>),
+}
+
+impl Curved {
+    fn contains(&self, p: [f64; 2]) -> bool {
+        match self {
+            Curved::Disk(d) => inside_disk(d, p),
+            Curved::Polygon(poly) => inside_polygon(poly, p),
+        }
+    }
+
+    fn bbox(&self) -> [f64; 4] {
+        match self {
+            Curved::Disk(d) => [d[0] - d[2], d[1] - d[2], d[0] + d[2], d[1] + d[2]],
+            Curved::Polygon(poly) => poly.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| {
+                    [
+                        b[0].min(p[0]),
+                        b[1].min(p[1]),
+                        b[2].max(p[0]),
+                        b[3].max(p[1]),
+                    ]
+                },
+            ),
+        }
+    }
+}
+
+/// Bounding box `[xmin, ymin, xmax, ymax]` of every shape of every body (m).
+pub fn bodies_bbox(scene: &Scene) -> [f64; 4] {
+    let mut bb = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut grow = |b: [f64; 4]| {
+        bb = [
+            bb[0].min(b[0]),
+            bb[1].min(b[1]),
+            bb[2].max(b[2]),
+            bb[3].max(b[3]),
+        ];
+    };
+    for (_, body) in scene.bodies() {
+        body.rects.iter().for_each(|r| grow(*r));
+        body.disks
+            .iter()
+            .for_each(|d| grow(Curved::Disk(*d).bbox()));
+        body.polygons
+            .iter()
+            .for_each(|p| grow(Curved::Polygon(p.clone()).bbox()));
+    }
+    bb
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_of_degree_2n_minus_1() {
+        for n in 1..=6 {
+            let gl = gauss_legendre(n);
+            assert!((gl.iter().map(|p| p.1).sum::<f64>() - 2.0).abs() < 1e-13);
+            let deg = 2 * n - 1;
+            let exact = if deg % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (deg as f64 + 1.0)
+            };
+            let got: f64 = gl.iter().map(|(x, w)| w * x.powi(deg as i32)).sum();
+            assert!((got - exact).abs() < 1e-13, "n = {n}");
+            let even = 2 * n - 2;
+            let got: f64 = gl.iter().map(|(x, w)| w * x.powi(even as i32)).sum();
+            assert!((got - 2.0 / (even as f64 + 1.0)).abs() < 1e-13, "n = {n}");
+        }
+        let two = gauss_legendre(2);
+        assert!((two[1].0 - 1.0 / 3f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn polygon_helpers() {
+        let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        assert_eq!(polygon_area(&sq), 1.0);
+        assert!(inside_polygon(&sq, [0.5, 0.5]));
+        assert!(!inside_polygon(&sq, [1.5, 0.5]));
+    }
+}

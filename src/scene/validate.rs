@@ -1,0 +1,426 @@
+//! Range checks on every scene value. Each failure names the key and says
+//! what is allowed. Geometric checks that need the grid (empty bodies, bodies
+//! outside an explicit grid, constraints that match no node) are in
+//! `model::Model::new`.
+
+use super::Scene;
+use super::schema::*;
+use crate::error::SceneError;
+use crate::shape::lme;
+
+fn finite(key: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            key,
+            format!("must be a finite number, got {v}"),
+        ))
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), SceneError> {
+    finite(key, v)?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(key, format!("must be > 0, got {v}")))
+    }
+}
+
+fn finite_point(key: &str, p: &[f64]) -> Result<(), SceneError> {
+    for &v in p {
+        finite(key, v)?;
+    }
+    Ok(())
+}
+
+pub(super) fn check(file: SceneFile, default_name: &str) -> Result<Scene, SceneError> {
+    let name = file
+        .name
+        .clone()
+        .unwrap_or_else(|| default_name.to_string());
+    if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
+        return Err(SceneError::invalid(
+            "name",
+            format!("must be a plain folder name (no slashes), got {name:?}"),
+        ));
+    }
+
+    // --- solver -----------------------------------------------------------
+    let s = &file.solver;
+    positive("solver.t_end", s.t_end)?;
+    finite("solver.cfl", s.cfl)?;
+    if !(s.cfl > 0.0 && s.cfl <= 1.0) {
+        return Err(SceneError::invalid(
+            "solver.cfl",
+            format!("must be in (0, 1], got {}", s.cfl),
+        ));
+    }
+    finite("solver.npc_gamma", s.npc_gamma)?;
+    if !(s.npc_gamma > 0.0 && s.npc_gamma <= 1.0) {
+        return Err(SceneError::invalid(
+            "solver.npc_gamma",
+            format!("must be in (0, 1], got {}", s.npc_gamma),
+        ));
+    }
+    finite("solver.lme_tol", s.lme_tol)?;
+    if !(s.lme_tol > 0.0 && s.lme_tol <= 1e-2) {
+        return Err(SceneError::invalid(
+            "solver.lme_tol",
+            format!("must be in (0, 1e-2], got {}", s.lme_tol),
+        ));
+    }
+
+    // --- grid -------------------------------------------------------------
+    let g = &file.grid;
+    positive("grid.h", g.h)?;
+    if let Some(o) = g.origin {
+        finite_point("grid.origin", &o)?;
+    }
+    if let Some(m) = g.margin {
+        finite("grid.margin", m)?;
+        if m < 0.0 {
+            return Err(SceneError::invalid(
+                "grid.margin",
+                format!("must be >= 0, got {m}"),
+            ));
+        }
+    }
+    match (g.min, g.max) {
+        (None, None) => {}
+        (Some(lo), Some(hi)) => {
+            finite_point("grid.min", &lo)?;
+            finite_point("grid.max", &hi)?;
+            if !(lo[0] < hi[0] && lo[1] < hi[1]) {
+                return Err(SceneError::invalid(
+                    "grid.max",
+                    format!("must exceed grid.min in both coordinates, got min {lo:?}, max {hi:?}"),
+                ));
+            }
+        }
+        (Some(_), None) => {
+            return Err(SceneError::invalid(
+                "grid.max",
+                "is required when grid.min is set",
+            ));
+        }
+        (None, Some(_)) => {
+            return Err(SceneError::invalid(
+                "grid.min",
+                "is required when grid.max is set",
+            ));
+        }
+    }
+    finite("grid.perturb", g.perturb)?;
+    if !(0.0..0.25).contains(&g.perturb) {
+        return Err(SceneError::invalid(
+            "grid.perturb",
+            format!(
+                "must be in [0, 0.25) (a fraction of h; larger moves can fold Q4 cells), got {}",
+                g.perturb
+            ),
+        ));
+    }
+
+    if s.shape == ShapeKind::Lme {
+        finite("solver.lme_gamma", s.lme_gamma)?;
+        let (gmin, gmax) = (
+            lme::gamma_min(s.lme_tol),
+            lme::gamma_max(s.lme_tol, g.perturb),
+        );
+        if !(s.lme_gamma >= gmin && s.lme_gamma <= gmax) {
+            return Err(SceneError::invalid(
+                "solver.lme_gamma",
+                format!(
+                    "must be in [{gmin:.2}, {gmax:.2}] for lme_tol = {:e} and grid.perturb = {} \
+                     (above, the support cannot enclose a cell; below, it spans more than {} cells), got {}",
+                    s.lme_tol,
+                    g.perturb,
+                    lme::MAX_REACH_CELLS,
+                    s.lme_gamma
+                ),
+            ));
+        }
+    }
+
+    // --- materials --------------------------------------------------------
+    if file.materials.is_empty() {
+        return Err(SceneError::invalid(
+            "materials",
+            "must define at least one material",
+        ));
+    }
+    for (mname, m) in &file.materials {
+        let key = |k: &str| format!("materials.{mname}.{k}");
+        positive(&key("density"), m.density)?;
+        positive(&key("E"), m.youngs_modulus)?;
+        finite(&key("nu"), m.nu)?;
+        if !(m.nu > -1.0 && m.nu < 0.5) {
+            return Err(SceneError::invalid(
+                key("nu"),
+                format!("must be in (-1, 0.5), got {}", m.nu),
+            ));
+        }
+    }
+
+    // --- bodies -----------------------------------------------------------
+    if file.bodies.is_empty() {
+        return Err(SceneError::invalid(
+            "bodies",
+            "must define at least one body",
+        ));
+    }
+    let mut ugimp_ppc: Option<(String, u32)> = None;
+    for (bname, b) in &file.bodies {
+        let key = |k: &str| format!("bodies.{bname}.{k}");
+        if !file.materials.contains_key(&b.material) {
+            let known: Vec<_> = file.materials.keys().map(String::as_str).collect();
+            return Err(SceneError::invalid(
+                key("material"),
+                format!(
+                    "names `{}`, which is not defined; defined: {}",
+                    b.material,
+                    known.join(", ")
+                ),
+            ));
+        }
+        if !(1..=6).contains(&b.ppc) {
+            return Err(SceneError::invalid(
+                key("ppc"),
+                format!("must be in 1..=6, got {}", b.ppc),
+            ));
+        }
+        finite_point(&key("velocity"), &b.velocity)?;
+        if b.rects.is_empty() && b.disks.is_empty() && b.polygons.is_empty() {
+            return Err(SceneError::invalid(
+                bname_key(bname),
+                "is empty: give at least one of rects, disks, polygons",
+            ));
+        }
+        for (i, r) in b.rects.iter().enumerate() {
+            finite_point(&key("rects"), r)?;
+            if !(r[0] < r[2] && r[1] < r[3]) {
+                return Err(SceneError::invalid(
+                    format!("bodies.{bname}.rects[{i}]"),
+                    format!(
+                        "must be [xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax, got {r:?}"
+                    ),
+                ));
+            }
+        }
+        for (i, d) in b.disks.iter().enumerate() {
+            finite_point(&key("disks"), d)?;
+            if d[2] <= 0.0 {
+                return Err(SceneError::invalid(
+                    format!("bodies.{bname}.disks[{i}]"),
+                    format!("must be [cx, cy, r] with r > 0, got {d:?}"),
+                ));
+            }
+        }
+        for (i, poly) in b.polygons.iter().enumerate() {
+            for p in poly {
+                finite_point(&key("polygons"), p)?;
+            }
+            if poly.len() < 3 || super::seed::polygon_area(poly).abs() <= 0.0 {
+                return Err(SceneError::invalid(
+                    format!("bodies.{bname}.polygons[{i}]"),
+                    "must have at least 3 vertices enclosing a positive area",
+                ));
+            }
+        }
+        if s.shape == ShapeKind::Ugimp {
+            match &ugimp_ppc {
+                None => ugimp_ppc = Some((bname.clone(), b.ppc)),
+                Some((first, ppc)) if *ppc != b.ppc => {
+                    return Err(SceneError::invalid(
+                        key("ppc"),
+                        format!(
+                            "is {} but bodies.{first}.ppc is {ppc}: uGIMP uses one particle size \
+                             h/(2 ppc), so every body needs the same ppc",
+                            b.ppc
+                        ),
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    check_rect_overlaps(&file)?;
+
+    // --- constraints ------------------------------------------------------
+    for (cname, c) in &file.constraints {
+        for v in c.min.iter().chain(&c.max) {
+            if v.is_nan() {
+                return Err(SceneError::invalid(
+                    format!("constraints.{cname}"),
+                    "min/max must not be NaN",
+                ));
+            }
+        }
+        if !(c.min[0] <= c.max[0] && c.min[1] <= c.max[1]) {
+            return Err(SceneError::invalid(
+                format!("constraints.{cname}.max"),
+                format!(
+                    "must be >= min in both coordinates, got min {:?}, max {:?}",
+                    c.min, c.max
+                ),
+            ));
+        }
+    }
+
+    // --- gravity ----------------------------------------------------------
+    if let Some(gr) = &file.gravity {
+        finite_point("gravity.g", &gr.g)?;
+        match (gr.ramp, gr.ramp_period) {
+            (Ramp::Sine, None) => {
+                return Err(SceneError::invalid(
+                    "gravity.ramp_period",
+                    "is required with ramp = \"sine\"",
+                ));
+            }
+            (_, Some(t)) => positive("gravity.ramp_period", t)?,
+            _ => {}
+        }
+    }
+
+    // --- output -----------------------------------------------------------
+    let o = &file.output;
+    let sample_interval = match o.sample_interval {
+        Some(v) => {
+            positive("output.sample_interval", v)?;
+            v
+        }
+        None => s.t_end / 500.0,
+    };
+    if let Some(v) = o.vtk_interval {
+        positive("output.vtk_interval", v)?;
+    }
+    for (pname, p) in &o.probes {
+        finite_point(&format!("output.probes.{pname}"), p)?;
+    }
+
+    // --- exact solution applicability -------------------------------------
+    if let Some(kind) = file.exact {
+        check_exact(&file, kind)?;
+    }
+
+    let margin = match g.margin {
+        Some(m) => m,
+        None => {
+            file.bodies
+                .values()
+                .map(|b| b.velocity[0].hypot(b.velocity[1]))
+                .fold(0.0, f64::max)
+                * s.t_end
+        }
+    };
+    Ok(Scene {
+        name,
+        file,
+        margin,
+        sample_interval,
+    })
+}
+
+fn bname_key(bname: &str) -> String {
+    format!("bodies.{bname}")
+}
+
+/// Rectangles may touch but not overlap (overlaps would double the mass).
+fn check_rect_overlaps(file: &SceneFile) -> Result<(), SceneError> {
+    let rects: Vec<(String, [f64; 4])> = file
+        .bodies
+        .iter()
+        .flat_map(|(n, b)| {
+            b.rects
+                .iter()
+                .enumerate()
+                .map(move |(i, r)| (format!("bodies.{n}.rects[{i}]"), *r))
+        })
+        .collect();
+    for (i, (ka, a)) in rects.iter().enumerate() {
+        for (kb, b) in &rects[i + 1..] {
+            let ox = a[2].min(b[2]) - a[0].max(b[0]);
+            let oy = a[3].min(b[3]) - a[1].max(b[1]);
+            if ox > 0.0 && oy > 0.0 {
+                return Err(SceneError::invalid(
+                    ka.clone(),
+                    format!("overlaps {kb}: rectangles may touch but not overlap"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
+    let what = match kind {
+        ExactKind::DykaBar => "dyka_bar",
+        ExactKind::ElasticColumn => "elastic_column",
+    };
+    if file.materials.len() != 1 {
+        return Err(SceneError::invalid(
+            "exact",
+            format!(
+                "= \"{what}\" needs exactly one material, the scene has {}",
+                file.materials.len()
+            ),
+        ));
+    }
+    let m = file.materials.values().next().expect("one material");
+    if m.nu != 0.0 {
+        return Err(SceneError::invalid(
+            "exact",
+            format!(
+                "= \"{what}\" is a 1D solution and needs nu = 0 (plane strain then has no lateral coupling), got nu = {}",
+                m.nu
+            ),
+        ));
+    }
+    if file
+        .bodies
+        .values()
+        .any(|b| !b.disks.is_empty() || !b.polygons.is_empty())
+    {
+        return Err(SceneError::invalid(
+            "exact",
+            format!("= \"{what}\" needs bodies made of rects only"),
+        ));
+    }
+    match kind {
+        ExactKind::DykaBar => {
+            if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
+                return Err(SceneError::invalid(
+                    "exact",
+                    "= \"dyka_bar\" needs no gravity",
+                ));
+            }
+            if file.bodies.values().any(|b| b.velocity[1] != 0.0) {
+                return Err(SceneError::invalid(
+                    "exact",
+                    "= \"dyka_bar\" needs horizontal initial velocities",
+                ));
+            }
+        }
+        ExactKind::ElasticColumn => {
+            let ok = file
+                .gravity
+                .as_ref()
+                .is_some_and(|g| g.g[0] == 0.0 && g.g[1] < 0.0);
+            if !ok {
+                return Err(SceneError::invalid(
+                    "exact",
+                    "= \"elastic_column\" needs gravity along -y (gravity.g = [0, -g])",
+                ));
+            }
+            if file.bodies.values().any(|b| b.velocity != [0.0, 0.0]) {
+                return Err(SceneError::invalid(
+                    "exact",
+                    "= \"elastic_column\" needs bodies at rest",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
