@@ -1,0 +1,50 @@
+//! What the run driver needs from a backend (CPU reference or GPU): advance
+//! in time, report probes, energy and reactions at sample times, and hand
+//! back the particle state at the end.
+
+use crate::cpu::energy::Energy;
+use crate::fault::Fault;
+use crate::model::{Model, Particles};
+
+/// State of one probe particle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeState {
+    pub x: [f64; 2],
+    pub v: [f64; 2],
+    pub stress: [f64; 3],
+}
+
+/// Everything recorded at a sample time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Time of the sample (s).
+    pub t: f64,
+    /// In `Model::probes` order.
+    pub probes: Vec<ProbeState>,
+    pub energy: Energy,
+    /// Per constraint group, reaction of the last step (N per unit thickness).
+    pub reactions: Vec<[f64; 2]>,
+}
+
+pub trait Backend {
+    /// Human-readable description, e.g. "cpu (f64, 2 threads)".
+    fn name(&self) -> String;
+    /// Simulated time reached (s).
+    fn time(&self) -> f64;
+    /// Steps taken.
+    fn steps(&self) -> u64;
+    /// Takes steps until the time reaches `t_stop` or the model's `t_end`.
+    /// The last step before `t_end` is shortened to land on it exactly;
+    /// other stops may be passed by less than one step.
+    fn advance(&mut self, t_stop: f64) -> Result<(), Fault>;
+    /// Takes exactly `n` steps (or fewer if t_end comes first); for benchmarks.
+    fn advance_steps(&mut self, n: u64) -> Result<(), Fault>;
+    /// Probes, energy and reactions now.
+    fn sample(&mut self) -> Sample;
+    /// Particle state now (the GPU backend downloads it).
+    fn particles(&mut self) -> &Particles;
+    /// The model being run (its particles may be stale on the GPU backend).
+    fn model(&self) -> &Model;
+    /// Memory the backend holds per particle, grid included (bytes).
+    fn bytes_per_particle(&self) -> f64;
+}

@@ -1,0 +1,225 @@
+//! Throughput benchmark: particle-steps per second of a whole step, per
+//! backend, shape function and particle count, on a synthetic scene (an
+//! elastic square set vibrating by its initial velocity field, so every
+//! stage does real work). Used by `lme-mpm bench` and `benches/throughput.rs`.
+
+use crate::backend::Backend;
+use crate::error::Result;
+use crate::model::Model;
+use crate::run::{BackendChoice, make_backend};
+use crate::scene::{Override, Scene};
+use std::fmt::Write;
+use std::time::Instant;
+
+/// One benchmark configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    /// Label, e.g. "lme-g2".
+    pub label: String,
+    /// `--set` overrides applied to the synthetic scene.
+    pub sets: Vec<String>,
+}
+
+impl Case {
+    pub fn new(label: &str, sets: &[&str]) -> Self {
+        Case {
+            label: label.to_string(),
+            sets: sets.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+}
+
+/// The shape functions the issue's table asks for, with NPC.
+pub fn standard_cases() -> Vec<Case> {
+    vec![
+        Case::new("linear", &["solver.shape=linear"]),
+        Case::new("ugimp", &["solver.shape=ugimp"]),
+        Case::new("lme-g2", &["solver.shape=lme", "solver.lme_gamma=2"]),
+        Case::new("lme-g3", &["solver.shape=lme", "solver.lme_gamma=3"]),
+        Case::new("lme-g4", &["solver.shape=lme", "solver.lme_gamma=4"]),
+    ]
+}
+
+/// A square of `cells`² cells, 2×2 particles per cell, h = 1 m, resting on
+/// a wall; its two halves start towards each other at 0.5 m/s, so it
+/// vibrates in place (zero net momentum) and every stage does real work.
+/// No gravity; t_end far away so a benchmark never reaches it.
+pub fn scene(particles: usize, case: &Case) -> Result<Scene> {
+    let cells = ((particles as f64 / 4.0).sqrt().round() as usize).max(2);
+    let side = cells as f64;
+    let half = (cells / 2) as f64;
+    let text = format!(
+        r#"
+name = "bench"
+[grid]
+h = 1.0
+margin = 1.0
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.left]
+material = "m"
+velocity = [0.5, 0.0]
+rects = [[0.0, 0.0, {half}, {side}]]
+[bodies.right]
+material = "m"
+velocity = [-0.5, 0.0]
+rects = [[{half}, 0.0, {side}, {side}]]
+[constraints.wall]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "y"
+[solver]
+t_end = 1e9
+"#
+    );
+    let overrides = case
+        .sets
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    Ok(Scene::from_str(&text, "bench scene", "bench", &overrides)?)
+}
+
+/// One measured point.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub backend: String,
+    pub case: String,
+    pub particles: usize,
+    pub steps: u64,
+    pub seconds: f64,
+    pub particle_steps_per_second: f64,
+    pub bytes_per_particle: f64,
+}
+
+/// Times whole steps of `backend` for at least `min_seconds` (after one
+/// warm-up step), at most `max_steps`.
+pub fn time_steps(
+    backend: &mut dyn Backend,
+    min_seconds: f64,
+    max_steps: u64,
+) -> Result<(u64, f64)> {
+    backend
+        .advance_steps(1)
+        .map_err(|f| crate::Error::Gpu(format!("benchmark scene went unstable: {f}")))?;
+    let n = backend.model().particles.len() as f64;
+    let start = Instant::now();
+    let mut steps = 0u64;
+    let mut batch = 1u64;
+    while start.elapsed().as_secs_f64() < min_seconds && steps < max_steps {
+        let b = batch.min(max_steps - steps);
+        backend
+            .advance_steps(b)
+            .map_err(|f| crate::Error::Gpu(format!("benchmark scene went unstable: {f}")))?;
+        steps += b;
+        // Grow batches so timer overhead stays small on fast backends.
+        if start.elapsed().as_secs_f64() * 20.0 < min_seconds {
+            batch = (batch * 2).min(1 << 16);
+        }
+        let _ = n;
+    }
+    Ok((steps, start.elapsed().as_secs_f64()))
+}
+
+/// Measures every (case, particle count) on `choice`.
+pub fn run(
+    choice: BackendChoice,
+    cases: &[Case],
+    counts: &[usize],
+    min_seconds: f64,
+    mut on_point: impl FnMut(&Point),
+) -> Result<Vec<Point>> {
+    let mut out = Vec::new();
+    for case in cases {
+        for &n in counts {
+            let scene = scene(n, case)?;
+            let model = Model::new(&scene)?;
+            let particles = model.particles.len();
+            let mut backend = make_backend(choice, model, false)?;
+            let (steps, seconds) = time_steps(backend.as_mut(), min_seconds, 100_000)?;
+            let p = Point {
+                backend: backend.name(),
+                case: case.label.clone(),
+                particles,
+                steps,
+                seconds,
+                particle_steps_per_second: particles as f64 * steps as f64 / seconds,
+                bytes_per_particle: backend.bytes_per_particle(),
+            };
+            on_point(&p);
+            out.push(p);
+        }
+    }
+    Ok(out)
+}
+
+/// CSV of measured points.
+pub fn csv(points: &[Point]) -> String {
+    let mut s = String::from(
+        "backend,case,particles,steps,seconds,particle_steps_per_second,bytes_per_particle\n",
+    );
+    for p in points {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{}",
+            p.backend,
+            p.case,
+            p.particles,
+            p.steps,
+            p.seconds,
+            p.particle_steps_per_second,
+            p.bytes_per_particle
+        );
+    }
+    s
+}
+
+/// Markdown table row for a point.
+pub fn table_row(p: &Point) -> String {
+    format!(
+        "| {} | {} | {} | {} | {:.3} | {:.3e} | {:.0} |",
+        p.backend,
+        p.case,
+        p.particles,
+        p.steps,
+        p.seconds,
+        p.particle_steps_per_second,
+        p.bytes_per_particle
+    )
+}
+
+pub const TABLE_HEADER: &str = "| backend | case | particles | steps | seconds | particle-steps/s | bytes/particle |\n|---|---|---|---|---|---|---|";
+
+/// A line describing this machine for the docs: CPU model and thread count.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    format!("{cpu}, {} threads", rayon::current_num_threads())
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the system clock.
+pub fn today() -> String {
+    let days = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs() / 86_400) as i64;
+    // Civil-from-days (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}

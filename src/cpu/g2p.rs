@@ -1,0 +1,106 @@
+//! Stage `g2p`: move the particles with the nodal solution (paper eqs. 22–23
+//! for FE, Algorithm 1 step 8 for NPC), then check each particle is still
+//! finite and inside the grid.
+//! FE:  v_p += Δt Σ N f/m;  x_p += Δt Σ N v_I (v_I after the momentum update).
+//! NPC: a_p = Σ N f/m;  v_p += Δt a_p;  x_p += Δt Σ N v_I + ½ Δt² a_p, with
+//!      v_I the corrected or the predicted nodal velocity (`NpcPosition`).
+//! GPU twin: `shaders/g2p.wgsl`.
+
+use super::ShapeCache;
+use crate::fault::{Fault, FaultKind};
+use crate::model::{Grid, Integrator};
+use crate::scene::NpcPosition;
+use crate::shape::ShapeFault;
+use rayon::prelude::*;
+
+#[derive(Debug, Clone, Copy)]
+pub struct G2pParams {
+    pub dt: f64,
+    pub integrator: Integrator,
+    pub mass_eps: f64,
+    /// Distance (m) a particle must keep from the grid's edge.
+    pub edge_margin: f64,
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn g2p(
+    cache: &ShapeCache,
+    mv: &[[f64; 3]],
+    force: &[[f64; 2]],
+    grid: &Grid,
+    prm: G2pParams,
+    x: &mut [[f64; 2]],
+    v: &mut [[f64; 2]],
+    a: &mut [[f64; 2]],
+) -> Result<(), Fault> {
+    let dt = prm.dt;
+    let kernel =
+        |p: usize, x: &mut [f64; 2], v: &mut [f64; 2], a: Option<&mut [f64; 2]>| -> Option<Fault> {
+            let (nodes, w) = cache.particle(p);
+            // Σ N f/m and Σ N v_I over nodes with mass.
+            let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
+            for (&node, wk) in nodes.iter().zip(w) {
+                let n = &mv[node as usize];
+                if n[0] > prm.mass_eps {
+                    let f = &force[node as usize];
+                    acc[0] += wk[0] * f[0] / n[0];
+                    acc[1] += wk[0] * f[1] / n[0];
+                    vel[0] += wk[0] * n[1];
+                    vel[1] += wk[0] * n[2];
+                }
+            }
+            v[0] += dt * acc[0];
+            v[1] += dt * acc[1];
+            match prm.integrator {
+                Integrator::Fe => {
+                    x[0] += dt * vel[0];
+                    x[1] += dt * vel[1];
+                }
+                Integrator::Npc { gamma, position } => {
+                    if position != NpcPosition::Corrected {
+                        // v_pred = v_corr − γ Δt f/m, interpolated.
+                        vel[0] -= gamma * dt * acc[0];
+                        vel[1] -= gamma * dt * acc[1];
+                    }
+                    let half_dt2 = if position == NpcPosition::Newmark {
+                        0.0
+                    } else {
+                        0.5 * dt * dt
+                    };
+                    x[0] += dt * vel[0] + half_dt2 * acc[0];
+                    x[1] += dt * vel[1] + half_dt2 * acc[1];
+                    if let Some(a) = a {
+                        *a = acc;
+                    }
+                }
+            }
+            if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
+                return Some(Fault::at(
+                    p,
+                    FaultKind::NonFinite {
+                        field: "position or velocity",
+                    },
+                ));
+            }
+            if !grid.contains(*x, prm.edge_margin) {
+                return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
+            }
+            None
+        };
+    let fault = if a.is_empty() {
+        (x.par_iter_mut(), v.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(p, (x, v))| kernel(p, x, v, None))
+            .reduce(|| None, Fault::first)
+    } else {
+        (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(p, (x, v, a))| kernel(p, x, v, Some(a)))
+            .reduce(|| None, Fault::first)
+    };
+    fault.map_or(Ok(()), Err)
+}

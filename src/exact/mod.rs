@@ -1,0 +1,33 @@
+//! Exact solutions the benchmarks are scored against, built from the scene
+//! (geometry, material, loads) so a changed scene is scored correctly.
+
+pub mod column;
+pub mod dyka;
+
+use crate::model::{Model, Particles};
+use crate::scene::{ExactKind, Scene};
+use serde::Serialize;
+
+/// Error figures written to `summary.json` under `"errors"`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Errors {
+    Dyka(dyka::DykaErrors),
+    Column(column::ColumnErrors),
+}
+
+/// Scores the particle state at time `t` against the scene's exact solution.
+pub fn score(
+    kind: ExactKind,
+    scene: &Scene,
+    model: &Model,
+    particles: &Particles,
+    t: f64,
+) -> Errors {
+    match kind {
+        ExactKind::DykaBar => Errors::Dyka(dyka::DykaBar::from_scene(scene).score(particles, t)),
+        ExactKind::ElasticColumn => {
+            Errors::Column(column::ElasticColumn::from_scene(scene, model).score(particles, t))
+        }
+    }
+}

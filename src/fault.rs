@@ -1,0 +1,75 @@
+//! Why a run went unstable, and which particle showed it first. A fault is
+//! a result of the run (status `unstable`), never a panic.
+
+use crate::shape::ShapeFault;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FaultKind {
+    /// The shape function could not be evaluated (left the grid, LME Newton failed).
+    Shape(ShapeFault),
+    /// A field became NaN or infinite.
+    NonFinite { field: &'static str },
+    /// 1 + tr(Δε) ≤ 0: the particle's volume would vanish or turn negative.
+    NonPositiveDensity,
+    /// Kinetic + strain energy grew past `ENERGY_RUNAWAY` times the energy the
+    /// run could have received (initial energy plus a bound on the work of gravity).
+    EnergyRunaway { ratio: f64 },
+}
+
+/// The first problem a step found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fault {
+    /// Particle index (`id` in particles.csv), when one particle is to blame.
+    pub particle: Option<usize>,
+    pub kind: FaultKind,
+}
+
+impl Fault {
+    pub fn at(particle: usize, kind: FaultKind) -> Self {
+        Fault {
+            particle: Some(particle),
+            kind,
+        }
+    }
+
+    /// Keeps the fault of the lowest particle index, so parallel stages
+    /// report the same particle every run.
+    pub fn first(a: Option<Fault>, b: Option<Fault>) -> Option<Fault> {
+        match (a, b) {
+            (Some(x), Some(y)) => Some(if y.particle < x.particle { y } else { x }),
+            (x, None) => x,
+            (None, y) => y,
+        }
+    }
+
+    /// Short machine-friendly reason for `summary.json`.
+    pub fn code(&self) -> &'static str {
+        match self.kind {
+            FaultKind::Shape(ShapeFault::OutsideGrid) => "left_grid",
+            FaultKind::Shape(_) => "lme_newton",
+            FaultKind::NonFinite { .. } => "non_finite",
+            FaultKind::NonPositiveDensity => "non_positive_density",
+            FaultKind::EnergyRunaway { .. } => "energy_runaway",
+        }
+    }
+}
+
+impl std::fmt::Display for Fault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.kind {
+            FaultKind::Shape(s) => write!(f, "{s}")?,
+            FaultKind::NonFinite { field } => write!(f, "{field} became NaN or infinite")?,
+            FaultKind::NonPositiveDensity => {
+                write!(f, "density would become non-positive (1 + tr Δε ≤ 0)")?
+            }
+            FaultKind::EnergyRunaway { ratio } => write!(
+                f,
+                "energy runaway: kinetic + strain energy is {ratio:.1} times what the loads could supply"
+            )?,
+        }
+        if let Some(p) = self.particle {
+            write!(f, " (particle {p})")?;
+        }
+        Ok(())
+    }
+}

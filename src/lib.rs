@@ -1,0 +1,26 @@
+//! lme-mpm: a 2D Material Point Method with Local Max-Ent (LME) shape
+//! functions and the Newmark predictor-corrector (NPC) of Molinos et al.,
+//! beside linear (Q4) and uGIMP shape functions and Forward Euler, with a
+//! CPU reference path (f64, rayon) whose stages have WGSL twins.
+//!
+//! A run: `scene::Scene::load` → `model::Model::new` → a `backend::Backend`
+//! (`cpu::CpuBackend`) → `solver::drive` → `output`. The step itself is the
+//! ordered stage list `solver::STEP`.
+
+pub mod backend;
+pub mod bench;
+pub mod cpu;
+pub mod docgen;
+pub mod error;
+pub mod exact;
+pub mod fault;
+pub mod material;
+pub mod model;
+pub mod output;
+pub mod rng;
+pub mod run;
+pub mod scene;
+pub mod shape;
+pub mod solver;
+
+pub use error::{Error, Result, SceneError};

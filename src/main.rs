@@ -1,0 +1,213 @@
+//! The `lme-mpm` command line: run, check. Exit codes: 0 completed,
+//! 2 invalid input, 3 unstable run, 1 anything else.
+
+use clap::{Parser, Subcommand};
+use lme_mpm::run::{self, BackendChoice, RunOptions};
+use lme_mpm::scene::{Override, Scene};
+use lme_mpm::solver::RunStatus;
+use lme_mpm::{Error, SceneError};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME/uGIMP/linear shape functions, FE/NPC time integration, CPU and GPU (wgpu)", long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene and write its outputs (summary.json, probes.csv, particles.csv, VTK).
+    Run {
+        /// Scene file (TOML), e.g. cases/dyka_bar.toml.
+        scene: PathBuf,
+        /// Where to run: auto = GPU when an adapter exists, else CPU.
+        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+        backend: BackendChoice,
+        /// Output folder. Default: out/<scene name>.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene key, e.g. --set solver.shape=ugimp --set grid.h=0.0005 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress bar and no result line.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Check a scene without running it: prints particles, nodes, time step and memory.
+    Check {
+        scene: PathBuf,
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// Measure particle-steps per second of whole steps on a synthetic scene.
+    Bench {
+        /// Backend to measure.
+        #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
+        backend: BackendChoice,
+        /// Particle counts, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
+        particles: Vec<usize>,
+        /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4.
+        #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
+        cases: Vec<String>,
+        /// Seconds of stepping per point (after one warm-up step).
+        #[arg(long, default_value_t = 2.0)]
+        seconds: f64,
+        /// Folder for bench.csv.
+        #[arg(long, default_value = "out/bench")]
+        out: PathBuf,
+        /// Also rewrite the measured table in this markdown file (e.g. docs/performance.md).
+        #[arg(long)]
+        doc: Option<PathBuf>,
+    },
+}
+
+fn load(path: &std::path::Path, set: &[String]) -> Result<Scene, SceneError> {
+    let overrides = set
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    Scene::load(path, &overrides)
+}
+
+fn fail(e: &Error) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::from(e.exit_code() as u8)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            scene,
+            backend,
+            out,
+            set,
+            quiet,
+        } => {
+            let scene = match load(&scene, &set) {
+                Ok(s) => s,
+                Err(e) => return fail(&Error::Scene(e)),
+            };
+            let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+            let opts = RunOptions {
+                backend,
+                out: out.clone(),
+                progress: !quiet && std::io::stderr().is_terminal(),
+                verbose: !quiet,
+            };
+            match run::run(&scene, &opts) {
+                Ok(outcome) => {
+                    let s = &outcome.summary;
+                    if !quiet {
+                        eprintln!(
+                            "{}: t = {:.6e} s, {} steps, {} particles, {:.3e} particle-steps/s on {}",
+                            s.status,
+                            s.t,
+                            s.steps,
+                            s.particles,
+                            s.particle_steps_per_second,
+                            s.backend
+                        );
+                        if let Some(r) = &s.reason {
+                            eprintln!("reason: {r}");
+                        }
+                        if let Some(e) = &s.errors {
+                            eprintln!("errors: {}", serde_json::to_string(e).unwrap_or_default());
+                        }
+                        eprintln!("outputs: {}", out.display());
+                    }
+                    match outcome.status {
+                        RunStatus::Completed => ExitCode::SUCCESS,
+                        RunStatus::Unstable { .. } => ExitCode::from(3),
+                    }
+                }
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Bench {
+            backend,
+            particles,
+            cases,
+            seconds,
+            out,
+            doc,
+        } => bench(backend, &particles, &cases, seconds, &out, doc.as_deref()),
+        Command::Check { scene, set } => {
+            let scene = match load(&scene, &set) {
+                Ok(s) => s,
+                Err(e) => return fail(&Error::Scene(e)),
+            };
+            match lme_mpm::model::Model::new(&scene) {
+                Ok(model) => {
+                    print!("{}", lme_mpm::run::describe(&scene, &model));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&Error::Scene(e)),
+            }
+        }
+    }
+}
+
+fn bench(
+    backend: BackendChoice,
+    particles: &[usize],
+    cases: &[String],
+    seconds: f64,
+    out: &std::path::Path,
+    doc: Option<&std::path::Path>,
+) -> ExitCode {
+    use lme_mpm::bench;
+    let all = bench::standard_cases();
+    let mut chosen = Vec::new();
+    for c in cases {
+        match all.iter().find(|k| &k.label == c) {
+            Some(k) => chosen.push(k.clone()),
+            None => {
+                let known: Vec<_> = all.iter().map(|k| k.label.as_str()).collect();
+                eprintln!(
+                    "error: unknown bench case `{c}`; known: {}",
+                    known.join(", ")
+                );
+                return ExitCode::from(2);
+            }
+        }
+    }
+    println!("{}", bench::TABLE_HEADER);
+    let points = match bench::run(backend, &chosen, particles, seconds, |p| {
+        println!("{}", bench::table_row(p))
+    }) {
+        Ok(p) => p,
+        Err(e) => return fail(&e),
+    };
+    if let Err(e) = std::fs::create_dir_all(out) {
+        eprintln!("error: cannot create {}: {e}", out.display());
+        return ExitCode::from(1);
+    }
+    if let Err(e) =
+        lme_mpm::output::write_atomic(&out.join("bench.csv"), bench::csv(&points).as_bytes())
+    {
+        return fail(&e);
+    }
+    if let Some(doc) = doc {
+        let name = format!("{backend:?}").to_lowercase();
+        let mut body = format!(
+            "Measured {} on {} with `lme-mpm bench --backend {name} --seconds {seconds}` (release build).\n\n{}\n",
+            bench::today(),
+            bench::machine(),
+            bench::TABLE_HEADER
+        );
+        for p in &points {
+            body.push_str(&bench::table_row(p));
+            body.push('\n');
+        }
+        let section = format!("bench-{name}");
+        if let Err(e) = lme_mpm::docgen::replace_section(doc, &section, &body) {
+            return fail(&e);
+        }
+    }
+    ExitCode::SUCCESS
+}

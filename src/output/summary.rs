@@ -1,0 +1,54 @@
+//! `summary.json`: how the run ended, how fast it ran, and its error against
+//! the exact solution when the scene has one. Fields are documented in
+//! docs/outputs.md.
+
+use crate::exact::Errors;
+use crate::scene::{ExactKind, IntegratorKind, NpcPosition, SceneFile, ShapeKind};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// `completed` or `unstable`.
+    pub status: &'static str,
+    /// Why the run stopped early (unstable only).
+    pub reason: Option<String>,
+    /// Machine-friendly reason: left_grid, lme_newton, non_finite, non_positive_density, energy_runaway.
+    pub reason_code: Option<&'static str>,
+    /// Particle that showed the fault first, if one did.
+    pub unstable_particle: Option<usize>,
+    pub scene: String,
+    /// Time reached (s).
+    pub t: f64,
+    pub t_end: f64,
+    pub steps: u64,
+    pub particles: usize,
+    pub nodes: usize,
+    /// Wall time spent stepping (s), outputs excluded.
+    pub wall_seconds: f64,
+    /// Wall time of the whole run, setup and outputs included (s).
+    pub wall_seconds_total: f64,
+    /// particles × steps / wall_seconds.
+    pub particle_steps_per_second: f64,
+    pub backend: String,
+    pub bytes_per_particle: f64,
+    pub shape: ShapeKind,
+    pub lme_gamma: Option<f64>,
+    pub integrator: IntegratorKind,
+    pub npc_gamma: Option<f64>,
+    pub npc_position: Option<NpcPosition>,
+    pub cfl: f64,
+    /// Grid spacing (m).
+    pub h: f64,
+    pub perturb: f64,
+    /// Final kinetic and strain energy (J per metre of thickness).
+    pub energy: BTreeMap<&'static str, f64>,
+    /// Final reaction per constraint (N per metre of thickness).
+    pub reactions: BTreeMap<String, [f64; 2]>,
+    pub exact: Option<ExactKind>,
+    /// Error figures against the exact solution (when `exact` is set).
+    pub errors: Option<Errors>,
+    /// The scene as run (overrides applied, defaults filled in).
+    pub scene_resolved: SceneFile,
+    pub version: &'static str,
+}

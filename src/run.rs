@@ -1,0 +1,375 @@
+//! `lme-mpm run`: build the model, pick a backend, drive it to t_end while
+//! writing samples and snapshots, then score and summarise. Nothing is
+//! written before the scene and model are known to be valid.
+
+use crate::backend::{Backend, Sample};
+use crate::cpu::CpuBackend;
+use crate::error::{Error, Result};
+use crate::exact;
+use crate::model::Model;
+use crate::output::{self, csv, summary::Summary, vtk};
+use crate::scene::Scene;
+use crate::shape::Shape;
+use crate::solver::{self, Observer, RunStatus, Schedule};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// `--backend`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BackendChoice {
+    /// The GPU when an adapter exists, else the CPU path (says which and why).
+    Auto,
+    /// The f64 CPU reference path.
+    Cpu,
+    /// The wgpu path; fails when no adapter exists.
+    Gpu,
+}
+
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    pub backend: BackendChoice,
+    pub out: PathBuf,
+    /// Show a progress bar on a terminal (runs over a second).
+    pub progress: bool,
+    /// Print the backend choice and the result line to stderr.
+    pub verbose: bool,
+}
+
+/// How a run ended, with its summary (also written to summary.json).
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub status: RunStatus,
+    pub summary: Summary,
+}
+
+/// Makes the backend `choice` asks for.
+pub fn make_backend(
+    choice: BackendChoice,
+    model: Model,
+    verbose: bool,
+) -> Result<Box<dyn Backend>> {
+    match choice {
+        BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
+        BackendChoice::Auto => {
+            if verbose {
+                eprintln!("backend: CPU path (this build has no GPU path yet)");
+            }
+            Ok(Box::new(CpuBackend::new(model)))
+        }
+        BackendChoice::Gpu => Err(Error::NoAdapter(
+            "this build has no GPU path yet; use --backend cpu or auto".to_string(),
+        )),
+    }
+}
+
+/// Runs `scene` and writes its outputs to `opts.out`.
+pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
+    let start = Instant::now();
+    let model = Model::new(scene)?;
+    let mut backend = make_backend(opts.backend, model, opts.verbose)?;
+
+    std::fs::create_dir_all(&opts.out)
+        .map_err(|e| Error::io("cannot create output folder", &opts.out, e))?;
+    let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
+    output::write_atomic(&opts.out.join("scene.resolved.toml"), resolved.as_bytes())?;
+
+    let mut writer = Writer::new(&opts.out, backend.model(), opts.progress);
+    let schedule = Schedule {
+        sample_interval: scene.sample_interval,
+        vtk_interval: scene.file.output.vtk_interval,
+    };
+    let t_drive = Instant::now();
+    let status = solver::drive(backend.as_mut(), schedule, &mut writer);
+    let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
+    writer.finish_progress();
+    if let Some(e) = writer.error.take() {
+        return Err(e);
+    }
+
+    let t = backend.time();
+    let steps = backend.steps();
+    let bytes_per_particle = backend.bytes_per_particle();
+    let backend_name = backend.name();
+    let final_sample = writer.samples.last().cloned();
+    let errors = scene.file.exact.map(|k| {
+        let particles = backend.particles().clone();
+        exact::score(k, scene, backend.model(), &particles, t)
+    });
+    let model = backend.model().clone();
+    let particles = backend.particles();
+    if scene.file.output.particles_csv {
+        output::write_atomic(
+            &opts.out.join("particles.csv"),
+            csv::particles(&model.body_names, particles).as_bytes(),
+        )?;
+    }
+    let snap_done = writer.snapshots.last().is_some_and(|(ts, _)| *ts == t);
+    if (scene.file.output.vtk_final || !matches!(status, RunStatus::Completed)) && !snap_done {
+        writer.write_snapshot(particles, t)?;
+    }
+    writer.flush()?;
+
+    let n = model.particles.len();
+    let solver = scene.solver();
+    let (reason, reason_code, unstable_particle) = match &status {
+        RunStatus::Completed => (None, None, None),
+        RunStatus::Unstable { fault, .. } => {
+            (Some(fault.to_string()), Some(fault.code()), fault.particle)
+        }
+    };
+    let npc = matches!(model.integrator, crate::model::Integrator::Npc { .. });
+    let summary = Summary {
+        status: match status {
+            RunStatus::Completed => "completed",
+            RunStatus::Unstable { .. } => "unstable",
+        },
+        reason,
+        reason_code,
+        unstable_particle,
+        scene: scene.name.clone(),
+        t,
+        t_end: model.t_end,
+        steps,
+        particles: n,
+        nodes: model.grid.n_nodes(),
+        wall_seconds: wall,
+        wall_seconds_total: start.elapsed().as_secs_f64(),
+        particle_steps_per_second: n as f64 * steps as f64 / wall,
+        backend: backend_name,
+        bytes_per_particle,
+        shape: solver.shape,
+        lme_gamma: matches!(model.shape, Shape::Lme(_)).then_some(solver.lme_gamma),
+        integrator: solver.integrator,
+        npc_gamma: npc.then_some(solver.npc_gamma),
+        npc_position: npc.then_some(solver.npc_position),
+        cfl: solver.cfl,
+        h: model.grid.h,
+        perturb: model.grid.perturb,
+        energy: final_sample
+            .as_ref()
+            .map(|s| BTreeMap::from([("kinetic", s.energy.kinetic), ("strain", s.energy.strain)]))
+            .unwrap_or_default(),
+        reactions: final_sample
+            .as_ref()
+            .map(|s| {
+                model
+                    .constraints
+                    .groups
+                    .iter()
+                    .map(|g| g.name.clone())
+                    .zip(s.reactions.iter().copied())
+                    .collect()
+            })
+            .unwrap_or_default(),
+        exact: scene.file.exact,
+        errors,
+        scene_resolved: scene.file.clone(),
+        version: env!("CARGO_PKG_VERSION"),
+    };
+    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    output::write_atomic(&opts.out.join("summary.json"), json.as_bytes())?;
+    Ok(Outcome { status, summary })
+}
+
+/// Observer that keeps the samples, rewrites the CSV files now and then (so
+/// a killed run leaves complete files) and writes VTK snapshots.
+struct Writer {
+    dir: PathBuf,
+    probe_names: Vec<String>,
+    group_names: Vec<String>,
+    samples: Vec<Sample>,
+    snapshots: Vec<(f64, String)>,
+    last_flush: Instant,
+    io_seconds: f64,
+    error: Option<Error>,
+    progress: Option<(ProgressBar, Instant)>,
+}
+
+/// Rewrite the CSV files at most this often while running.
+const FLUSH_EVERY: Duration = Duration::from_secs(5);
+/// Runs shorter than this show no progress bar.
+const PROGRESS_AFTER: Duration = Duration::from_secs(1);
+
+impl Writer {
+    fn new(dir: &Path, model: &Model, progress: bool) -> Self {
+        let bar = progress.then(|| {
+            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::hidden());
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:40}] {percent:>3}%  {msg}  eta {eta}",
+                )
+                .expect("valid template")
+                .progress_chars("=> "),
+            );
+            (bar, Instant::now())
+        });
+        Writer {
+            dir: dir.to_path_buf(),
+            probe_names: model.probes.iter().map(|p| p.name.clone()).collect(),
+            group_names: model
+                .constraints
+                .groups
+                .iter()
+                .map(|g| g.name.clone())
+                .collect(),
+            samples: Vec::new(),
+            snapshots: Vec::new(),
+            last_flush: Instant::now(),
+            io_seconds: 0.0,
+            error: None,
+            progress: bar,
+        }
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        let t0 = Instant::now();
+        output::write_atomic(
+            &self.dir.join("probes.csv"),
+            csv::probes(&self.probe_names, &self.samples).as_bytes(),
+        )?;
+        output::write_atomic(
+            &self.dir.join("energy.csv"),
+            csv::energy(&self.samples).as_bytes(),
+        )?;
+        output::write_atomic(
+            &self.dir.join("reactions.csv"),
+            csv::reactions(&self.group_names, &self.samples).as_bytes(),
+        )?;
+        self.last_flush = Instant::now();
+        self.io_seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn write_snapshot(&mut self, particles: &crate::model::Particles, t: f64) -> Result<()> {
+        let t0 = Instant::now();
+        let vdir = self.dir.join("vtk");
+        std::fs::create_dir_all(&vdir).map_err(|e| Error::io("cannot create", &vdir, e))?;
+        let name = format!("particles_{:05}.vtu", self.snapshots.len());
+        output::write_atomic(&vdir.join(&name), &vtk::particles_vtu(particles, t))?;
+        self.snapshots.push((t, format!("vtk/{name}")));
+        output::write_atomic(
+            &self.dir.join("particles.pvd"),
+            vtk::pvd(&self.snapshots).as_bytes(),
+        )?;
+        self.io_seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn finish_progress(&mut self) {
+        if let Some((bar, _)) = &self.progress {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Observer for Writer {
+    fn sample(&mut self, sample: &Sample) {
+        self.samples.push(sample.clone());
+        if self.error.is_none() && self.last_flush.elapsed() > FLUSH_EVERY {
+            if let Err(e) = self.flush() {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    fn snapshot(&mut self, backend: &mut dyn Backend) {
+        if self.error.is_some() {
+            return;
+        }
+        let t = backend.time();
+        if let Err(e) = self.write_snapshot(backend.particles(), t) {
+            self.error = Some(e);
+        }
+    }
+
+    fn progress(&mut self, fraction: f64) {
+        if let Some((bar, started)) = &self.progress {
+            if bar.is_hidden() && started.elapsed() > PROGRESS_AFTER {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+            bar.set_position((fraction * 1000.0) as u64);
+            if let Some(s) = self.samples.last() {
+                bar.set_message(format!("t = {:.4e} s", s.t));
+            }
+        }
+    }
+}
+
+/// Text that `lme-mpm check` prints: what the scene will run.
+pub fn describe(scene: &Scene, model: &Model) -> String {
+    let backend = CpuBackend::new(model.clone());
+    let dt = backend.next_dt();
+    let s = scene.solver();
+    let g = &model.grid;
+    let shape = match &model.shape {
+        Shape::Lme(l) => format!(
+            "lme (gamma = {}, support radius {:.3} h)",
+            l.gamma,
+            l.radius / l.h
+        ),
+        Shape::Ugimp(u) => format!("ugimp (lp = {:.4} h)", u.lp_h),
+        Shape::Linear => "linear".to_string(),
+    };
+    let integrator = match model.integrator {
+        crate::model::Integrator::Fe => "fe".to_string(),
+        crate::model::Integrator::Npc { gamma, position } => {
+            format!("npc (gamma = {gamma}, position: {position:?})")
+        }
+    };
+    format!(
+        "scene {name}: valid\n{desc}\
+         particles   {np}\n\
+         grid        {nx} x {ny} nodes, h = {h} m, from ({x0}, {y0}) to ({x1}, {y1}) m{pert}\n\
+         shape       {shape}\n\
+         integrator  {integrator}, cfl = {cfl}\n\
+         time        t_end = {t_end} s, first dt = {dt:.4e} s, about {steps:.0} steps\n\
+         work        about {work:.3e} particle-steps\n\
+         memory      {bpp:.0} bytes per particle on the CPU path\n\
+         constraints {nc}\n\
+         probes      {npr}\n\
+         exact       {exact}\n",
+        name = scene.name,
+        desc = if scene.file.description.is_empty() {
+            String::new()
+        } else {
+            format!("{}\n", scene.file.description.trim())
+        },
+        np = model.particles.len(),
+        nx = g.nx,
+        ny = g.ny,
+        h = g.h,
+        x0 = g.min[0],
+        y0 = g.min[1],
+        x1 = g.max()[0],
+        y1 = g.max()[1],
+        pert = if g.is_perturbed() {
+            format!(", interior nodes perturbed by up to {} h", g.perturb)
+        } else {
+            String::new()
+        },
+        cfl = s.cfl,
+        t_end = s.t_end,
+        steps = (s.t_end / dt).ceil(),
+        work = (s.t_end / dt).ceil() * model.particles.len() as f64,
+        bpp = backend.bytes_per_particle(),
+        nc = model
+            .constraints
+            .groups
+            .iter()
+            .map(|c| format!("{} ({} nodes)", c.name, c.nodes.len()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        npr = model
+            .probes
+            .iter()
+            .map(|p| format!("{} -> particle {}", p.name, p.particle))
+            .collect::<Vec<_>>()
+            .join(", "),
+        exact = scene
+            .file
+            .exact
+            .map_or("none".to_string(), |e| format!("{e:?}")),
+    )
+}
