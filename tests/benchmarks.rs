@@ -1,0 +1,207 @@
+//! The papers' benchmarks on the CPU path, scored against exact solutions:
+//! Dyka's bar (NPC vs FE), the elastic block (LME vs Q4), and the test that
+//! chose the NPC position update.
+
+mod common;
+
+use common::{column, dyka_rms, run};
+use lme_mpm::cpu::CpuBackend;
+use lme_mpm::model::Model;
+use lme_mpm::scene::{Override, Scene};
+use lme_mpm::solver::{self, Recorder, RunStatus, Schedule};
+
+/// Dyka's bar, LME γ = 4, NPC, 1 mm cells: we measure an RMS velocity error
+/// of 0.503 m/s at t_end = 1e-4 s (10% of the 5 m/s impact speed). At that
+/// instant the reflected front is just reaching the free end, and the error
+/// is the front smeared over ~3 cells plus the small trailing ripple NPC
+/// leaves. The bound is the measured value plus 10%: loose enough for
+/// harmless round-off changes, tight enough to fail if the ripple grows
+/// (FE's ripple alone adds 20%) or the front arrives a cell late.
+const DYKA_LME_NPC_RMS_BOUND: f64 = 0.55;
+
+#[test]
+fn dyka_lme_npc_error_is_bounded_and_below_fe() {
+    let npc = run("dyka_bar.toml", &[]);
+    let fe = run("dyka_bar.toml", &["solver.integrator=fe"]);
+    assert_eq!(npc.status, RunStatus::Completed);
+    assert_eq!(fe.status, RunStatus::Completed);
+    let (e_npc, e_fe) = (dyka_rms(&npc), dyka_rms(&fe));
+    println!("Dyka 1 mm LME g=4: RMS NPC {e_npc:.4} m/s, FE {e_fe:.4} m/s");
+    assert!(
+        e_npc < DYKA_LME_NPC_RMS_BOUND,
+        "NPC RMS {e_npc} ≥ {DYKA_LME_NPC_RMS_BOUND}"
+    );
+    assert!(
+        e_npc < 0.9 * e_fe,
+        "NPC RMS {e_npc} not clearly below FE's {e_fe}"
+    );
+
+    // NPC damps the post-front ripple; FE does not (paper Fig. 8): energy
+    // falls a little under NPC and is kept, ripple and all, by FE.
+    let energy = |r: &common::Run| -> Vec<f64> {
+        r.recorder
+            .samples
+            .iter()
+            .map(|s| s.energy.kinetic + s.energy.strain)
+            .collect()
+    };
+    let (en, ef) = (energy(&npc), energy(&fe));
+    let e0 = en[0];
+    let max_npc = en.iter().copied().fold(0.0, f64::max);
+    assert!(
+        max_npc <= e0 * (1.0 + 1e-9),
+        "NPC energy grew to {max_npc} from {e0}"
+    );
+    println!(
+        "energy at t_end / E0: NPC {:.4}, FE {:.4}",
+        en.last().unwrap() / e0,
+        ef.last().unwrap() / e0
+    );
+    assert!(
+        ef.last().unwrap() > en.last().unwrap(),
+        "FE should dissipate less than NPC"
+    );
+}
+
+#[test]
+fn elastic_block_lme_matches_the_exact_column() {
+    let r = run("elastic_block.toml", &[]);
+    assert_eq!(r.status, RunStatus::Completed);
+    let e = column(&r);
+    println!("{e:?}");
+    // The issue's bounds: σ_yy of the bottom row within 5% of −ρ0 g (H − Y),
+    // top settlement within 3% of the exact value for our (log-strain) law.
+    assert!(e.sigma_yy_bottom_rel_error < 0.05, "{e:?}");
+    assert!(e.settlement_rel_error < 0.03, "{e:?}");
+    // The base carries the weight: ρ0 g H W = 5.886e6 N/m, give or take the
+    // small oscillation the ramp leaves (we see < 1%).
+    let ry = r.recorder.samples.last().unwrap().reactions[0][1];
+    let weight = 6000.0 * 9.81 * 10.0 * 10.0;
+    assert!(
+        (ry - weight).abs() < 0.02 * weight,
+        "base reaction {ry} vs weight {weight}"
+    );
+}
+
+#[test]
+fn elastic_block_q4_fails_or_is_far_worse_than_lme() {
+    let lme = column(&run("elastic_block.toml", &[]));
+    let q4 = run("elastic_block.toml", &["solver.shape=linear"]);
+    match q4.status {
+        RunStatus::Unstable { fault, t, .. } => println!("Q4 went unstable at t = {t}: {fault}"),
+        RunStatus::Completed => {
+            // Our Q4 completes (the paper's blew up early; see
+            // docs/verification.md), but no better than this:
+            let q = column(&q4);
+            println!("Q4 {q:?}\nLME {lme:?}");
+            assert!(
+                q.settlement_rel_error > 0.03
+                    && q.settlement_rel_error > 10.0 * lme.settlement_rel_error,
+                "Q4 settlement error {} vs LME {}",
+                q.settlement_rel_error,
+                lme.settlement_rel_error
+            );
+            assert!(
+                q.sigma_yy_bottom_rel_error > 3.0 * lme.sigma_yy_bottom_rel_error,
+                "Q4 bottom stress error {} vs LME {}",
+                q.sigma_yy_bottom_rel_error,
+                lme.sigma_yy_bottom_rel_error
+            );
+        }
+    }
+}
+
+/// A free-falling, unconstrained body: every particle must follow
+/// x0 + v0 t + ½ g t². The three readings of the NPC position update differ
+/// by a multiple of Δt² a per step, which adds up to an O(Δt) drift.
+fn free_fall(position: &str, shape: &str) -> (f64, f64) {
+    let text = r#"
+        [grid]
+        h = 0.25
+        margin = 6.0
+        [materials.m]
+        model = "linear_elastic"
+        density = 1000.0
+        E = 1e6
+        nu = 0.2
+        [bodies.b]
+        material = "m"
+        velocity = [1.0, 0.0]
+        rects = [[0.0, 0.0, 1.0, 1.0]]
+        [gravity]
+        g = [0.0, -10.0]
+        [solver]
+        lme_gamma = 3.0
+        t_end = 1.0
+    "#;
+    let sets = [
+        format!("solver.npc_position={position}"),
+        format!("solver.shape={shape}"),
+    ];
+    let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let scene = Scene::from_str(text, "free fall", "fall", &o).unwrap();
+    let mut b = CpuBackend::new(Model::new(&scene).unwrap());
+    let dt = b.next_dt();
+    let status = solver::drive(
+        &mut b,
+        Schedule {
+            sample_interval: 0.1,
+            vtk_interval: None,
+        },
+        &mut Recorder::default(),
+    );
+    assert_eq!(status, RunStatus::Completed);
+    let p = &b.model.particles;
+    let worst = (0..p.len())
+        .map(|i| {
+            let dy = p.x[i][1] - p.x0[i][1];
+            let dx = p.x[i][0] - p.x0[i][0];
+            (dy + 5.0).abs().max((dx - 1.0).abs())
+        })
+        .fold(0.0, f64::max);
+    (worst, dt)
+}
+
+#[test]
+fn npc_position_reading_newmark_is_exact_in_free_fall() {
+    for shape in ["lme", "linear", "ugimp"] {
+        let (newmark, dt) = free_fall("newmark", shape);
+        let (predicted, _) = free_fall("predicted", shape);
+        let (corrected, _) = free_fall("corrected", shape);
+        println!(
+            "{shape}: dt {dt:.3e}; drift newmark {newmark:.3e}, predicted {predicted:.3e}, corrected {corrected:.3e} m"
+        );
+        // Newmark: exact but for the first step, where a_p = 0 (½Δt² g).
+        assert!(
+            newmark < 0.5 * dt * dt * 10.0 * 1.01,
+            "{shape}: newmark drift {newmark}"
+        );
+        // The paper's printed reading drifts by ½ Δt g t, the authors' code by Δt g t.
+        let gt = 10.0 * 1.0;
+        assert!(
+            (predicted / (0.5 * dt * gt) - 1.0).abs() < 0.05,
+            "{shape}: predicted drift {predicted}"
+        );
+        assert!(
+            (corrected / (dt * gt) - 1.0).abs() < 0.05,
+            "{shape}: corrected drift {corrected}"
+        );
+    }
+}
+
+#[test]
+fn npc_position_readings_agree_on_dyka() {
+    // Dyka's displacements are ~3e-5 of the bar: the reading cannot matter
+    // there, and must not (it only moves particles, not the strain).
+    let base = dyka_rms(&run("dyka_bar.toml", &["solver.npc_position=newmark"]));
+    for pos in ["predicted", "corrected"] {
+        let e = dyka_rms(&run(
+            "dyka_bar.toml",
+            &[&format!("solver.npc_position={pos}")],
+        ));
+        assert!(
+            (e - base).abs() < 1e-3 * base,
+            "{pos}: {e} vs newmark {base}"
+        );
+    }
+}

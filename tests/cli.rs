@@ -1,0 +1,289 @@
+//! The `lme-mpm` binary: bad input exits 2 with a message naming the key and
+//! writes nothing; an unstable run exits 3 and keeps its outputs; a good run
+//! exits 0 and writes every output file in its documented shape.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lme-mpm"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lme-mpm-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn run_with(scene: &Path, out: &Path, sets: &[&str]) -> Output {
+    let mut c = bin();
+    c.arg("run").arg(scene).arg("--out").arg(out).arg("--quiet");
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    c.output().expect("binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Writes `text` as a scene file and returns its path.
+fn scene_file(dir: &Path, text: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn dyka_text() -> String {
+    std::fs::read_to_string(common::case("dyka_bar.toml")).unwrap()
+}
+
+/// Every way of getting the input wrong: exit 2, the message names the key
+/// (or the line), and no output folder appears.
+#[test]
+fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
+    let dyka = common::case("dyka_bar.toml");
+    let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
+        (
+            "malformed toml",
+            scene_file(&tmp("s1"), "[grid\nh = 1"),
+            vec![],
+            "TOML parse error",
+        ),
+        (
+            "unknown key",
+            scene_file(
+                &tmp("s2"),
+                &dyka_text().replace("cfl = 0.1", "cfl = 0.1\ncfll = 3"),
+            ),
+            vec![],
+            "unknown field `cfll`",
+        ),
+        (
+            "negative density",
+            dyka.clone(),
+            vec!["materials.steel.density=-7833"],
+            "materials.steel.density",
+        ),
+        ("cfl zero", dyka.clone(), vec!["solver.cfl=0"], "solver.cfl"),
+        (
+            "cfl above one",
+            dyka.clone(),
+            vec!["solver.cfl=1.5"],
+            "must be in (0, 1]",
+        ),
+        (
+            "empty body",
+            dyka.clone(),
+            vec!["bodies.bar.rects=[]"],
+            "bodies.bar",
+        ),
+        (
+            "body outside the grid",
+            dyka.clone(),
+            vec!["grid.min=[0.05, -0.003]", "grid.max=[0.14, 0.004]"],
+            "outside the grid",
+        ),
+        (
+            "unknown shape",
+            dyka.clone(),
+            vec!["solver.shape=lmx"],
+            "unknown variant `lmx`",
+        ),
+        (
+            "bad --set syntax",
+            dyka.clone(),
+            vec!["solver.shape"],
+            "expected dotted.key=value",
+        ),
+        (
+            "--set into a value",
+            dyka.clone(),
+            vec!["grid.h.x=1"],
+            "not a table",
+        ),
+        (
+            "unknown key via --set",
+            dyka.clone(),
+            vec!["solver.gama=3"],
+            "unknown field `gama`",
+        ),
+        (
+            "lme gamma out of range",
+            dyka.clone(),
+            vec!["solver.lme_gamma=50"],
+            "solver.lme_gamma",
+        ),
+        (
+            "missing material",
+            dyka.clone(),
+            vec!["bodies.bar.material=iron"],
+            "bodies.bar.material",
+        ),
+        (
+            "constraint matching no node",
+            dyka.clone(),
+            vec![
+                "constraints.fixed_end.min=[5, -1]",
+                "constraints.fixed_end.max=[6, 1]",
+            ],
+            "matches no node",
+        ),
+        (
+            "disk holding no particle point",
+            scene_file(
+                &tmp("s3"),
+                "[grid]\nh = 1.0\n[materials.m]\nmodel = \"linear_elastic\"\ndensity = 1.0\nE = 1.0\nnu = 0.0\n\
+                 [bodies.a]\nmaterial = \"m\"\nrects = [[0, 0, 2, 2]]\n[bodies.dot]\nmaterial = \"m\"\n\
+                 disks = [[5.5, 5.5, 0.05]]\n[solver]\nt_end = 1.0\n",
+            ),
+            vec![],
+            "bodies.dot` is empty",
+        ),
+    ];
+    for (what, scene, sets, needle) in cases {
+        let out = tmp("never-written");
+        let o = run_with(&scene, &out, &sets);
+        let msg = stderr(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{what}: exit {:?}, stderr: {msg}",
+            o.status.code()
+        );
+        assert!(
+            msg.contains(needle),
+            "{what}: message lacks {needle:?}: {msg}"
+        );
+        assert!(msg.lines().count() <= 8, "{what}: message too long: {msg}");
+        assert!(!out.exists(), "{what}: output folder was created");
+        // `check` agrees with `run`.
+        let mut c = bin();
+        c.arg("check").arg(&scene);
+        for s in &sets {
+            c.arg("--set").arg(s);
+        }
+        assert_eq!(
+            c.output().unwrap().status.code(),
+            Some(2),
+            "{what}: check disagrees"
+        );
+    }
+}
+
+#[test]
+fn unstable_run_exits_3_and_keeps_its_outputs() {
+    // An impactor at 2 km/s with no room left beyond the bar leaves the grid.
+    let out = tmp("unstable");
+    let o = run_with(
+        &common::case("dyka_bar.toml"),
+        &out,
+        &["bodies.impactor.velocity=[-2000, 0]", "grid.margin=0"],
+    );
+    assert_eq!(o.status.code(), Some(3), "stderr: {}", stderr(&o));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["status"], "unstable");
+    assert_eq!(s["reason_code"], "left_grid");
+    assert!(s["unstable_particle"].is_u64());
+    assert!(s["t"].as_f64().unwrap() < 1e-4);
+    for f in [
+        "probes.csv",
+        "energy.csv",
+        "particles.csv",
+        "particles.pvd",
+        "scene.resolved.toml",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing after an unstable run");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn completed_run_writes_every_output() {
+    let out = tmp("ok");
+    let o = run_with(
+        &common::case("dyka_bar.toml"),
+        &out,
+        &[
+            "output.vtk_interval=5e-5",
+            "grid.h=0.002",
+            "bodies.impactor.rects=[[0,0,0.033325,0.002]]",
+            "bodies.bar.rects=[[0.033325,0,0.1333,0.002]]",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["status"], "completed");
+    assert_eq!(s["t"].as_f64().unwrap(), 1e-4);
+    assert_eq!(
+        s["h"].as_f64().unwrap(),
+        0.002,
+        "--set grid.h did not reach the run"
+    );
+    let n = s["particles"].as_u64().unwrap() as usize;
+    assert!(s["particle_steps_per_second"].as_f64().unwrap() > 0.0);
+    assert!(s["errors"]["rms_velocity"].as_f64().unwrap() > 0.0);
+    assert_eq!(
+        s["backend"].as_str().unwrap().split(' ').next(),
+        Some("cpu")
+    );
+
+    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    assert!(probes.starts_with("t,probe,x,y,vx,vy,sxx,syy,sxy\n"));
+    assert!(probes.lines().skip(1).all(|l| l.split(',').count() == 9));
+    assert!(probes.contains(",free_end,"));
+
+    let parts = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    let mut lines = parts.lines();
+    assert_eq!(
+        lines.next(),
+        Some("id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume")
+    );
+    assert_eq!(lines.clone().count(), n);
+    let mass: f64 = lines
+        .map(|l| l.split(',').nth(11).unwrap().parse::<f64>().unwrap())
+        .sum();
+    let bar_mass = 7833.0 * 0.1333 * 0.002;
+    assert!(
+        (mass - bar_mass).abs() < 1e-9 * bar_mass,
+        "particle mass {mass} vs bar {bar_mass}"
+    );
+
+    // VTK: three snapshots (0, 5e-5, 1e-4), each with the right point count
+    // and a complete appended block.
+    let pvd = std::fs::read_to_string(out.join("particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 3, "{pvd}");
+    for k in 0..3 {
+        let bytes = std::fs::read(out.join(format!("vtk/particles_{k:05}.vtu"))).unwrap();
+        let text = String::from_utf8_lossy(&bytes);
+        assert!(text.contains(&format!("NumberOfPoints=\"{n}\"")));
+        assert!(text.ends_with("</AppendedData>\n</VTKFile>\n"));
+        // Header + payload sizes add up: 6 point arrays, points, 3 cell arrays.
+        let payload = n * (12 * 3 + 4 + 4 + 4) + n * 12 + n * (8 + 8 + 1) + 10 * 8;
+        let start = text.find("<AppendedData encoding=\"raw\">\n_").unwrap() + 31;
+        let end = bytes.len() - "\n</AppendedData>\n</VTKFile>\n".len();
+        assert_eq!(end - start, payload);
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn gpu_backend_without_a_gpu_path_fails_clearly() {
+    let out = tmp("gpu");
+    let o = run_with(&common::case("dyka_bar.toml"), &out, &[]);
+    assert_eq!(o.status.code(), Some(0));
+    let mut c = bin();
+    c.args(["run", "--backend", "gpu", "--quiet", "--out"])
+        .arg(&out)
+        .arg(common::case("dyka_bar.toml"));
+    let o = c.output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("GPU"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&out);
+}
