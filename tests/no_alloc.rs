@@ -1,0 +1,76 @@
+//! The CPU path allocates nothing per step: buffers are made when the
+//! backend is built (and the scatter scratch on its first use). Counted with
+//! a global allocator over whole steps of every shape and integrator.
+
+mod common;
+
+use lme_mpm::cpu::CpuBackend;
+use lme_mpm::model::Model;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+const STEPS: usize = 500;
+
+/// Allocations during `STEPS` steps of each configuration, in a pool of `threads`.
+fn allocations(threads: usize) -> Vec<(String, usize)> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut out = Vec::new();
+        for sets in [
+            &["solver.shape=lme"][..],
+            &["solver.shape=linear", "solver.integrator=fe"],
+            &["solver.shape=ugimp"],
+        ] {
+            let scene = common::scene("elastic_block.toml", sets);
+            let mut b = CpuBackend::new(Model::new(&scene).unwrap());
+            // Warm-up: the pool's threads start and the scatter scratch is sized.
+            for _ in 0..3 {
+                b.step().unwrap();
+            }
+            let before = ALLOCATIONS.load(Ordering::SeqCst);
+            for _ in 0..STEPS {
+                b.step().unwrap();
+            }
+            let n = ALLOCATIONS.load(Ordering::SeqCst) - before;
+            out.push((format!("{sets:?}"), n));
+        }
+        out
+    })
+}
+
+#[test]
+fn steps_do_not_allocate() {
+    // One thread, and two (the private-grid scatter path): none at all.
+    for threads in [1, 2] {
+        for (what, n) in allocations(threads) {
+            assert_eq!(
+                n, 0,
+                "{what}: {n} allocations in {STEPS} steps on {threads} thread(s)"
+            );
+        }
+    }
+}
