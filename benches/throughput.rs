@@ -19,6 +19,7 @@ fn main() {
     println!("{}", bench::TABLE_HEADER);
     let points = bench::run(
         BackendChoice::Cpu,
+        None,
         &bench::standard_cases(),
         &counts,
         seconds,

@@ -3,8 +3,29 @@
 //! back the particle state at the end.
 
 use crate::cpu::energy::Energy;
+use crate::error::{Error, Result};
 use crate::fault::Fault;
 use crate::model::{Model, Particles};
+
+/// Why `advance` stopped short: the run went unstable (a result), or the
+/// backend itself failed (a GPU device error: an error).
+#[derive(Debug)]
+pub enum Halt {
+    Unstable(Fault),
+    Failed(Error),
+}
+
+impl From<Fault> for Halt {
+    fn from(f: Fault) -> Self {
+        Halt::Unstable(f)
+    }
+}
+
+impl From<Error> for Halt {
+    fn from(e: Error) -> Self {
+        Halt::Failed(e)
+    }
+}
 
 /// State of one probe particle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,13 +57,13 @@ pub trait Backend {
     /// Takes steps until the time reaches `t_stop` or the model's `t_end`.
     /// The last step before `t_end` is shortened to land on it exactly;
     /// other stops may be passed by less than one step.
-    fn advance(&mut self, t_stop: f64) -> Result<(), Fault>;
+    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt>;
     /// Takes exactly `n` steps (or fewer if t_end comes first); for benchmarks.
-    fn advance_steps(&mut self, n: u64) -> Result<(), Fault>;
+    fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt>;
     /// Probes, energy and reactions now.
-    fn sample(&mut self) -> Sample;
+    fn sample(&mut self) -> Result<Sample>;
     /// Particle state now (the GPU backend downloads it).
-    fn particles(&mut self) -> &Particles;
+    fn particles(&mut self) -> Result<&Particles>;
     /// The model being run (its particles may be stale on the GPU backend).
     fn model(&self) -> &Model;
     /// Memory the backend holds per particle, grid included (bytes).

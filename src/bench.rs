@@ -18,6 +18,8 @@ pub struct Case {
     pub label: String,
     /// `--set` overrides applied to the synthetic scene.
     pub sets: Vec<String>,
+    /// GPU-path choices (the CPU path ignores them).
+    pub gpu: crate::gpu::GpuOptions,
 }
 
 impl Case {
@@ -25,6 +27,7 @@ impl Case {
         Case {
             label: label.to_string(),
             sets: sets.iter().map(|s| s.to_string()).collect(),
+            gpu: Default::default(),
         }
     }
 }
@@ -38,6 +41,14 @@ pub fn standard_cases() -> Vec<Case> {
         Case::new("lme-g3", &["solver.shape=lme", "solver.lme_gamma=3"]),
         Case::new("lme-g4", &["solver.shape=lme", "solver.lme_gamma=4"]),
     ]
+}
+
+/// Extra cases: LME with weights stored per slot on the GPU (the
+/// alternative to recomputing them from λ in each pass).
+pub fn extra_cases() -> Vec<Case> {
+    let mut stored = Case::new("lme-g3-stored", &["solver.shape=lme", "solver.lme_gamma=3"]);
+    stored.gpu.lme_stored = true;
+    vec![stored]
 }
 
 /// A square of `cells`² cells, 2×2 particles per cell, h = 1 m, resting on
@@ -102,31 +113,35 @@ pub fn time_steps(
     min_seconds: f64,
     max_steps: u64,
 ) -> Result<(u64, f64)> {
-    backend
-        .advance_steps(1)
-        .map_err(|f| crate::Error::Gpu(format!("benchmark scene went unstable: {f}")))?;
-    let n = backend.model().particles.len() as f64;
+    backend.advance_steps(1).map_err(halted)?;
     let start = Instant::now();
     let mut steps = 0u64;
     let mut batch = 1u64;
     while start.elapsed().as_secs_f64() < min_seconds && steps < max_steps {
         let b = batch.min(max_steps - steps);
-        backend
-            .advance_steps(b)
-            .map_err(|f| crate::Error::Gpu(format!("benchmark scene went unstable: {f}")))?;
+        backend.advance_steps(b).map_err(halted)?;
         steps += b;
         // Grow batches so timer overhead stays small on fast backends.
         if start.elapsed().as_secs_f64() * 20.0 < min_seconds {
             batch = (batch * 2).min(1 << 16);
         }
-        let _ = n;
     }
     Ok((steps, start.elapsed().as_secs_f64()))
+}
+
+fn halted(h: crate::backend::Halt) -> crate::Error {
+    match h {
+        crate::backend::Halt::Failed(e) => e,
+        crate::backend::Halt::Unstable(f) => {
+            crate::Error::Gpu(format!("the benchmark scene went unstable: {f}"))
+        }
+    }
 }
 
 /// Measures every (case, particle count) on `choice`.
 pub fn run(
     choice: BackendChoice,
+    adapter: Option<&str>,
     cases: &[Case],
     counts: &[usize],
     min_seconds: f64,
@@ -138,7 +153,7 @@ pub fn run(
             let scene = scene(n, case)?;
             let model = Model::new(&scene)?;
             let particles = model.particles.len();
-            let mut backend = make_backend(choice, model, false)?;
+            let mut backend = make_backend(choice, adapter, model, false, case.gpu)?;
             let (steps, seconds) = time_steps(backend.as_mut(), min_seconds, 100_000)?;
             let p = Point {
                 backend: backend.name(),
@@ -222,4 +237,51 @@ pub fn today() -> String {
     let m = if mp < 10 { mp + 3 } else { mp - 9 };
     let y = yoe + era * 400 + i64::from(m <= 2);
     format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// GPU/CPU throughput ratio of one (case, particle count), both measured in
+/// the same `lme-mpm bench` run.
+#[derive(Debug, Clone)]
+pub struct Ratio {
+    pub case: String,
+    pub particles: usize,
+    pub cpu: f64,
+    pub gpu: f64,
+}
+
+/// Pairs CPU and GPU points of the same case and size.
+pub fn ratios(points: &[Point]) -> Vec<Ratio> {
+    let mut out = Vec::new();
+    for g in points.iter().filter(|p| p.backend.starts_with("gpu")) {
+        if let Some(c) = points.iter().find(|c| {
+            c.backend.starts_with("cpu") && c.case == g.case && c.particles == g.particles
+        }) {
+            out.push(Ratio {
+                case: g.case.clone(),
+                particles: g.particles,
+                cpu: c.particle_steps_per_second,
+                gpu: g.particle_steps_per_second,
+            });
+        }
+    }
+    out
+}
+
+/// Markdown table of ratios.
+pub fn ratio_table(r: &[Ratio]) -> String {
+    let mut s = String::from(
+        "| case | particles | CPU particle-steps/s | GPU particle-steps/s | GPU / CPU |\n|---|---|---|---|---|\n",
+    );
+    for x in r {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.3e} | {:.3e} | {:.2} |",
+            x.case,
+            x.particles,
+            x.cpu,
+            x.gpu,
+            x.gpu / x.cpu
+        );
+    }
+    s
 }

@@ -14,6 +14,7 @@ pub mod docgen;
 pub mod error;
 pub mod exact;
 pub mod fault;
+pub mod gpu;
 pub mod material;
 pub mod model;
 pub mod output;

@@ -26,6 +26,9 @@ enum Command {
         /// Where to run: auto = GPU when an adapter exists, else CPU.
         #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
         backend: BackendChoice,
+        /// GPU adapter to use: a case-insensitive part of its name (see `lme-mpm info`).
+        #[arg(long)]
+        adapter: Option<String>,
         /// Output folder. Default: out/<scene name>.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -42,15 +45,22 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// Measure particle-steps per second of whole steps on a synthetic scene.
+    /// List GPU adapters: backend, device type, float-atomic support, key limits.
+    Info,
+    /// Measure particle-steps per second of whole steps on a synthetic scene,
+    /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
     Bench {
-        /// Backend to measure.
-        #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
-        backend: BackendChoice,
+        /// Backends to measure.
+        #[arg(long, value_enum, default_value_t = BenchBackends::Both)]
+        backend: BenchBackends,
+        /// GPU adapter (part of its name).
+        #[arg(long)]
+        adapter: Option<String>,
         /// Particle counts, comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
         particles: Vec<usize>,
-        /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4.
+        /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
+        /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed).
         #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
         cases: Vec<String>,
         /// Seconds of stepping per point (after one warm-up step).
@@ -59,7 +69,7 @@ enum Command {
         /// Folder for bench.csv.
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
-        /// Also rewrite the measured table in this markdown file (e.g. docs/performance.md).
+        /// Also rewrite the measured tables in this markdown file (e.g. docs/performance.md).
         #[arg(long)]
         doc: Option<PathBuf>,
     },
@@ -79,11 +89,19 @@ fn fail(e: &Error) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    // Mesa's Vulkan device-select layer prints a harmless XDG_RUNTIME_DIR
+    // warning on headless machines; this is its documented switch. Set
+    // before any thread starts.
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: single-threaded here, nothing reads the environment concurrently.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
     let cli = Cli::parse();
     match cli.command {
         Command::Run {
             scene,
             backend,
+            adapter,
             out,
             set,
             quiet,
@@ -95,6 +113,7 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
             let opts = RunOptions {
                 backend,
+                adapter,
                 out: out.clone(),
                 progress: !quiet && std::io::stderr().is_terminal(),
                 verbose: !quiet,
@@ -128,14 +147,24 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
+        Command::Info => info(),
         Command::Bench {
             backend,
+            adapter,
             particles,
             cases,
             seconds,
             out,
             doc,
-        } => bench(backend, &particles, &cases, seconds, &out, doc.as_deref()),
+        } => bench(
+            backend,
+            adapter.as_deref(),
+            &particles,
+            &cases,
+            seconds,
+            &out,
+            doc.as_deref(),
+        ),
         Command::Check { scene, set } => {
             let scene = match load(&scene, &set) {
                 Ok(s) => s,
@@ -152,8 +181,68 @@ fn main() -> ExitCode {
     }
 }
 
+/// `--backend` of `lme-mpm bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BenchBackends {
+    Cpu,
+    Gpu,
+    /// The CPU path and, when an adapter exists, the GPU (any adapter, software included).
+    Both,
+}
+
+fn info() -> ExitCode {
+    let list = lme_mpm::gpu::context::adapters();
+    if list.is_empty() {
+        println!(
+            "no GPU adapter: wgpu sees none (install a Vulkan driver; mesa-vulkan-drivers gives the llvmpipe software adapter)"
+        );
+        println!(
+            "runs use the CPU path ({} threads)",
+            rayon::current_num_threads()
+        );
+        return ExitCode::SUCCESS;
+    }
+    for a in &list {
+        println!("{}", a.name);
+        println!("  backend            {}", a.backend);
+        println!(
+            "  device type        {:?}{}",
+            a.device_type,
+            if a.is_software() {
+                " (software: slower than the CPU path; --backend auto skips it)"
+            } else {
+                ""
+            }
+        );
+        println!("  driver             {}", a.driver);
+        println!(
+            "  float atomics      {}",
+            if a.float_atomics {
+                "yes (atomic<f32> add)"
+            } else {
+                "no (compare-exchange loop)"
+            }
+        );
+        println!(
+            "  max binding size   {} MiB",
+            a.max_storage_buffer_binding_size >> 20
+        );
+        println!("  max buffer size    {} MiB", a.max_buffer_size >> 20);
+        println!(
+            "  storage buffers    {} per stage",
+            a.max_storage_buffers_per_shader_stage
+        );
+        println!(
+            "  workgroups per dim {}",
+            a.max_compute_workgroups_per_dimension
+        );
+    }
+    ExitCode::SUCCESS
+}
+
 fn bench(
-    backend: BackendChoice,
+    backends: BenchBackends,
+    adapter: Option<&str>,
     particles: &[usize],
     cases: &[String],
     seconds: f64,
@@ -161,7 +250,10 @@ fn bench(
     doc: Option<&std::path::Path>,
 ) -> ExitCode {
     use lme_mpm::bench;
-    let all = bench::standard_cases();
+    let all: Vec<_> = bench::standard_cases()
+        .into_iter()
+        .chain(bench::extra_cases())
+        .collect();
     let mut chosen = Vec::new();
     for c in cases {
         match all.iter().find(|k| &k.label == c) {
@@ -176,13 +268,35 @@ fn bench(
             }
         }
     }
-    println!("{}", bench::TABLE_HEADER);
-    let points = match bench::run(backend, &chosen, particles, seconds, |p| {
-        println!("{}", bench::table_row(p))
-    }) {
-        Ok(p) => p,
-        Err(e) => return fail(&e),
+    let choices: Vec<BackendChoice> = match backends {
+        BenchBackends::Cpu => vec![BackendChoice::Cpu],
+        BenchBackends::Gpu => vec![BackendChoice::Gpu],
+        BenchBackends::Both => {
+            let gpu = !lme_mpm::gpu::context::adapters().is_empty();
+            if !gpu {
+                eprintln!("bench: no GPU adapter, measuring the CPU path only");
+            }
+            if gpu {
+                vec![BackendChoice::Cpu, BackendChoice::Gpu]
+            } else {
+                vec![BackendChoice::Cpu]
+            }
+        }
     };
+    println!("{}", bench::TABLE_HEADER);
+    let mut points = Vec::new();
+    for choice in choices {
+        match bench::run(choice, adapter, &chosen, particles, seconds, |p| {
+            println!("{}", bench::table_row(p))
+        }) {
+            Ok(p) => points.extend(p),
+            Err(e) => return fail(&e),
+        }
+    }
+    let ratios = bench::ratios(&points);
+    if !ratios.is_empty() {
+        println!("\n{}", bench::ratio_table(&ratios));
+    }
     if let Err(e) = std::fs::create_dir_all(out) {
         eprintln!("error: cannot create {}: {e}", out.display());
         return ExitCode::from(1);
@@ -193,16 +307,32 @@ fn bench(
         return fail(&e);
     }
     if let Some(doc) = doc {
-        let name = format!("{backend:?}").to_lowercase();
+        let name = format!("{backends:?}").to_lowercase();
+        let adapters: Vec<String> = points
+            .iter()
+            .filter(|p| p.backend.starts_with("gpu"))
+            .map(|p| p.backend.clone())
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
         let mut body = format!(
-            "Measured {} on {} with `lme-mpm bench --backend {name} --seconds {seconds}` (release build).\n\n{}\n",
+            "Measured {} on {}{} with `lme-mpm bench --backend {name} --seconds {seconds}` (release build).\n\n{}\n",
             bench::today(),
             bench::machine(),
+            if adapters.is_empty() {
+                String::new()
+            } else {
+                format!(" and {}", adapters.join(", "))
+            },
             bench::TABLE_HEADER
         );
         for p in &points {
             body.push_str(&bench::table_row(p));
             body.push('\n');
+        }
+        if !ratios.is_empty() {
+            body.push('\n');
+            body.push_str(&bench::ratio_table(&ratios));
         }
         let section = format!("bench-{name}");
         if let Err(e) = lme_mpm::docgen::replace_section(doc, &section, &body) {

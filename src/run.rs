@@ -6,6 +6,7 @@ use crate::backend::{Backend, Sample};
 use crate::cpu::CpuBackend;
 use crate::error::{Error, Result};
 use crate::exact;
+use crate::gpu::{self, GpuBackend};
 use crate::model::Model;
 use crate::output::{self, csv, summary::Summary, vtk};
 use crate::scene::Scene;
@@ -30,6 +31,8 @@ pub enum BackendChoice {
 #[derive(Debug, Clone)]
 pub struct RunOptions {
     pub backend: BackendChoice,
+    /// Case-insensitive substring of the GPU adapter's name (`--adapter`).
+    pub adapter: Option<String>,
     pub out: PathBuf,
     /// Show a progress bar on a terminal (runs over a second).
     pub progress: bool,
@@ -44,23 +47,54 @@ pub struct Outcome {
     pub summary: Summary,
 }
 
-/// Makes the backend `choice` asks for.
+/// Makes the backend `choice` asks for. `adapter` picks a GPU adapter by
+/// name. `auto` takes a hardware GPU when there is one and otherwise the CPU
+/// path (a software adapter such as llvmpipe is slower than the CPU path);
+/// with `verbose` it says which it took and why.
 pub fn make_backend(
     choice: BackendChoice,
+    adapter: Option<&str>,
     model: Model,
     verbose: bool,
+    gpu_opts: gpu::GpuOptions,
 ) -> Result<Box<dyn Backend>> {
+    let req = |allow_software| gpu::context::AdapterRequest {
+        name: adapter.map(str::to_string),
+        allow_software,
+        force_cas: std::env::var_os("LME_MPM_FORCE_CAS").is_some(),
+    };
     match choice {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
-        BackendChoice::Auto => {
+        BackendChoice::Gpu => {
+            let ctx = gpu::context::open(&req(true))?;
+            let b = GpuBackend::with_options(ctx, model, gpu_opts)?;
             if verbose {
-                eprintln!("backend: CPU path (this build has no GPU path yet)");
+                eprintln!("backend: {}", b.name());
             }
-            Ok(Box::new(CpuBackend::new(model)))
+            Ok(Box::new(b))
         }
-        BackendChoice::Gpu => Err(Error::NoAdapter(
-            "this build has no GPU path yet; use --backend cpu or auto".to_string(),
-        )),
+        BackendChoice::Auto => match gpu::context::open(&req(false)) {
+            Ok(ctx) => {
+                let b = GpuBackend::with_options(ctx, model, gpu_opts)?;
+                if verbose {
+                    eprintln!("backend: {} (auto: a GPU adapter was found)", b.name());
+                }
+                Ok(Box::new(b))
+            }
+            Err(e) => {
+                if verbose {
+                    let why = match &e {
+                        Error::NoAdapter(m) => m.clone(),
+                        other => other.to_string(),
+                    };
+                    eprintln!(
+                        "backend: CPU path (f64, {} threads); auto found no usable GPU: {why}",
+                        rayon::current_num_threads()
+                    );
+                }
+                Ok(Box::new(CpuBackend::new(model)))
+            }
+        },
     }
 }
 
@@ -68,7 +102,13 @@ pub fn make_backend(
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let start = Instant::now();
     let model = Model::new(scene)?;
-    let mut backend = make_backend(opts.backend, model, opts.verbose)?;
+    let mut backend = make_backend(
+        opts.backend,
+        opts.adapter.as_deref(),
+        model,
+        opts.verbose,
+        gpu::GpuOptions::default(),
+    )?;
 
     std::fs::create_dir_all(&opts.out)
         .map_err(|e| Error::io("cannot create output folder", &opts.out, e))?;
@@ -81,7 +121,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         vtk_interval: scene.file.output.vtk_interval,
     };
     let t_drive = Instant::now();
-    let status = solver::drive(backend.as_mut(), schedule, &mut writer);
+    let status = solver::drive(backend.as_mut(), schedule, &mut writer)?;
     let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
     writer.finish_progress();
     if let Some(e) = writer.error.take() {
@@ -93,12 +133,13 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let bytes_per_particle = backend.bytes_per_particle();
     let backend_name = backend.name();
     let final_sample = writer.samples.last().cloned();
-    let errors = scene.file.exact.map(|k| {
-        let particles = backend.particles().clone();
-        exact::score(k, scene, backend.model(), &particles, t)
-    });
+    let particles = backend.particles()?.clone();
     let model = backend.model().clone();
-    let particles = backend.particles();
+    let errors = scene
+        .file
+        .exact
+        .map(|k| exact::score(k, scene, &model, &particles, t));
+    let particles = &particles;
     if scene.file.output.particles_csv {
         output::write_atomic(
             &opts.out.join("particles.csv"),
@@ -279,7 +320,8 @@ impl Observer for Writer {
             return;
         }
         let t = backend.time();
-        if let Err(e) = self.write_snapshot(backend.particles(), t) {
+        let written = backend.particles().and_then(|p| self.write_snapshot(p, t));
+        if let Err(e) = written {
             self.error = Some(e);
         }
     }
@@ -299,8 +341,8 @@ impl Observer for Writer {
 
 /// Text that `lme-mpm check` prints: what the scene will run.
 pub fn describe(scene: &Scene, model: &Model) -> String {
-    let backend = CpuBackend::new(model.clone());
-    let dt = backend.next_dt();
+    let dt = crate::cpu::cfl::time_step(model, 0.0).0;
+    let bytes_cpu = CpuBackend::bytes_per_particle_of(model);
     let s = scene.solver();
     let g = &model.grid;
     let shape = match &model.shape {
@@ -353,7 +395,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         t_end = s.t_end,
         steps = (s.t_end / dt).ceil(),
         work = (s.t_end / dt).ceil() * model.particles.len() as f64,
-        bpp = backend.bytes_per_particle(),
+        bpp = bytes_cpu,
         nc = model
             .constraints
             .groups

@@ -7,8 +7,9 @@
 //! FE has no acceleration term and corrects with Δt f/m (the nodal
 //! momentum update of Zhang et al.).
 
-use crate::backend::{Backend, Sample};
+use crate::backend::{Backend, Halt, Sample};
 use crate::cpu::energy::Energy;
+use crate::error::Result;
 use crate::fault::{Fault, FaultKind};
 
 /// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
@@ -93,9 +94,14 @@ pub struct Schedule {
 
 /// Runs `backend` to the model's t_end, sampling on `schedule`. Returns how
 /// the run ended; an unstable run stops at the step that found the fault.
-pub fn drive(backend: &mut dyn Backend, schedule: Schedule, obs: &mut dyn Observer) -> RunStatus {
+/// Errors are failures of the backend itself (a lost GPU device).
+pub fn drive(
+    backend: &mut dyn Backend,
+    schedule: Schedule,
+    obs: &mut dyn Observer,
+) -> Result<RunStatus> {
     let t_end = backend.model().t_end;
-    let first = backend.sample();
+    let first = backend.sample()?;
     let e0 = first.energy;
     let scale = energy_floor(backend);
     obs.sample(&first);
@@ -107,36 +113,40 @@ pub fn drive(backend: &mut dyn Backend, schedule: Schedule, obs: &mut dyn Observ
     loop {
         let t = backend.time();
         if t >= t_end {
-            return RunStatus::Completed;
+            return Ok(RunStatus::Completed);
         }
         let next_sample = k_sample as f64 * schedule.sample_interval;
         let next_vtk = schedule
             .vtk_interval
             .map_or(f64::INFINITY, |i| k_vtk as f64 * i);
         let stop = next_sample.min(next_vtk).min(t_end);
-        if let Err(fault) = backend.advance(stop) {
-            let s = backend.sample();
-            obs.sample(&s);
-            return RunStatus::Unstable {
-                fault,
-                t: backend.time(),
-                step: backend.steps(),
-            };
+        match backend.advance(stop) {
+            Ok(()) => {}
+            Err(Halt::Failed(e)) => return Err(e),
+            Err(Halt::Unstable(fault)) => {
+                let s = backend.sample()?;
+                obs.sample(&s);
+                return Ok(RunStatus::Unstable {
+                    fault,
+                    t: backend.time(),
+                    step: backend.steps(),
+                });
+            }
         }
         let t = backend.time();
         obs.progress(t / t_end);
         if t >= next_sample || t >= t_end {
-            let s = backend.sample();
+            let s = backend.sample()?;
             obs.sample(&s);
             while k_sample as f64 * schedule.sample_interval <= t {
                 k_sample += 1;
             }
             if let Some(fault) = runaway(&e0, &s.energy, scale) {
-                return RunStatus::Unstable {
+                return Ok(RunStatus::Unstable {
                     fault,
                     t,
                     step: backend.steps(),
-                };
+                });
             }
         }
         if let Some(iv) = schedule.vtk_interval {

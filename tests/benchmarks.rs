@@ -149,7 +149,8 @@ fn free_fall(position: &str, shape: &str) -> (f64, f64) {
             vtk_interval: None,
         },
         &mut Recorder::default(),
-    );
+    )
+    .unwrap();
     assert_eq!(status, RunStatus::Completed);
     let p = &b.model.particles;
     let worst = (0..p.len())

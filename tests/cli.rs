@@ -274,16 +274,43 @@ fn completed_run_writes_every_output() {
 }
 
 #[test]
-fn gpu_backend_without_a_gpu_path_fails_clearly() {
-    let out = tmp("gpu");
-    let o = run_with(&common::case("dyka_bar.toml"), &out, &[]);
-    assert_eq!(o.status.code(), Some(0));
+fn backend_choice_is_said_plainly_and_a_missing_adapter_fails_clearly() {
+    let out = tmp("backend");
+    // auto: says which path it took and why (a software adapter does not count as a GPU).
     let mut c = bin();
-    c.args(["run", "--backend", "gpu", "--quiet", "--out"])
+    c.args(["run", "--out"])
         .arg(&out)
         .arg(common::case("dyka_bar.toml"));
     let o = c.output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let msg = stderr(&o);
+    let line = msg
+        .lines()
+        .find(|l| l.starts_with("backend:"))
+        .unwrap_or_else(|| panic!("no backend line: {msg}"));
+    assert!(line.contains("CPU path") || line.contains("gpu:"), "{line}");
+    if line.contains("CPU path") {
+        assert!(line.contains("auto found no usable GPU"), "{line}");
+    }
+    // gpu with an adapter name that matches nothing: exit 1, says what exists.
+    let mut c = bin();
+    c.args([
+        "run",
+        "--backend",
+        "gpu",
+        "--adapter",
+        "no-such-adapter",
+        "--quiet",
+        "--out",
+    ])
+    .arg(&out)
+    .arg(common::case("dyka_bar.toml"));
+    let o = c.output().unwrap();
     assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("GPU"), "{}", stderr(&o));
+    let msg = stderr(&o);
+    assert!(
+        msg.contains("no GPU adapter") && msg.contains("no-such-adapter"),
+        "{msg}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }

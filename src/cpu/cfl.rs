@@ -3,7 +3,29 @@
 //! speed at the particle's current density. GPU twin: `shaders/cfl.wgsl`.
 
 use crate::material::Material;
+use crate::model::Model;
 use rayon::prelude::*;
+
+/// Δt of a step starting at `t`, and whether it is the last: a step that
+/// would reach within 1e-6 of t_end is shortened to land on it exactly
+/// (the same rule as shaders/step_begin.wgsl).
+pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
+    let p = &model.particles;
+    let c = max_speed(
+        &p.v,
+        &p.rho,
+        &p.body,
+        &model.materials,
+        &model.body_material,
+    );
+    let dt = model.cfl * model.grid.min_spacing() / c;
+    let rem = model.t_end - t;
+    if dt >= rem * (1.0 - 1e-6) {
+        (rem, true)
+    } else {
+        (dt, false)
+    }
+}
 
 /// Largest signal speed over all particles (m/s).
 pub fn max_speed(

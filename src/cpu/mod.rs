@@ -13,7 +13,8 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
 
-use crate::backend::{Backend, ProbeState, Sample};
+use crate::backend::{Backend, Halt, ProbeState, Sample};
+use crate::error::Result;
 use crate::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
 use crate::solver::{STEP, Stage};
@@ -46,11 +47,6 @@ impl ShapeCache {
         let (o, n) = (p * self.stride, self.count[p] as usize);
         (&self.nodes[o..o + n], &self.w[o..o + n])
     }
-
-    /// Bytes held per particle.
-    pub fn bytes_per_particle(&self) -> usize {
-        2 + self.stride * (4 + 24)
-    }
 }
 
 /// Runs a `Model` on the CPU.
@@ -70,6 +66,8 @@ pub struct CpuBackend {
     steps: u64,
     /// Time step of the step in progress (s).
     dt: f64,
+    /// The step in progress lands on t_end.
+    final_step: bool,
 }
 
 impl CpuBackend {
@@ -93,30 +91,57 @@ impl CpuBackend {
             t: 0.0,
             steps: 0,
             dt: 0.0,
+            final_step: false,
             model,
         }
     }
 
-    /// Time step the next `step` would take (s).
-    pub fn next_dt(&self) -> f64 {
-        let m = &self.model;
-        let p = &m.particles;
-        let c = cfl::max_speed(&p.v, &p.rho, &p.body, &m.materials, &m.body_material);
-        (m.cfl * m.grid.min_spacing() / c).min(m.t_end - self.t)
+    /// Memory the CPU path holds per particle for `model` (bytes): the
+    /// particle fields it uses, the shape cache, and the grid's share.
+    pub fn bytes_per_particle_of(model: &Model) -> f64 {
+        let p = &model.particles;
+        let n = p.len().max(1) as f64;
+        // x, v, x0 (16 each), mass, rho (8 each), stress (24), body (4).
+        let mut per = 16.0 * 3.0 + 8.0 * 2.0 + 24.0 + 4.0;
+        if !p.a.is_empty() {
+            per += 16.0;
+        }
+        if !p.lambda.is_empty() {
+            per += 16.0;
+        }
+        // Shape cache: a count, then per slot a node index and 3 f64.
+        per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
+        // Nodes: [m, qx, qy] and [fx, fy] in f64.
+        per + model.grid.n_nodes() as f64 * 40.0 / n
     }
 
-    /// One step: the stages of `solver::STEP` in order.
-    pub fn step(&mut self) -> Result<(), Fault> {
+    /// Time step the next `step` would take (s).
+    pub fn next_dt(&self) -> f64 {
+        cfl::time_step(&self.model, self.t).0
+    }
+
+    /// Time step of the step in progress, or of the last one (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// One step: the stages of `solver::STEP` in order. The time advances
+    /// only when every stage succeeded.
+    pub fn step(&mut self) -> std::result::Result<(), Fault> {
         for stage in STEP {
             self.run_stage(*stage)?;
         }
-        self.t += self.dt;
+        self.t = if self.final_step {
+            self.model.t_end
+        } else {
+            self.t + self.dt
+        };
         self.steps += 1;
         Ok(())
     }
 
     /// Runs one stage of the step (public so tests can compare stages one by one).
-    pub fn run_stage(&mut self, stage: Stage) -> Result<(), Fault> {
+    pub fn run_stage(&mut self, stage: Stage) -> std::result::Result<(), Fault> {
         let m = &mut self.model;
         let p = &mut m.particles;
         let (gamma, npc) = match m.integrator {
@@ -124,10 +149,7 @@ impl CpuBackend {
             Integrator::Npc { gamma, .. } => (gamma, true),
         };
         match stage {
-            Stage::Cfl => {
-                let c = cfl::max_speed(&p.v, &p.rho, &p.body, &m.materials, &m.body_material);
-                self.dt = (m.cfl * m.grid.min_spacing() / c).min(m.t_end - self.t);
-            }
+            Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
             Stage::ClearGrid => clear_grid::clear_grid(&mut self.mv, &mut self.force),
             Stage::ShapeEval => {
                 shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
@@ -214,14 +236,14 @@ impl Backend for CpuBackend {
         self.steps
     }
 
-    fn advance(&mut self, t_stop: f64) -> Result<(), Fault> {
+    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt> {
         while self.t < t_stop && self.t < self.model.t_end {
             self.step()?;
         }
         Ok(())
     }
 
-    fn advance_steps(&mut self, n: u64) -> Result<(), Fault> {
+    fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt> {
         for _ in 0..n {
             if self.t >= self.model.t_end {
                 break;
@@ -231,9 +253,9 @@ impl Backend for CpuBackend {
         Ok(())
     }
 
-    fn sample(&mut self) -> Sample {
+    fn sample(&mut self) -> Result<Sample> {
         let p = &self.model.particles;
-        Sample {
+        Ok(Sample {
             t: self.t,
             probes: self
                 .model
@@ -247,11 +269,11 @@ impl Backend for CpuBackend {
                 .collect(),
             energy: energy::energy(&self.model),
             reactions: self.reactions.clone(),
-        }
+        })
     }
 
-    fn particles(&mut self) -> &Particles {
-        &self.model.particles
+    fn particles(&mut self) -> Result<&Particles> {
+        Ok(&self.model.particles)
     }
 
     fn model(&self) -> &Model {
@@ -259,20 +281,6 @@ impl Backend for CpuBackend {
     }
 
     fn bytes_per_particle(&self) -> f64 {
-        let n = self.model.particles.len().max(1) as f64;
-        let per_particle = 8.0 * (2.0 + 2.0 + 1.0 + 1.0 + 3.0 + 2.0)
-            + 4.0
-            + if self.model.particles.a.is_empty() {
-                0.0
-            } else {
-                16.0
-            }
-            + if self.model.particles.lambda.is_empty() {
-                0.0
-            } else {
-                16.0
-            }
-            + self.cache.bytes_per_particle() as f64;
-        per_particle + (self.mv.len() as f64 * 40.0) / n
+        CpuBackend::bytes_per_particle_of(&self.model)
     }
 }

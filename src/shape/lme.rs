@@ -124,7 +124,7 @@ impl Lme {
             }
         }
         if n < 3 {
-            return Err(ShapeFault::LmeTooFewNodes { nodes: n });
+            return Err(ShapeFault::LmeTooFewNodes { nodes: Some(n) });
         }
         let its = self.newton(&mut w[..n], lambda)?;
         Ok((n, its))
@@ -167,7 +167,7 @@ impl Lme {
             if it == self.max_iter {
                 return Err(ShapeFault::LmeNotConverged {
                     iterations: it,
-                    residual: rn / self.h,
+                    residual: Some(rn / self.h),
                 });
             }
             // Backtracking along the Newton direction (log Z is convex in λ).
@@ -190,7 +190,7 @@ impl Lme {
             let Some((trial, t)) = accepted else {
                 return Err(ShapeFault::LmeNotConverged {
                     iterations: it,
-                    residual: rn / self.h,
+                    residual: Some(rn / self.h),
                 });
             };
             lam = trial;

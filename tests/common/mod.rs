@@ -39,7 +39,7 @@ pub fn run(name: &str, sets: &[&str]) -> Run {
         sample_interval: scene.sample_interval,
         vtk_interval: None,
     };
-    let status = solver::drive(&mut backend, schedule, &mut recorder);
+    let status = solver::drive(&mut backend, schedule, &mut recorder).unwrap();
     let t = backend.time();
     let errors = scene
         .file
@@ -66,3 +66,5 @@ pub fn column(r: &Run) -> lme_mpm::exact::column::ColumnErrors {
         other => panic!("not a column score: {other:?}"),
     }
 }
+
+pub mod gpu;

@@ -1,0 +1,23 @@
+// Stage `clear_grid`: zero the nodal accumulators and the reactions.
+// CPU twin: src/cpu/clear_grid.rs.
+#include "shared/common.wgsl"
+
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
+@group(0) @binding({{B_REACTIONS}}) var<storage, read_write> reactions: array<f32>;
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = linear_index(gid, nwg);
+    if sim.running == 0u {
+        return;
+    }
+    if n < 2u * params.n_groups {
+        reactions[n] = 0.0;
+    }
+    if n >= params.n_nodes {
+        return;
+    }
+    for (var k = 0u; k < NODE_STRIDE; k++) {
+        node_acc[n * NODE_STRIDE + k] = 0.0;
+    }
+}

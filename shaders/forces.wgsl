@@ -1,0 +1,47 @@
+// Stage `forces`: f_I += −V_p σ_p ∇N_I + N_I m_p b(t) with atomics,
+// V_p = m_p/ρ_p. CPU twin: src/cpu/forces.rs.
+#include "shared/common.wgsl"
+#include "shared/shape_bindings.wgsl" LME_ACCESS=read
+#include "shared/shape.wgsl"
+
+@group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
+@group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
+@group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
+@group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
+@group(0) @binding({{B_STRESS}}) var<storage, read> stress: array<f32>;
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
+
+#include "shared/atomics.wgsl" ARR=node_acc FN=node_add
+
+// Gravity at time t (paper eq. 45 when ramped).
+fn gravity_at(t: f32) -> vec2<f32> {
+    let period = params.ramp_period;
+    if period > 0.0 && t <= 0.5 * period {
+        let pi = 3.14159265358979;
+        return params.gravity * 0.5 * (sin(2.0 * pi * t / period - 0.5 * pi) + 1.0);
+    }
+    return params.gravity;
+}
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if sim.running == 0u || p >= params.n_particles {
+        return;
+    }
+    let m = mass[p];
+    let vol = m / rho[p];
+    let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+    let b = m * gravity_at(sim.t + sim.t_lo);
+    let c = shape_ctx(p, x0[p] + u[p]);
+    for (var k = 0u; k < STENCIL; k++) {
+        let w = shape_node(c, k);
+        if !w.ok {
+            continue;
+        }
+        let f = -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * b;
+        let base = w.node * NODE_STRIDE;
+        node_add(base + 3u, f.x);
+        node_add(base + 4u, f.y);
+    }
+}

@@ -1,0 +1,62 @@
+// Stage `g2p`: particle update and checks.
+// FE:  v += Δt Σ N f/m;  u += Δt Σ N v_I.
+// NPC: a = Σ N f/m;  v += Δt a;  u += Δt Σ N v_I (+ ½ Δt² a), v_I corrected or
+//      predicted as NPC_POSITION_* says. Positions live as x0 + u, so f32
+//      displacements keep their precision.
+// CPU twin: src/cpu/g2p.rs.
+#include "shared/common.wgsl"
+#include "shared/shape_bindings.wgsl" LME_ACCESS=read
+#include "shared/shape.wgsl"
+
+@group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
+@group(0) @binding({{B_U}}) var<storage, read_write> u: array<vec2<f32>>;
+@group(0) @binding({{B_V}}) var<storage, read_write> v: array<vec2<f32>>;
+#if NPC
+@group(0) @binding({{B_A}}) var<storage, read_write> a: array<vec2<f32>>;
+#endif
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read> node_acc: array<f32>;
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if sim.running == 0u || p >= params.n_particles {
+        return;
+    }
+    let dt = sim.dt;
+    let c = shape_ctx(p, x0[p] + u[p]);
+    var acc = vec2<f32>(0.0);
+    var vel = vec2<f32>(0.0);
+    for (var k = 0u; k < STENCIL; k++) {
+        let w = shape_node(c, k);
+        if !w.ok {
+            continue;
+        }
+        let b = w.node * NODE_STRIDE;
+        let m = node_acc[b];
+        if m > params.mass_eps {
+            acc += w.n * vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]) / m;
+            vel += w.n * vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]);
+        }
+    }
+    let vp = v[p] + dt * acc;
+    var du = dt * vel;
+#if NPC
+#if !NPC_POSITION_CORRECTED
+    du -= params.npc_gamma * dt * dt * acc;
+#endif
+#if !NPC_POSITION_NEWMARK
+    du += 0.5 * dt * dt * acc;
+#endif
+    a[p] = acc;
+#endif
+    let up = u[p] + du;
+    v[p] = vp;
+    u[p] = up;
+    if !(is_finite(up.x) && is_finite(up.y) && is_finite(vp.x) && is_finite(vp.y)) {
+        report_fault(FAULT_NON_FINITE_MOTION, p);
+        return;
+    }
+    if !inside_grid(x0[p] + up, params.edge_margin) {
+        report_fault(FAULT_LEFT_GRID, p);
+    }
+}

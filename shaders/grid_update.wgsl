@@ -1,0 +1,81 @@
+// Stage `grid_update`, two entry points around the force computation.
+// `predict`: v_I = q_I / m_I, then fixed components set to zero.
+// `correct`: reactions (−f on fixed components, summed per constraint),
+// those components zeroed, then v_I += γ Δt f_I / m_I (FE: γ = 1).
+// CPU twin: src/cpu/grid_update.rs.
+#include "shared/common.wgsl"
+
+@group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
+#if CORRECT
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
+@group(0) @binding({{B_REACTIONS}}) var<storage, read_write> reactions: array<{{ATOMIC_T}}>;
+#include "shared/atomics.wgsl" ARR=reactions FN=reaction_add
+#else
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
+#endif
+
+// Fixed directions of node (i, j): bit 1 = x, bit 2 = y.
+fn fix_bits(i: u32, j: u32) -> u32 {
+    var f = 0u;
+    for (var g = 0u; g < params.n_groups; g++) {
+        let c = constraints[g];
+        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+            f |= c.fix;
+        }
+    }
+    return f;
+}
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = linear_index(gid, nwg);
+    if sim.running == 0u || n >= params.n_nodes {
+        return;
+    }
+    let i = n % params.nx;
+    let j = n / params.nx;
+    let b = n * NODE_STRIDE;
+    let m = node_acc[b];
+#if CORRECT
+    var f = vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]);
+    for (var g = 0u; g < params.n_groups; g++) {
+        let c = constraints[g];
+        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+            if (c.fix & 1u) != 0u && f.x != 0.0 {
+                reaction_add(2u * g, -f.x);
+            }
+            if (c.fix & 2u) != 0u && f.y != 0.0 {
+                reaction_add(2u * g + 1u, -f.y);
+            }
+        }
+    }
+    let fix = fix_bits(i, j);
+    if (fix & 1u) != 0u {
+        f.x = 0.0;
+    }
+    if (fix & 2u) != 0u {
+        f.y = 0.0;
+    }
+    node_acc[b + 3u] = f.x;
+    node_acc[b + 4u] = f.y;
+    if m > params.mass_eps {
+        let gdt = params.npc_gamma * sim.dt / m;
+        node_acc[b + 1u] += gdt * f.x;
+        node_acc[b + 2u] += gdt * f.y;
+    }
+#else
+    var vel = vec2<f32>(0.0);
+    if m > params.mass_eps {
+        vel = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) / m;
+        let fix = fix_bits(i, j);
+        if (fix & 1u) != 0u {
+            vel.x = 0.0;
+        }
+        if (fix & 2u) != 0u {
+            vel.y = 0.0;
+        }
+    }
+    node_acc[b + 1u] = vel.x;
+    node_acc[b + 2u] = vel.y;
+#endif
+}

@@ -1,0 +1,33 @@
+// Bilinear Q4 (isoparametric on perturbed grids). CPU twin: src/shape/linear.rs.
+
+const STENCIL: u32 = 4u;
+
+struct ShapeCtx {
+    cp: CellPoint,
+}
+
+fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
+    return ShapeCtx(locate(x));
+}
+
+fn shape_valid(c: ShapeCtx) -> bool {
+    return c.cp.ok;
+}
+
+fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
+    // Corners counter-clockwise from (0, 0), as on the CPU.
+    let di = select(0u, 1u, k == 1u || k == 2u);
+    let dj = select(0u, 1u, k >= 2u);
+    let s = c.cp.st.x;
+    let t = c.cp.st.y;
+    let ns = select(1.0 - s, s, di == 1u);
+    let nt = select(1.0 - t, t, dj == 1u);
+    let ds = select(-1.0, 1.0, di == 1u);
+    let dt = select(-1.0, 1.0, dj == 1u);
+    var w: NodeW;
+    w.node = (c.cp.j + dj) * params.nx + c.cp.i + di;
+    w.n = ns * nt;
+    w.dn = to_physical(c.cp.map, vec2<f32>(ds * nt, ns * dt));
+    w.ok = c.cp.ok;
+    return w;
+}

@@ -1,0 +1,99 @@
+// Local max-ent weights. Default: from a particle's solved state (λ, log Z,
+// J⁻¹), which `lme_newton` writes each step: N_a = exp(−β|d|² + λ·d − log Z),
+// ∇N_a = −N_a J⁻¹ d, d = x − x_a, over nodes within the support radius, one
+// pass over the search box per use (24 bytes per particle). LME_STORED:
+// `lme_newton` stores N and ∇N per search-box slot (16 bytes per slot) and
+// the passes read them. docs/performance.md compares the two.
+// CPU twin: src/shape/lme.rs.
+
+const STENCIL: u32 = {{LME_SIDE}}u * {{LME_SIDE}}u;
+const LME_EMPTY: u32 = 0xffffffffu;
+
+// First node of the search box around x.
+fn lme_box(x: vec2<f32>) -> vec2<u32> {
+    let q = x * params.inv_h;
+    return vec2<u32>(max(ceil(q - vec2<f32>(params.lme_reach)), vec2<f32>(0.0)));
+}
+
+// The k-th node of the search box and its offset d = x − x_a, if inside the support.
+struct LmeNode {
+    node: u32,
+    d: vec2<f32>,
+    ok: bool,
+}
+
+fn lme_node(x: vec2<f32>, i0: u32, j0: u32, k: u32) -> LmeNode {
+    var r: LmeNode;
+    let i = i0 + k % params.lme_side;
+    let j = j0 + k / params.lme_side;
+    r.ok = i < params.nx && j < params.ny;
+    if r.ok {
+        r.d = x - node_xy(i, j);
+        r.ok = dot(r.d, r.d) <= params.lme_r2;
+        r.node = j * params.nx + i;
+    }
+    return r;
+}
+
+#if LME_STORED
+struct ShapeCtx {
+    base: u32,
+    ok: bool,
+}
+
+fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
+    return ShapeCtx(p * STENCIL, inside_grid(x, 0.0));
+}
+
+fn shape_valid(c: ShapeCtx) -> bool {
+    return c.ok;
+}
+
+fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
+    let s = c.base + k;
+    var w: NodeW;
+    w.node = lme_nodes[s];
+    w.ok = c.ok && w.node != LME_EMPTY;
+    w.n = lme_w[3u * s];
+    w.dn = vec2<f32>(lme_w[3u * s + 1u], lme_w[3u * s + 2u]);
+    return w;
+}
+#else
+struct ShapeCtx {
+    x: vec2<f32>,
+    i0: u32,
+    j0: u32,
+    lam: vec2<f32>,
+    // log Z, then J⁻¹ as [00, 01, 11].
+    cache: vec4<f32>,
+    ok: bool,
+}
+
+fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
+    var c: ShapeCtx;
+    c.x = x;
+    let b = lme_box(x);
+    c.i0 = b.x;
+    c.j0 = b.y;
+    c.lam = lambda[p];
+    c.cache = lme_cache[p];
+    c.ok = inside_grid(x, 0.0);
+    return c;
+}
+
+fn shape_valid(c: ShapeCtx) -> bool {
+    return c.ok;
+}
+
+fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
+    let a = lme_node(c.x, c.i0, c.j0, k);
+    var w: NodeW;
+    w.ok = a.ok && c.ok;
+    w.node = a.node;
+    let f = -params.lme_beta * dot(a.d, a.d) + dot(c.lam, a.d);
+    w.n = exp(f - c.cache.x);
+    let jd = vec2<f32>(c.cache.y * a.d.x + c.cache.z * a.d.y, c.cache.z * a.d.x + c.cache.w * a.d.y);
+    w.dn = -w.n * jd;
+    return w;
+}
+#endif

@@ -1,0 +1,123 @@
+// Shared structs and helpers. Keep in sync with src/gpu/layout.rs, which
+// defines each struct once in Rust with a compile-time size check; the test
+// tests/gpu_layout.rs compares both with naga's reflection of this file.
+
+const WG: u32 = 256u;
+// Fault codes, packed as (particle << 4) | code into Sim.fault (atomicMin
+// keeps the lowest particle). Keep in sync with src/gpu/layout.rs.
+const FAULT_NONE: u32 = 0xffffffffu;
+const FAULT_LEFT_GRID: u32 = 1u;
+const FAULT_NON_FINITE_STRAIN: u32 = 2u;
+const FAULT_NON_FINITE_STRESS: u32 = 3u;
+const FAULT_NON_FINITE_MOTION: u32 = 4u;
+const FAULT_DENSITY: u32 = 5u;
+const FAULT_LME_FEW_NODES: u32 = 6u;
+const FAULT_LME_NOT_CONVERGED: u32 = 7u;
+const FAULT_LME_SINGULAR: u32 = 8u;
+
+// Scene constants (uniform), fixed for a run.
+struct Params {
+    n_particles: u32,
+    n_nodes: u32,
+    nx: u32,
+    ny: u32,
+    h: f32,
+    inv_h: f32,
+    // CFL number times the smallest node spacing (m).
+    cfl_h: f32,
+    // Nodes lighter than this (kg) are empty.
+    mass_eps: f32,
+    // t_end as a two-float sum (s).
+    t_end_hi: f32,
+    t_end_lo: f32,
+    // Full gravity (m/s^2).
+    gravity: vec2<f32>,
+    // T of the sine ramp (eq. 45); 0 = constant gravity.
+    ramp_period: f32,
+    // NPC γ; FE uses 1 (the nodal momentum update).
+    npc_gamma: f32,
+    // (1 − γ) for the NPC predictor; FE 0.
+    p2g_accel: f32,
+    // Distance a particle keeps from the grid's edge (m).
+    edge_margin: f32,
+    // Grid size (m): positions run over [0, grid_w] x [0, grid_hgt].
+    grid_w: f32,
+    grid_hgt: f32,
+    // LME: β (1/m^2), support radius squared (m^2), Newton |r| tolerance (m),
+    // search reach (cells), search box side (nodes), iteration cap.
+    lme_beta: f32,
+    lme_r2: f32,
+    lme_tol: f32,
+    lme_reach: f32,
+    lme_side: u32,
+    lme_max_iter: u32,
+    // uGIMP particle half-width over h.
+    ugimp_lp: f32,
+    n_groups: u32,
+    n_probes: u32,
+    n_materials: u32,
+}
+
+// Run state on the device (storage, read_write), read back at sample times.
+struct Sim {
+    // Time reached (s) as a compensated (Kahan) sum t + t_lo.
+    t: f32,
+    t_lo: f32,
+    // This step's Δt (s).
+    dt: f32,
+    // Steps stop once the time reaches t_stop_hi + t_stop_lo (s).
+    t_stop_hi: f32,
+    t_stop_lo: f32,
+    steps: u32,
+    // 1 while the current step runs; every pass returns early on 0.
+    running: u32,
+    // 1 when this step lands on t_end.
+    final_step: u32,
+    // Largest signal speed (m/s) as f32 bits: positive floats order like u32.
+    cmax_bits: atomic<u32>,
+    // (particle << 4) | code of the first fault, FAULT_NONE if none.
+    fault: atomic<u32>,
+    // Most LME Newton iterations any particle took (diagnostics).
+    lme_iters: atomic<u32>,
+    _pad: u32,
+}
+
+struct Material {
+    // Lamé λ, shear modulus μ, P-wave modulus λ + 2μ, Young's E (Pa), ν.
+    lame: f32,
+    shear: f32,
+    p_modulus: f32,
+    youngs: f32,
+    nu: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+// Nodes with i0 <= i <= i1 and j0 <= j <= j1 are fixed in the `fix` bits
+// (1 = x, 2 = y); their reactions add up in `reactions[group]`.
+struct Constraint {
+    i0: u32,
+    i1: u32,
+    j0: u32,
+    j1: u32,
+    fix: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// Linear invocation index over a 2D dispatch (large counts exceed 65535
+// workgroups in x).
+fn linear_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+fn is_finite(v: f32) -> bool {
+    // NaN fails v == v; ±inf exceed the largest finite f32.
+    return v == v && abs(v) <= 3.4028235e38;
+}
+
+fn report_fault(code: u32, particle: u32) {
+    atomicMin(&sim.fault, (particle << 4u) | code);
+}

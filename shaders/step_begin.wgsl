@@ -1,0 +1,27 @@
+// Stage `step_begin` (one invocation): this step's Δt from the CFL reduction
+// and whether the step runs at all. Twin of the Δt and stop logic of
+// CpuBackend (src/cpu/mod.rs, Stage::Cfl and `advance`).
+#include "shared/common.wgsl"
+
+@compute @workgroup_size(1)
+fn main() {
+    let fault = atomicLoad(&sim.fault);
+    let cmax = bitcast<f32>(atomicLoad(&sim.cmax_bits));
+    // The next `cfl` pass accumulates from zero.
+    atomicStore(&sim.cmax_bits, 0u);
+    let rem_stop = (sim.t_stop_hi - sim.t) + (sim.t_stop_lo - sim.t_lo);
+    let rem_end = (params.t_end_hi - sim.t) + (params.t_end_lo - sim.t_lo);
+    sim.final_step = 0u;
+    if fault != FAULT_NONE || rem_stop <= 0.0 || rem_end <= 0.0 {
+        sim.running = 0u;
+        sim.dt = 0.0;
+        return;
+    }
+    var dt = params.cfl_h / cmax;
+    if dt >= rem_end * (1.0 - 1e-6) {
+        dt = rem_end;
+        sim.final_step = 1u;
+    }
+    sim.dt = dt;
+    sim.running = 1u;
+}

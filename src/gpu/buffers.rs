@@ -1,0 +1,306 @@
+//! GPU buffers: one per field (so no single binding passes an adapter's
+//! limit), made only for what the scene uses (no `a` without NPC, no λ
+//! without LME, no node positions on a regular grid). The binding table
+//! below is the one place binding numbers are defined: WGSL files write
+//! `@binding({{B_X0}})`, the preprocessor fills in the number.
+
+use super::GpuOptions;
+use super::context::GpuContext;
+use super::layout::{GpuConstraint, GpuMaterial, NODE_STRIDE, PROBE_STRIDE, Params, Sim};
+use crate::error::{Error, Result};
+use crate::material::Material;
+use crate::model::{FIX_X, FIX_Y, Integrator, Model};
+use crate::shape::Shape;
+use std::collections::BTreeMap;
+
+/// Every buffer a stage may bind. The binding number is the position here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Buf {
+    Params,
+    Sim,
+    Materials,
+    Constraints,
+    X0,
+    U,
+    V,
+    A,
+    Mass,
+    Rho,
+    Stress,
+    Mat,
+    Lambda,
+    LmeCache,
+    LmeNodes,
+    LmeW,
+    NodeAcc,
+    NodePos,
+    Reactions,
+    ProbeIdx,
+    ProbeOut,
+    EnergyOut,
+}
+
+impl Buf {
+    pub const ALL: [Buf; 22] = [
+        Buf::Params,
+        Buf::Sim,
+        Buf::Materials,
+        Buf::Constraints,
+        Buf::X0,
+        Buf::U,
+        Buf::V,
+        Buf::A,
+        Buf::Mass,
+        Buf::Rho,
+        Buf::Stress,
+        Buf::Mat,
+        Buf::Lambda,
+        Buf::LmeCache,
+        Buf::LmeNodes,
+        Buf::LmeW,
+        Buf::NodeAcc,
+        Buf::NodePos,
+        Buf::Reactions,
+        Buf::ProbeIdx,
+        Buf::ProbeOut,
+        Buf::EnergyOut,
+    ];
+
+    pub fn binding(self) -> u32 {
+        Buf::ALL.iter().position(|b| *b == self).expect("in ALL") as u32
+    }
+
+    pub fn from_binding(b: u32) -> Option<Buf> {
+        Buf::ALL.get(b as usize).copied()
+    }
+
+    /// Token in WGSL: `{{B_NODE_ACC}}` for `Buf::NodeAcc`.
+    pub fn token(self) -> String {
+        let name = format!("{self:?}");
+        let mut t = String::from("B");
+        for c in name.chars() {
+            if c.is_uppercase() {
+                t.push('_');
+            }
+            t.push(c.to_ascii_uppercase());
+        }
+        t
+    }
+}
+
+/// The buffers of one run and the model they were built from.
+pub struct Buffers {
+    pub map: BTreeMap<Buf, wgpu::Buffer>,
+    pub n_particles: usize,
+    pub n_nodes: usize,
+    pub n_probes: usize,
+    pub n_groups: usize,
+}
+
+fn f32x2(v: [f64; 2]) -> [f32; 2] {
+    [v[0] as f32, v[1] as f32]
+}
+
+impl Buffers {
+    pub fn get(&self, b: Buf) -> &wgpu::Buffer {
+        self.map
+            .get(&b)
+            .unwrap_or_else(|| panic!("buffer {b:?} not made for this scene"))
+    }
+
+    /// Bytes of GPU memory held, and per particle.
+    pub fn bytes(&self) -> u64 {
+        self.map.values().map(|b| b.size()).sum()
+    }
+
+    /// Makes and fills every buffer `model` needs.
+    pub fn new(
+        ctx: &GpuContext,
+        model: &Model,
+        params: &Params,
+        opts: &GpuOptions,
+    ) -> Result<Buffers> {
+        let p = &model.particles;
+        let n = p.len();
+        let g = &model.grid;
+        let origin = g.min;
+        let rel = |x: [f64; 2]| [(x[0] - origin[0]) as f32, (x[1] - origin[1]) as f32];
+        let mut data: Vec<(Buf, Vec<u8>)> = Vec::new();
+        let bytes = |v: &[f32]| bytemuck::cast_slice::<f32, u8>(v).to_vec();
+        let flat2 = |it: &mut dyn Iterator<Item = [f32; 2]>| it.flatten().collect::<Vec<f32>>();
+
+        data.push((Buf::Params, bytemuck::bytes_of(params).to_vec()));
+        data.push((Buf::Sim, bytemuck::bytes_of(&initial_sim()).to_vec()));
+        let mats: Vec<GpuMaterial> = model
+            .materials
+            .iter()
+            .map(|m| match m {
+                Material::LinearElastic(e) => GpuMaterial {
+                    lame: e.lame as f32,
+                    shear: e.shear as f32,
+                    p_modulus: e.p_modulus as f32,
+                    youngs: e.youngs as f32,
+                    nu: e.nu as f32,
+                    _pad: [0.0; 3],
+                },
+            })
+            .collect();
+        data.push((Buf::Materials, bytemuck::cast_slice(&mats).to_vec()));
+        data.push((
+            Buf::Constraints,
+            bytemuck::cast_slice(&constraints(model)).to_vec(),
+        ));
+        data.push((Buf::X0, bytes(&flat2(&mut p.x0.iter().map(|x| rel(*x))))));
+        let u: Vec<f32> =
+            flat2(&mut (0..n).map(|i| f32x2([p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]])));
+        data.push((Buf::U, bytes(&u)));
+        data.push((Buf::V, bytes(&flat2(&mut p.v.iter().map(|v| f32x2(*v))))));
+        if matches!(model.integrator, Integrator::Npc { .. }) {
+            data.push((Buf::A, bytes(&flat2(&mut p.a.iter().map(|v| f32x2(*v))))));
+        }
+        let to32 = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
+        data.push((Buf::Mass, bytes(&to32(&p.mass))));
+        data.push((Buf::Rho, bytes(&to32(&p.rho))));
+        let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
+        data.push((Buf::Stress, bytes(&s)));
+        if model.materials.len() > 1 {
+            let mat: Vec<u32> = p
+                .body
+                .iter()
+                .map(|b| model.body_material[*b as usize])
+                .collect();
+            data.push((Buf::Mat, bytemuck::cast_slice(&mat).to_vec()));
+        }
+        if matches!(model.shape, Shape::Lme(_)) {
+            data.push((
+                Buf::Lambda,
+                bytes(&flat2(&mut p.lambda.iter().map(|v| f32x2(*v)))),
+            ));
+            if opts.lme_stored {
+                let slots = (params.lme_side * params.lme_side) as usize;
+                data.push((Buf::LmeNodes, vec![0xffu8; 4 * slots * n]));
+                data.push((Buf::LmeW, vec![0u8; 12 * slots * n]));
+            } else {
+                data.push((Buf::LmeCache, vec![0u8; 16 * n]));
+            }
+        }
+        data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * g.n_nodes()]));
+        if g.is_perturbed() {
+            data.push((
+                Buf::NodePos,
+                bytes(&flat2(&mut g.pos.iter().map(|x| rel(*x)))),
+            ));
+        }
+        let groups = model.constraints.groups.len();
+        data.push((Buf::Reactions, vec![0u8; 8 * groups.max(1)]));
+        let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
+        let probe_idx = if probe_idx.is_empty() {
+            vec![0]
+        } else {
+            probe_idx
+        };
+        data.push((Buf::ProbeIdx, bytemuck::cast_slice(&probe_idx).to_vec()));
+        data.push((
+            Buf::ProbeOut,
+            vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
+        ));
+        data.push((Buf::EnergyOut, vec![0u8; 16]));
+
+        let limit = ctx.limits.max_storage_buffer_binding_size;
+        let max_buf = ctx.limits.max_buffer_size;
+        let mut map = BTreeMap::new();
+        for (b, bytes) in data {
+            let size = (bytes.len() as u64).max(16).next_multiple_of(4);
+            if size > limit.min(max_buf) {
+                return Err(Error::Gpu(format!(
+                    "the {b:?} buffer needs {size} bytes, more than this adapter binds ({} bytes): \
+                     the scene has {n} particles and {} nodes; use fewer, or an adapter with larger bindings",
+                    limit.min(max_buf),
+                    g.n_nodes()
+                )));
+            }
+            let usage = if b == Buf::Params {
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
+            } else {
+                wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC
+            };
+            let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{b:?}")),
+                size,
+                usage,
+                mapped_at_creation: false,
+            });
+            ctx.queue.write_buffer(&buf, 0, &bytes);
+            map.insert(b, buf);
+        }
+        Ok(Buffers {
+            map,
+            n_particles: n,
+            n_nodes: g.n_nodes(),
+            n_probes: model.probes.len(),
+            n_groups: groups,
+        })
+    }
+}
+
+/// The Sim state at t = 0.
+pub fn initial_sim() -> Sim {
+    Sim {
+        t: 0.0,
+        t_lo: 0.0,
+        dt: 0.0,
+        t_stop_hi: 0.0,
+        t_stop_lo: 0.0,
+        steps: 0,
+        running: 0,
+        final_step: 0,
+        cmax_bits: 0,
+        fault: super::layout::FAULT_NONE,
+        lme_iters: 0,
+        _pad: 0,
+    }
+}
+
+/// Constraint groups as lattice index boxes (membership is decided on the
+/// unperturbed lattice, exactly as `model::build_constraints` does).
+fn constraints(model: &Model) -> Vec<GpuConstraint> {
+    let g = &model.grid;
+    let mut out = Vec::new();
+    for grp in &model.constraints.groups {
+        let (mut i0, mut i1, mut j0, mut j1) = (u32::MAX, 0, u32::MAX, 0);
+        for &n in &grp.nodes {
+            let (i, j) = (n % g.nx as u32, n / g.nx as u32);
+            i0 = i0.min(i);
+            i1 = i1.max(i);
+            j0 = j0.min(j);
+            j1 = j1.max(j);
+        }
+        debug_assert_eq!(
+            ((i1 - i0 + 1) * (j1 - j0 + 1)) as usize,
+            grp.nodes.len(),
+            "a box region selects a box of nodes"
+        );
+        out.push(GpuConstraint {
+            i0,
+            i1,
+            j0,
+            j1,
+            fix: (grp.fix & FIX_X) as u32 | (grp.fix & FIX_Y) as u32,
+            _pad: [0; 3],
+        });
+    }
+    if out.is_empty() {
+        // A binding may not be empty; n_groups = 0 keeps this one unread.
+        out.push(GpuConstraint {
+            i0: 1,
+            i1: 0,
+            j0: 1,
+            j1: 0,
+            fix: 0,
+            _pad: [0; 3],
+        });
+    }
+    out
+}

@@ -1,0 +1,106 @@
+//! Every struct shared with WGSL, defined once here with explicit padding
+//! and a compile-time size check. Keep in sync with shaders/shared/types.wgsl;
+//! tests/gpu_layout.rs compares offsets and sizes with naga's reflection.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Scene constants (uniform). See types.wgsl for each field's meaning and unit.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct Params {
+    pub n_particles: u32,
+    pub n_nodes: u32,
+    pub nx: u32,
+    pub ny: u32,
+    pub h: f32,
+    pub inv_h: f32,
+    pub cfl_h: f32,
+    pub mass_eps: f32,
+    pub t_end_hi: f32,
+    pub t_end_lo: f32,
+    pub gravity: [f32; 2],
+    pub ramp_period: f32,
+    pub npc_gamma: f32,
+    pub p2g_accel: f32,
+    pub edge_margin: f32,
+    pub grid_w: f32,
+    pub grid_hgt: f32,
+    pub lme_beta: f32,
+    pub lme_r2: f32,
+    pub lme_tol: f32,
+    pub lme_reach: f32,
+    pub lme_side: u32,
+    pub lme_max_iter: u32,
+    pub ugimp_lp: f32,
+    pub n_groups: u32,
+    pub n_probes: u32,
+    pub n_materials: u32,
+}
+const _: () = assert!(std::mem::size_of::<Params>() == 112);
+
+/// Run state on the device. Atomic fields of the WGSL struct are plain u32 here.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct Sim {
+    pub t: f32,
+    pub t_lo: f32,
+    pub dt: f32,
+    pub t_stop_hi: f32,
+    pub t_stop_lo: f32,
+    pub steps: u32,
+    pub running: u32,
+    pub final_step: u32,
+    pub cmax_bits: u32,
+    pub fault: u32,
+    pub lme_iters: u32,
+    pub _pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<Sim>() == 48);
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuMaterial {
+    pub lame: f32,
+    pub shear: f32,
+    pub p_modulus: f32,
+    pub youngs: f32,
+    pub nu: f32,
+    pub _pad: [f32; 3],
+}
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 32);
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuConstraint {
+    pub i0: u32,
+    pub i1: u32,
+    pub j0: u32,
+    pub j1: u32,
+    pub fix: u32,
+    pub _pad: [u32; 3],
+}
+const _: () = assert!(std::mem::size_of::<GpuConstraint>() == 32);
+
+/// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
+pub const NODE_STRIDE: usize = 5;
+/// Floats per probe in the probe buffer.
+pub const PROBE_STRIDE: usize = 8;
+/// Workgroup size of the per-particle and per-node passes.
+pub const WG: u32 = 256;
+
+/// Fault codes (types.wgsl): `Sim::fault` = (particle << 4) | code.
+pub const FAULT_NONE: u32 = 0xffff_ffff;
+pub const FAULT_LEFT_GRID: u32 = 1;
+pub const FAULT_NON_FINITE_STRAIN: u32 = 2;
+pub const FAULT_NON_FINITE_STRESS: u32 = 3;
+pub const FAULT_NON_FINITE_MOTION: u32 = 4;
+pub const FAULT_DENSITY: u32 = 5;
+pub const FAULT_LME_FEW_NODES: u32 = 6;
+pub const FAULT_LME_NOT_CONVERGED: u32 = 7;
+pub const FAULT_LME_SINGULAR: u32 = 8;
+
+/// Splits an f64 into a two-float sum hi + lo (for times in f32).
+pub fn split_f64(v: f64) -> (f32, f32) {
+    let hi = v as f32;
+    (hi, (v - hi as f64) as f32)
+}

@@ -1,0 +1,518 @@
+//! The GPU path: every stage of `solver::STEP` as a wgpu compute pass over
+//! f32 buffers, many steps per submission, with Δt computed on the device
+//! and the state read back only at sample and output times.
+//!
+//! `context` opens an adapter, `buffers` holds one buffer per field,
+//! `pipelines` builds the scene's passes from `shaders/` (expanded by
+//! `preprocess`), `layout` defines the structs shared with WGSL.
+
+pub mod buffers;
+pub mod context;
+pub mod layout;
+pub mod pipelines;
+pub mod preprocess;
+
+use crate::backend::{Backend, Halt, ProbeState, Sample};
+use crate::cpu::CpuBackend;
+use crate::cpu::energy::Energy;
+use crate::error::{Error, Result};
+use crate::fault::{Fault, FaultKind};
+use crate::model::{Integrator, Model, Particles};
+use crate::shape::{Shape, ShapeFault};
+use buffers::{Buf, Buffers};
+use context::{AtomicMode, GpuContext};
+use layout::*;
+use pipelines::{Pass, Pipelines};
+
+/// Most steps recorded into one submission.
+const MAX_BATCH: u64 = 512;
+/// LME Newton tolerance on the GPU: |r| ≤ 1e-5 h. f32 sums of ~20 terms of
+/// size ~h carry ~3e-7 h of round-off; 30 times that converges reliably
+/// (the CPU's f64 Newton uses 1e-10 h).
+pub const LME_TOL_F32: f64 = 1e-5;
+
+/// Choices of the GPU path that are not part of the scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GpuOptions {
+    /// LME: store N and ∇N per particle and search-box slot in `lme_newton`
+    /// instead of recomputing them from (λ, log Z, J⁻¹) in each pass. Off by
+    /// default: docs/performance.md has the measurement that decided it.
+    pub lme_stored: bool,
+}
+
+/// Runs a `Model` on a GPU adapter.
+pub struct GpuBackend {
+    pub ctx: GpuContext,
+    model: Model,
+    params: Params,
+    buffers: Buffers,
+    pipelines: Pipelines,
+    /// Device state at the last read-back.
+    sim: Sim,
+    /// Host particles match the device.
+    fresh: bool,
+    /// First Δt, computed on the host, to size the first batch (s).
+    dt_hint: f64,
+}
+
+impl GpuBackend {
+    /// Uploads `model` and builds its pipelines.
+    pub fn new(ctx: GpuContext, model: Model) -> Result<GpuBackend> {
+        GpuBackend::with_options(ctx, model, GpuOptions::default())
+    }
+
+    pub fn with_options(ctx: GpuContext, model: Model, opts: GpuOptions) -> Result<GpuBackend> {
+        let params = params(&model);
+        let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
+        let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
+        let dt_hint = crate::cpu::cfl::time_step(&model, 0.0).0;
+        let mut b = GpuBackend {
+            ctx,
+            model,
+            params,
+            buffers,
+            pipelines,
+            sim: buffers::initial_sim(),
+            fresh: true,
+            dt_hint,
+        };
+        b.sim = b.read_sim()?;
+        Ok(b)
+    }
+
+    pub fn atomics(&self) -> AtomicMode {
+        self.ctx.atomics
+    }
+
+    /// Records `n` whole steps into one submission.
+    fn submit_steps(&self, n: u64) {
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut cpass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("steps"),
+                timestamp_writes: None,
+            });
+            for _ in 0..n {
+                self.pipelines.encode_step(&mut cpass);
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Runs one pass on its own (per-stage parity tests).
+    pub fn run_pass(&mut self, pass: Pass) {
+        self.fresh = false;
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut cpass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pass"),
+                timestamp_writes: None,
+            });
+            self.pipelines.dispatch(&mut cpass, pass);
+        }
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Copies whole buffers to the host (one staging buffer, one wait).
+    pub fn read(&self, bufs: &[Buf]) -> Result<Vec<Vec<u8>>> {
+        let sizes: Vec<u64> = bufs.iter().map(|b| self.buffers.get(*b).size()).collect();
+        let total: u64 = sizes.iter().sum();
+        let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read-back"),
+            size: total,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        let mut off = 0;
+        for (b, s) in bufs.iter().zip(&sizes) {
+            enc.copy_buffer_to_buffer(self.buffers.get(*b), 0, &staging, off, *s);
+            off += s;
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.ctx
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
+        rx.recv()
+            .map_err(|_| Error::Gpu("read-back callback never ran".into()))?
+            .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
+        let view = staging
+            .get_mapped_range(..)
+            .map_err(|e| Error::Gpu(format!("reading a mapped buffer: {e}")))?;
+        let mut out = Vec::with_capacity(bufs.len());
+        let mut off = 0usize;
+        for s in &sizes {
+            out.push(view[off..off + *s as usize].to_vec());
+            off += *s as usize;
+        }
+        drop(view);
+        staging.unmap();
+        Ok(out)
+    }
+
+    /// The device's run state now.
+    pub fn read_sim(&self) -> Result<Sim> {
+        let b = self.read(&[Buf::Sim])?;
+        Ok(*bytemuck::from_bytes::<Sim>(
+            &b[0][..std::mem::size_of::<Sim>()],
+        ))
+    }
+
+    /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32).
+    pub fn read_nodes(&self) -> Result<Vec<[f32; NODE_STRIDE]>> {
+        let b = self.read(&[Buf::NodeAcc])?;
+        let f: &[f32] = bytemuck::cast_slice(&b[0]);
+        Ok(f.chunks_exact(NODE_STRIDE)
+            .take(self.buffers.n_nodes)
+            .map(|c| c.try_into().expect("chunk of NODE_STRIDE"))
+            .collect())
+    }
+
+    /// Reactions per constraint group, as last computed on the device.
+    pub fn read_reactions(&self) -> Result<Vec<[f64; 2]>> {
+        let b = self.read(&[Buf::Reactions])?;
+        let f: &[f32] = bytemuck::cast_slice(&b[0]);
+        Ok((0..self.buffers.n_groups)
+            .map(|g| [f[2 * g] as f64, f[2 * g + 1] as f64])
+            .collect())
+    }
+
+    fn write_sim(&self, sim: &Sim) {
+        self.ctx
+            .queue
+            .write_buffer(self.buffers.get(Buf::Sim), 0, bytemuck::bytes_of(sim));
+    }
+
+    /// Replaces the device state with a CPU backend's (parity tests): the
+    /// particles, the nodal arrays, the time and the step's Δt.
+    pub fn upload_state(&mut self, cpu: &CpuBackend) {
+        let p = &cpu.model.particles;
+        let q = &self.ctx.queue;
+        let f2 = |v: &[[f64; 2]]| {
+            v.iter()
+                .flat_map(|x| [x[0] as f32, x[1] as f32])
+                .collect::<Vec<f32>>()
+        };
+        let u: Vec<[f64; 2]> = (0..p.len())
+            .map(|i| [p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]])
+            .collect();
+        q.write_buffer(self.buffers.get(Buf::U), 0, bytemuck::cast_slice(&f2(&u)));
+        q.write_buffer(self.buffers.get(Buf::V), 0, bytemuck::cast_slice(&f2(&p.v)));
+        if !p.a.is_empty() {
+            q.write_buffer(self.buffers.get(Buf::A), 0, bytemuck::cast_slice(&f2(&p.a)));
+        }
+        if !p.lambda.is_empty() {
+            q.write_buffer(
+                self.buffers.get(Buf::Lambda),
+                0,
+                bytemuck::cast_slice(&f2(&p.lambda)),
+            );
+        }
+        let rho: Vec<f32> = p.rho.iter().map(|r| *r as f32).collect();
+        q.write_buffer(self.buffers.get(Buf::Rho), 0, bytemuck::cast_slice(&rho));
+        let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
+        q.write_buffer(self.buffers.get(Buf::Stress), 0, bytemuck::cast_slice(&s));
+        let nodes: Vec<f32> = cpu
+            .mv
+            .iter()
+            .zip(&cpu.force)
+            .flat_map(|(m, f)| {
+                [
+                    m[0] as f32,
+                    m[1] as f32,
+                    m[2] as f32,
+                    f[0] as f32,
+                    f[1] as f32,
+                ]
+            })
+            .collect();
+        q.write_buffer(
+            self.buffers.get(Buf::NodeAcc),
+            0,
+            bytemuck::cast_slice(&nodes),
+        );
+        let (t, t_lo) = split_f64(cpu.time());
+        let (sh, sl) = split_f64(self.model.t_end);
+        let sim = Sim {
+            t,
+            t_lo,
+            dt: cpu.dt() as f32,
+            t_stop_hi: sh,
+            t_stop_lo: sl,
+            running: 1,
+            ..buffers::initial_sim()
+        };
+        self.write_sim(&sim);
+        self.model.particles = p.clone();
+        self.fresh = false;
+    }
+
+    fn fault_of(&self, word: u32) -> Fault {
+        let particle = (word >> 4) as usize;
+        let kind = match word & 0xf {
+            FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
+            FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
+            FAULT_NON_FINITE_STRESS => FaultKind::NonFinite { field: "stress" },
+            FAULT_NON_FINITE_MOTION => FaultKind::NonFinite {
+                field: "position or velocity",
+            },
+            FAULT_DENSITY => FaultKind::NonPositiveDensity,
+            FAULT_LME_FEW_NODES => FaultKind::Shape(ShapeFault::LmeTooFewNodes { nodes: None }),
+            FAULT_LME_NOT_CONVERGED => FaultKind::Shape(ShapeFault::LmeNotConverged {
+                iterations: self.params.lme_max_iter,
+                residual: None,
+            }),
+            _ => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+        };
+        Fault::at(particle, kind)
+    }
+
+    /// The fault the device recorded, if any.
+    pub fn fault(&self) -> Option<Fault> {
+        (self.sim.fault != FAULT_NONE).then(|| self.fault_of(self.sim.fault))
+    }
+
+    fn t(&self) -> f64 {
+        self.sim.t as f64 + self.sim.t_lo as f64
+    }
+
+    /// Most LME Newton iterations any particle has taken in one step.
+    pub fn lme_max_iterations(&self) -> u32 {
+        self.sim.lme_iters
+    }
+}
+
+/// The scene constants the shaders read.
+pub fn params(model: &Model) -> Params {
+    let g = &model.grid;
+    let min_mass = model
+        .particles
+        .mass
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let (t_end_hi, t_end_lo) = split_f64(model.t_end);
+    let (gamma, p2g_accel) = match model.integrator {
+        Integrator::Fe => (1.0, 0.0),
+        Integrator::Npc { gamma, .. } => (gamma, 1.0 - gamma),
+    };
+    let gravity = model
+        .gravity
+        .map_or([0.0; 2], |g| [g.g[0] as f32, g.g[1] as f32]);
+    let ramp_period = model.gravity.map_or(0.0, |g| match g.ramp {
+        crate::scene::Ramp::None => 0.0,
+        crate::scene::Ramp::Sine => g.period as f32,
+    });
+    let (mut lme_beta, mut lme_r2, mut lme_tol, mut lme_reach) = (0.0, 0.0, 0.0, 0.0);
+    if let Shape::Lme(l) = &model.shape {
+        lme_beta = l.beta as f32;
+        lme_r2 = (l.radius * l.radius) as f32;
+        lme_tol = (LME_TOL_F32 * l.h) as f32;
+        lme_reach = ((l.radius + l.search_extra) / l.h) as f32;
+    }
+    Params {
+        n_particles: model.particles.len() as u32,
+        n_nodes: g.n_nodes() as u32,
+        nx: g.nx as u32,
+        ny: g.ny as u32,
+        h: g.h as f32,
+        inv_h: (1.0 / g.h) as f32,
+        cfl_h: (model.cfl * g.min_spacing()) as f32,
+        mass_eps: (crate::cpu::grid_update::MASS_EPS_REL * min_mass) as f32,
+        t_end_hi,
+        t_end_lo,
+        gravity,
+        ramp_period,
+        npc_gamma: gamma as f32,
+        p2g_accel: p2g_accel as f32,
+        edge_margin: model.shape.edge_margin() as f32,
+        grid_w: ((g.nx - 1) as f64 * g.h) as f32,
+        grid_hgt: ((g.ny - 1) as f64 * g.h) as f32,
+        lme_beta,
+        lme_r2,
+        lme_tol,
+        lme_reach,
+        lme_side: pipelines::lme_side(model),
+        lme_max_iter: crate::shape::lme::NEWTON_MAX_ITER,
+        ugimp_lp: match &model.shape {
+            Shape::Ugimp(u) => u.lp_h as f32,
+            _ => 0.0,
+        },
+        n_groups: model.constraints.groups.len() as u32,
+        n_probes: model.probes.len() as u32,
+        n_materials: model.materials.len() as u32,
+    }
+}
+
+impl Backend for GpuBackend {
+    fn name(&self) -> String {
+        let atomics = match self.ctx.atomics {
+            AtomicMode::Float => "float atomics",
+            AtomicMode::CompareExchange => "CAS atomics",
+        };
+        format!("gpu: {} (f32, {atomics})", self.ctx.adapter.label())
+    }
+
+    fn time(&self) -> f64 {
+        self.t()
+    }
+
+    fn steps(&self) -> u64 {
+        self.sim.steps as u64
+    }
+
+    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt> {
+        let t_end = self.model.t_end;
+        let target = t_stop.min(t_end);
+        let (hi, lo) = split_f64(target);
+        self.ctx.queue.write_buffer(
+            self.buffers.get(Buf::Sim),
+            12,
+            bytemuck::cast_slice(&[hi, lo]),
+        );
+        loop {
+            let t = self.t();
+            if t >= target {
+                return Ok(());
+            }
+            let dt = if self.sim.dt > 0.0 {
+                self.sim.dt as f64
+            } else {
+                self.dt_hint
+            };
+            let n = (((target - t) / dt).ceil() as u64 + 1).clamp(1, MAX_BATCH);
+            let before = self.sim.steps;
+            self.submit_steps(n);
+            self.fresh = false;
+            self.sim = self.read_sim()?;
+            if let Some(f) = self.fault() {
+                return Err(f.into());
+            }
+            if self.sim.steps == before && self.t() < target {
+                // No step ran although time remains: Δt must have become 0 or NaN.
+                return Err(Fault {
+                    particle: None,
+                    kind: FaultKind::NonFinite { field: "time step" },
+                }
+                .into());
+            }
+        }
+    }
+
+    fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt> {
+        let (hi, lo) = split_f64(self.model.t_end);
+        self.ctx.queue.write_buffer(
+            self.buffers.get(Buf::Sim),
+            12,
+            bytemuck::cast_slice(&[hi, lo]),
+        );
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(MAX_BATCH);
+            self.submit_steps(k);
+            left -= k;
+        }
+        self.fresh = false;
+        self.sim = self.read_sim()?;
+        self.fault().map_or(Ok(()), |f| Err(f.into()))
+    }
+
+    fn sample(&mut self) -> Result<Sample> {
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(self.buffers.get(Buf::EnergyOut), 0, None);
+        {
+            let mut cpass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("sample"),
+                timestamp_writes: None,
+            });
+            self.pipelines.dispatch(&mut cpass, Pass::Probes);
+            self.pipelines.dispatch(&mut cpass, Pass::Energy);
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        let b = self.read(&[Buf::ProbeOut, Buf::EnergyOut, Buf::Reactions, Buf::Sim])?;
+        self.sim = *bytemuck::from_bytes::<Sim>(&b[3][..std::mem::size_of::<Sim>()]);
+        let pr: &[f32] = bytemuck::cast_slice(&b[0]);
+        let origin = self.model.grid.min;
+        let probes = (0..self.model.probes.len())
+            .map(|k| {
+                let o = &pr[k * PROBE_STRIDE..];
+                ProbeState {
+                    x: [o[0] as f64 + origin[0], o[1] as f64 + origin[1]],
+                    v: [o[2] as f64, o[3] as f64],
+                    stress: [o[4] as f64, o[5] as f64, o[6] as f64],
+                }
+            })
+            .collect();
+        let e: &[f32] = bytemuck::cast_slice(&b[1]);
+        let r: &[f32] = bytemuck::cast_slice(&b[2]);
+        Ok(Sample {
+            t: self.t(),
+            probes,
+            energy: Energy {
+                kinetic: e[0] as f64,
+                strain: e[1] as f64,
+                gravity_work_bound: e[2] as f64,
+            },
+            reactions: (0..self.buffers.n_groups)
+                .map(|g| [r[2 * g] as f64, r[2 * g + 1] as f64])
+                .collect(),
+        })
+    }
+
+    fn particles(&mut self) -> Result<&Particles> {
+        if !self.fresh {
+            let npc = !self.model.particles.a.is_empty();
+            let lme = !self.model.particles.lambda.is_empty();
+            let mut want = vec![Buf::U, Buf::V, Buf::Rho, Buf::Stress];
+            if npc {
+                want.push(Buf::A);
+            }
+            if lme {
+                want.push(Buf::Lambda);
+            }
+            let b = self.read(&want)?;
+            let f = |k: usize| -> &[f32] { bytemuck::cast_slice(&b[k]) };
+            let p = &mut self.model.particles;
+            let n = p.len();
+            let (u, v, rho, s) = (f(0), f(1), f(2), f(3));
+            for i in 0..n {
+                p.x[i] = [
+                    p.x0[i][0] + u[2 * i] as f64,
+                    p.x0[i][1] + u[2 * i + 1] as f64,
+                ];
+                p.v[i] = [v[2 * i] as f64, v[2 * i + 1] as f64];
+                p.rho[i] = rho[i] as f64;
+                p.stress[i] = [s[3 * i] as f64, s[3 * i + 1] as f64, s[3 * i + 2] as f64];
+            }
+            let mut k = 4;
+            if npc {
+                let a = f(k);
+                for i in 0..n {
+                    p.a[i] = [a[2 * i] as f64, a[2 * i + 1] as f64];
+                }
+                k += 1;
+            }
+            if lme {
+                let l = f(k);
+                for i in 0..n {
+                    p.lambda[i] = [l[2 * i] as f64, l[2 * i + 1] as f64];
+                }
+            }
+            self.fresh = true;
+        }
+        Ok(&self.model.particles)
+    }
+
+    fn model(&self) -> &Model {
+        &self.model
+    }
+
+    fn bytes_per_particle(&self) -> f64 {
+        self.buffers.bytes() as f64 / self.model.particles.len().max(1) as f64
+    }
+}

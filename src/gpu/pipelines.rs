@@ -1,0 +1,402 @@
+//! Compute pipelines built for one scene: each pass's WGSL is expanded with
+//! the scene's flags (shape, integrator, material count, grid layout, atomic
+//! mode), validated by naga, and its bind group made from naga's list of the
+//! bindings it declares, so no binding number is repeated at a call site.
+
+use super::buffers::{Buf, Buffers};
+use super::context::{AtomicMode, GpuContext};
+use super::layout::WG;
+use super::preprocess::{self, Defines};
+use crate::error::{Error, Result};
+use crate::model::{Integrator, Model};
+use crate::scene::NpcPosition;
+use crate::shape::Shape;
+use crate::solver::Stage;
+
+/// One GPU pass: a WGSL file and entry point, run over a domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Pass {
+    Cfl,
+    StepBegin,
+    ClearGrid,
+    LmeNewton,
+    P2g,
+    GridPredict,
+    Stress,
+    Forces,
+    GridCorrect,
+    G2p,
+    StepEnd,
+    Probes,
+    Energy,
+}
+
+/// What a pass's invocations run over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Domain {
+    Particles,
+    /// Nodes, and at least 2 per constraint group (clear_grid zeroes reactions).
+    Nodes,
+    One,
+    Probes,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 13] = [
+        Pass::Cfl,
+        Pass::StepBegin,
+        Pass::ClearGrid,
+        Pass::LmeNewton,
+        Pass::P2g,
+        Pass::GridPredict,
+        Pass::Stress,
+        Pass::Forces,
+        Pass::GridCorrect,
+        Pass::G2p,
+        Pass::StepEnd,
+        Pass::Probes,
+        Pass::Energy,
+    ];
+
+    /// The WGSL file (under shaders/).
+    pub fn file(self) -> &'static str {
+        match self {
+            Pass::Cfl => "cfl.wgsl",
+            Pass::StepBegin => "step_begin.wgsl",
+            Pass::ClearGrid => "clear_grid.wgsl",
+            Pass::LmeNewton => "lme_newton.wgsl",
+            Pass::P2g => "p2g.wgsl",
+            Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
+            Pass::Stress => "stress.wgsl",
+            Pass::Forces => "forces.wgsl",
+            Pass::G2p => "g2p.wgsl",
+            Pass::StepEnd => "step_end.wgsl",
+            Pass::Probes => "probes.wgsl",
+            Pass::Energy => "energy.wgsl",
+        }
+    }
+
+    fn domain(self) -> Domain {
+        match self {
+            Pass::StepBegin | Pass::StepEnd => Domain::One,
+            Pass::ClearGrid | Pass::GridPredict | Pass::GridCorrect => Domain::Nodes,
+            Pass::Probes => Domain::Probes,
+            _ => Domain::Particles,
+        }
+    }
+
+    /// The GPU passes that do a solver stage. `Cfl` is the reduction plus
+    /// the one-invocation Δt/stop pass; shape evaluation is a pass of its
+    /// own only for LME (the others are evaluated inline where used).
+    pub fn for_stage(stage: Stage, lme: bool) -> &'static [Pass] {
+        match stage {
+            Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
+            Stage::ClearGrid => &[Pass::ClearGrid],
+            Stage::ShapeEval if lme => &[Pass::LmeNewton],
+            Stage::ShapeEval => &[],
+            Stage::P2g => &[Pass::P2g],
+            Stage::GridPredict => &[Pass::GridPredict],
+            Stage::Stress => &[Pass::Stress],
+            Stage::Forces => &[Pass::Forces],
+            Stage::GridCorrect => &[Pass::GridCorrect],
+            Stage::G2p => &[Pass::G2p],
+        }
+    }
+}
+
+/// Everything that selects a shader variant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variant {
+    pub shape: crate::scene::ShapeKind,
+    pub integrator: Integrator,
+    pub perturbed: bool,
+    pub multi_material: bool,
+    pub atomics: AtomicMode,
+    /// LME search box side (nodes); 1 for other shapes.
+    pub lme_side: u32,
+    /// LME weights stored per slot (`GpuOptions::lme_stored`).
+    pub lme_stored: bool,
+}
+
+impl Variant {
+    pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
+        Variant {
+            lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
+            shape: model.shape.kind(),
+            integrator: model.integrator,
+            perturbed: model.grid.is_perturbed(),
+            multi_material: model.materials.len() > 1,
+            atomics,
+            lme_side: lme_side(model),
+        }
+    }
+
+    /// Flags and values the WGSL is expanded with.
+    pub fn defines(&self) -> Defines {
+        use crate::scene::ShapeKind;
+        let mut d = Defines::default();
+        for b in Buf::ALL {
+            d.value(&b.token(), b.binding());
+        }
+        d.flag("SHAPE_LINEAR", self.shape == ShapeKind::Linear)
+            .flag("SHAPE_UGIMP", self.shape == ShapeKind::Ugimp)
+            .flag("SHAPE_LME", self.shape == ShapeKind::Lme)
+            .flag("PERTURBED", self.perturbed)
+            .flag("MULTI_MATERIAL", self.multi_material)
+            .flag("FLOAT_ATOMICS", self.atomics == AtomicMode::Float)
+            .flag("LME_STORED", self.lme_stored);
+        if let Integrator::Npc { position, .. } = self.integrator {
+            d.flag("NPC", true)
+                .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
+                .flag("NPC_POSITION_NEWMARK", position == NpcPosition::Newmark);
+        }
+        d.value(
+            "ATOMIC_T",
+            match self.atomics {
+                AtomicMode::Float => "atomic<f32>",
+                AtomicMode::CompareExchange => "atomic<u32>",
+            },
+        );
+        d.value("LME_SIDE", self.lme_side);
+        d
+    }
+
+    /// Whether the scene needs this pass.
+    pub fn uses(&self, pass: Pass) -> bool {
+        pass != Pass::LmeNewton || self.shape == crate::scene::ShapeKind::Lme
+    }
+}
+
+/// Side of the LME search box: the integers in [q − R, q + R] number at
+/// most floor(2R) + 1.
+pub fn lme_side(model: &Model) -> u32 {
+    match &model.shape {
+        Shape::Lme(l) => (2.0 * (l.radius + l.search_extra) / l.h).floor() as u32 + 1,
+        _ => 1,
+    }
+}
+
+/// Expands a pass's WGSL for `d`, adding the pass's own flag.
+pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
+    let mut d = d.clone();
+    d.flag("CORRECT", pass == Pass::GridCorrect);
+    preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
+}
+
+/// Parses and validates WGSL with naga (no GPU needed).
+pub fn validate(src: &str, name: &str, atomics: AtomicMode) -> Result<naga::Module> {
+    let module = naga::front::wgsl::parse_str(src).map_err(|e| {
+        Error::Gpu(format!(
+            "WGSL parse error:\n{}",
+            e.emit_to_string_with_path(src, name)
+        ))
+    })?;
+    let mut caps = naga::valid::Capabilities::default();
+    if atomics == AtomicMode::Float {
+        caps |= naga::valid::Capabilities::SHADER_FLOAT32_ATOMIC;
+    }
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        .validate(&module)
+        .map_err(|e| {
+            Error::Gpu(format!(
+                "WGSL validation error:\n{}",
+                e.emit_to_string_with_path(src, name)
+            ))
+        })?;
+    Ok(module)
+}
+
+/// A declared binding: its buffer and whether the pass writes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Binding {
+    pub buf: Buf,
+    pub uniform: bool,
+    pub writable: bool,
+}
+
+/// The bindings a module declares, from naga's reflection.
+pub fn bindings(module: &naga::Module) -> Vec<Binding> {
+    let mut out: Vec<Binding> = module
+        .global_variables
+        .iter()
+        .filter_map(|(_, v)| {
+            let rb = v.binding.as_ref()?;
+            let buf = Buf::from_binding(rb.binding)?;
+            let (uniform, writable) = match v.space {
+                naga::AddressSpace::Uniform => (true, false),
+                naga::AddressSpace::Storage { access } => {
+                    (false, access.contains(naga::StorageAccess::STORE))
+                }
+                _ => return None,
+            };
+            Some(Binding {
+                buf,
+                uniform,
+                writable,
+            })
+        })
+        .collect();
+    out.sort_by_key(|b| b.buf);
+    out
+}
+
+struct Built {
+    pass: Pass,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    domain: Domain,
+}
+
+/// Every pass the scene needs, ready to dispatch.
+pub struct Pipelines {
+    built: Vec<Built>,
+    n_particles: u32,
+    n_nodes_or_groups: u32,
+    n_probes: u32,
+    max_groups: u32,
+    pub lme: bool,
+}
+
+impl Pipelines {
+    pub fn new(
+        ctx: &GpuContext,
+        model: &Model,
+        buffers: &Buffers,
+        opts: &super::GpuOptions,
+    ) -> Result<Pipelines> {
+        let variant = Variant::of(model, ctx.atomics, opts);
+        let d = variant.defines();
+        let lme = matches!(model.shape, Shape::Lme(_));
+        let mut built = Vec::new();
+        for pass in Pass::ALL {
+            if !variant.uses(pass) {
+                continue;
+            }
+            let src = expand(pass, &d)?;
+            if let Some(dir) = std::env::var_os("LME_MPM_DUMP_WGSL") {
+                let _ = std::fs::create_dir_all(&dir);
+                let _ = std::fs::write(
+                    std::path::Path::new(&dir).join(format!("{pass:?}.wgsl")),
+                    &src,
+                );
+            }
+            let module = validate(&src, pass.file(), ctx.atomics)?;
+            let binds = bindings(&module);
+            let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let shader = ctx
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(pass.file()),
+                    source: wgpu::ShaderSource::Wgsl(src.into()),
+                });
+            let entries: Vec<wgpu::BindGroupLayoutEntry> = binds
+                .iter()
+                .map(|b| wgpu::BindGroupLayoutEntry {
+                    binding: b.buf.binding(),
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: if b.uniform {
+                            wgpu::BufferBindingType::Uniform
+                        } else {
+                            wgpu::BufferBindingType::Storage {
+                                read_only: !b.writable,
+                            }
+                        },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                })
+                .collect();
+            let bgl = ctx
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(pass.file()),
+                    entries: &entries,
+                });
+            let layout = ctx
+                .device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(pass.file()),
+                    bind_group_layouts: &[Some(&bgl)],
+                    immediate_size: 0,
+                });
+            let pipeline = ctx
+                .device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&format!("{pass:?}")),
+                    layout: Some(&layout),
+                    module: &shader,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+            let group_entries: Vec<wgpu::BindGroupEntry> = binds
+                .iter()
+                .map(|b| wgpu::BindGroupEntry {
+                    binding: b.buf.binding(),
+                    resource: buffers.get(b.buf).as_entire_binding(),
+                })
+                .collect();
+            let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(&format!("{pass:?}")),
+                layout: &bgl,
+                entries: &group_entries,
+            });
+            if let Some(e) = pollster::block_on(scope.pop()) {
+                return Err(Error::Gpu(format!("building the {pass:?} pipeline: {e}")));
+            }
+            built.push(Built {
+                pass,
+                pipeline,
+                bind_group,
+                domain: pass.domain(),
+            });
+        }
+        Ok(Pipelines {
+            built,
+            n_particles: buffers.n_particles as u32,
+            n_nodes_or_groups: buffers.n_nodes.max(2 * buffers.n_groups) as u32,
+            n_probes: buffers.n_probes as u32,
+            max_groups: ctx.limits.max_compute_workgroups_per_dimension,
+            lme,
+        })
+    }
+
+    /// Records one dispatch of `pass` (nothing if the scene does not use it).
+    pub fn dispatch(&self, cpass: &mut wgpu::ComputePass<'_>, pass: Pass) {
+        let Some(b) = self.built.iter().find(|b| b.pass == pass) else {
+            return;
+        };
+        let (x, y) = match b.domain {
+            Domain::One => (1, 1),
+            Domain::Probes => (self.n_probes.div_ceil(64).max(1), 1),
+            Domain::Particles => grid_2d(self.n_particles, self.max_groups),
+            Domain::Nodes => grid_2d(self.n_nodes_or_groups, self.max_groups),
+        };
+        cpass.set_pipeline(&b.pipeline);
+        cpass.set_bind_group(0, &b.bind_group, &[]);
+        cpass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Records the passes of one whole step, in `solver::STEP` order.
+    pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
+        for stage in crate::solver::STEP {
+            for pass in Pass::for_stage(*stage, self.lme) {
+                self.dispatch(cpass, *pass);
+            }
+        }
+        self.dispatch(cpass, Pass::StepEnd);
+    }
+}
+
+/// Workgroups for `n` invocations of size WG, folded into 2D past the
+/// per-dimension limit (the shaders' `linear_index` unfolds it).
+fn grid_2d(n: u32, max: u32) -> (u32, u32) {
+    let groups = n.div_ceil(WG).max(1);
+    if groups <= max {
+        (groups, 1)
+    } else {
+        (max, groups.div_ceil(max))
+    }
+}

@@ -1,0 +1,172 @@
+//! WGSL checks that need no GPU: every file is embedded in the binary, every
+//! pass expands and validates with naga in every variant a scene can ask
+//! for, and every struct shared with Rust has the same layout on both sides.
+
+use lme_mpm::gpu::context::AtomicMode;
+use lme_mpm::gpu::layout::{GpuConstraint, GpuMaterial, Params, Sim};
+use lme_mpm::gpu::pipelines::{self, Pass, Variant};
+use lme_mpm::gpu::preprocess::SOURCES;
+use lme_mpm::model::Integrator;
+use lme_mpm::scene::{NpcPosition, ShapeKind};
+use std::mem::{offset_of, size_of};
+use std::path::Path;
+
+fn wgsl_files(dir: &Path, base: &Path, out: &mut Vec<String>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            wgsl_files(&p, base, out);
+        } else if p.extension().is_some_and(|x| x == "wgsl") {
+            out.push(
+                p.strip_prefix(base)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/"),
+            );
+        }
+    }
+}
+
+#[test]
+fn every_wgsl_file_is_embedded() {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut on_disk = Vec::new();
+    wgsl_files(&base, &base, &mut on_disk);
+    on_disk.sort();
+    let mut embedded: Vec<String> = SOURCES.iter().map(|(p, _)| p.to_string()).collect();
+    embedded.sort();
+    assert_eq!(on_disk, embedded, "shaders/ and preprocess::SOURCES differ");
+}
+
+fn variants() -> Vec<Variant> {
+    let integrators = [
+        Integrator::Fe,
+        Integrator::Npc {
+            gamma: 0.5,
+            position: NpcPosition::Newmark,
+        },
+        Integrator::Npc {
+            gamma: 0.5,
+            position: NpcPosition::Predicted,
+        },
+        Integrator::Npc {
+            gamma: 0.5,
+            position: NpcPosition::Corrected,
+        },
+    ];
+    let mut out = Vec::new();
+    for shape in [ShapeKind::Linear, ShapeKind::Ugimp, ShapeKind::Lme] {
+        for integrator in integrators {
+            for perturbed in [false, true] {
+                for multi_material in [false, true] {
+                    for atomics in [AtomicMode::Float, AtomicMode::CompareExchange] {
+                        for lme_stored in [false, true] {
+                            if lme_stored && shape != ShapeKind::Lme {
+                                continue;
+                            }
+                            out.push(Variant {
+                                shape,
+                                integrator,
+                                perturbed,
+                                multi_material,
+                                atomics,
+                                lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
+                                lme_stored,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_pass_validates_in_every_variant() {
+    let mut checked = 0;
+    for v in variants() {
+        let d = v.defines();
+        for pass in Pass::ALL {
+            if !v.uses(pass) {
+                continue;
+            }
+            let src = pipelines::expand(pass, &d).unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
+            let module = pipelines::validate(&src, pass.file(), v.atomics)
+                .unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
+            // Only what the variant needs is declared.
+            let binds = pipelines::bindings(&module);
+            use lme_mpm::gpu::buffers::Buf;
+            let has = |b: Buf| binds.iter().any(|x| x.buf == b);
+            assert_eq!(
+                has(Buf::NodePos),
+                v.perturbed && pass_uses_shape(pass),
+                "{pass:?} {v:?}: node_pos"
+            );
+            assert!(
+                !has(Buf::A) || matches!(v.integrator, Integrator::Npc { .. }),
+                "{pass:?} {v:?}: a without NPC"
+            );
+            assert!(
+                !has(Buf::Lambda) || v.shape == ShapeKind::Lme,
+                "{pass:?} {v:?}: λ without LME"
+            );
+            assert!(
+                !has(Buf::Mat) || v.multi_material,
+                "{pass:?} {v:?}: material index with one material"
+            );
+            checked += 1;
+        }
+    }
+    println!("{checked} expanded passes validated");
+    assert!(checked > 500);
+}
+
+fn pass_uses_shape(pass: Pass) -> bool {
+    matches!(
+        pass,
+        Pass::LmeNewton | Pass::P2g | Pass::Stress | Pass::Forces | Pass::G2p
+    )
+}
+
+/// (name, offset) of every non-padding field of a WGSL struct, and its size.
+fn wgsl_struct(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                let fields = members
+                    .iter()
+                    .filter_map(|m| {
+                        let n = m.name.clone()?;
+                        (!n.starts_with('_')).then_some((n, m.offset))
+                    })
+                    .collect();
+                return (fields, *span);
+            }
+        }
+    }
+    panic!("struct {name} not found");
+}
+
+macro_rules! rust_fields {
+    ($t:ty; $($f:ident),* $(,)?) => {
+        (vec![$((stringify!($f).to_string(), offset_of!($t, $f) as u32)),*], size_of::<$t>() as u32)
+    };
+}
+
+#[test]
+fn shared_structs_match_rust_layouts() {
+    let v = variants()[0];
+    let src = pipelines::expand(Pass::Cfl, &v.defines()).unwrap();
+    let module = pipelines::validate(&src, "cfl.wgsl", v.atomics).unwrap();
+    let params = rust_fields!(Params; n_particles, n_nodes, nx, ny, h, inv_h, cfl_h, mass_eps, t_end_hi, t_end_lo,
+        gravity, ramp_period, npc_gamma, p2g_accel, edge_margin, grid_w, grid_hgt, lme_beta, lme_r2, lme_tol,
+        lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials);
+    assert_eq!(wgsl_struct(&module, "Params"), params);
+    let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault, lme_iters);
+    assert_eq!(wgsl_struct(&module, "Sim"), sim);
+    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu);
+    assert_eq!(wgsl_struct(&module, "Material"), mat);
+    let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix);
+    assert_eq!(wgsl_struct(&module, "Constraint"), con);
+}

@@ -1,0 +1,408 @@
+//! Per-stage parity: the same state goes through one stage on the CPU (f64)
+//! and on the GPU (f32), and every field the stage writes is compared. The
+//! particles are random, plus ones exactly on cell edges, within 1e-3 h of
+//! the grid's edge, and on Dirichlet nodes. Every shape function, both
+//! integrators, regular and perturbed grids, both atomic modes.
+
+mod common;
+
+use lme_mpm::backend::Backend;
+use lme_mpm::cpu::CpuBackend;
+use lme_mpm::gpu::pipelines::Pass;
+use lme_mpm::gpu::{GpuBackend, GpuOptions};
+use lme_mpm::model::Model;
+use lme_mpm::rng::SplitMix64;
+use lme_mpm::scene::{Override, Scene};
+use lme_mpm::solver::{STEP, Stage};
+
+/// Largest allowed |GPU − CPU| over a field, relative to the largest |CPU|
+/// value of that field (or of its change, for fields a stage updates).
+/// f32 carries 6e-8 relative round-off; a value is a sum of up to ~50
+/// weighted terms (LME γ = 3), gradients cancel (Σ∇N = 0), and the f32
+/// shape functions themselves differ from f64 by ~1e-6 (LME: exp of
+/// arguments up to ln(1/tol) ≈ 14, Newton stopped at |r| ≤ 1e-5 h).
+/// We measure worst errors of 1e-7 to 3e-6 for Q4 and uGIMP, and 7e-5 for
+/// LME's stress change (f32 Newton leaves Σ∇N ≈ 1e-5/h, which a velocity
+/// field of 1 m/s turns into a spurious strain rate); 2e-4 leaves margin for
+/// other adapters' arithmetic.
+const STAGE_TOL: f64 = 2e-4;
+/// λ from f32 Newton against f64 Newton, as |Δλ| h, for particles at least
+/// 0.1 h inside the grid: the f32 stop at |r| ≤ 1e-5 h leaves λ off by
+/// |J⁻¹ Δr| ≈ 1e-5 h / λ_min(J), λ_min(J) ≳ 0.05 h² there, so ~2e-4/h; 2e-3
+/// allows 10 times that. Nearer the edge J's normal eigenvalue vanishes and
+/// λ's normal part is ill-determined, but the weights are not (the nodes
+/// that carry weight sit at d·n ≈ 0): the later stages check those.
+const LAMBDA_TOL: f64 = 2e-3;
+
+const SCENE: &str = r#"
+[grid]
+h = 0.5
+min = [0.0, 0.0]
+max = [4.0, 3.0]
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.b]
+material = "m"
+rects = [[0.5, 0.5, 3.5, 2.5]]
+[constraints.base]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "y"
+[constraints.pin]
+min = [2.0, 1.0]
+max = [2.0, 2.0]
+fix = "xy"
+[gravity]
+g = [0.0, -9.81]
+[solver]
+lme_gamma = 3.0
+t_end = 1.0
+"#;
+
+/// A model with random particle state: positions anywhere valid, on cell
+/// edges, near the edge of the grid and on the pinned (interior Dirichlet) nodes.
+fn random_model(sets: &[&str], seed: u64) -> Model {
+    let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let scene = Scene::from_str(SCENE, "parity scene", "parity", &o).unwrap();
+    let mut m = Model::new(&scene).unwrap();
+    let g = m.grid.clone();
+    // uGIMP on a perturbed grid needs its particle square inside the grid in
+    // lattice units, which nodes moved by up to 0.2 h can cost.
+    let lattice = if g.is_perturbed() && matches!(m.shape, lme_mpm::shape::Shape::Ugimp(_)) {
+        0.3 * g.h
+    } else {
+        0.0
+    };
+    let margin = m.shape.edge_margin() + 1e-3 * g.h + lattice;
+    let (lo, hi) = (g.min, g.max());
+    let mut rng = SplitMix64::new(seed);
+    let p = &mut m.particles;
+    let n = p.len();
+    for i in 0..n {
+        let mut x = [
+            rng.range(lo[0] + margin, hi[0] - margin),
+            rng.range(lo[1] + margin, hi[1] - margin),
+        ];
+        match i % 8 {
+            // On a vertical and on a horizontal grid line.
+            1 => x[0] = lo[0] + g.h * (x[0] / g.h).round().clamp(1.0, (g.nx - 2) as f64),
+            2 => x[1] = lo[1] + g.h * (x[1] / g.h).round().clamp(1.0, (g.ny - 2) as f64),
+            // Just inside the grid's edge.
+            3 => x[0] = lo[0] + margin,
+            4 => x[1] = hi[1] - margin,
+            // On a pinned node.
+            5 => x = [2.0, 1.0 + 0.5 * (i % 3) as f64],
+            _ => {}
+        }
+        p.x[i] = x;
+        p.x0[i] = x;
+        p.v[i] = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+        p.stress[i] = [
+            rng.range(-1e5, 1e5),
+            rng.range(-1e5, 1e5),
+            rng.range(-5e4, 5e4),
+        ];
+        p.rho[i] = rng.range(900.0, 1100.0);
+        p.mass[i] *= rng.range(0.5, 1.5);
+        if !p.a.is_empty() {
+            p.a[i] = [rng.range(-50.0, 50.0), rng.range(-50.0, 50.0)];
+        }
+    }
+    m
+}
+
+/// max |a − b| / max |b| (or / max |b − base| when `base` is given).
+fn rel_err(a: &[f64], b: &[f64], base: Option<&[f64]>) -> f64 {
+    let scale = match base {
+        Some(s) => b
+            .iter()
+            .zip(s)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max),
+        None => b.iter().map(|x| x.abs()).fold(0.0, f64::max),
+    };
+    let err = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    if scale == 0.0 { err } else { err / scale }
+}
+
+fn flat2(v: &[[f64; 2]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+fn flat3(v: &[[f64; 3]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+
+struct Report {
+    worst: f64,
+}
+
+impl Report {
+    fn check(&mut self, what: &str, err: f64, tol: f64) {
+        println!("  {what:<40} {err:.2e}");
+        self.worst = self.worst.max(err / tol);
+        assert!(
+            err <= tol,
+            "{what}: GPU/CPU difference {err:.3e} > {tol:.1e}"
+        );
+    }
+}
+
+/// Runs every stage once on both backends from the same state.
+fn parity(label: &str, sets: &[&str], force_cas: bool) {
+    parity_with(label, sets, force_cas, GpuOptions::default());
+}
+
+fn parity_with(label: &str, sets: &[&str], force_cas: bool, opts: GpuOptions) {
+    let Some(ctx) = common::gpu::open(label, force_cas) else {
+        return;
+    };
+    println!("{label} ({:?} atomics)", ctx.atomics);
+    let model = random_model(sets, 42);
+    let lme = matches!(model.shape, lme_mpm::shape::Shape::Lme(_));
+    let mut cpu = CpuBackend::new(model.clone());
+    let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
+    let mut rep = Report { worst: 0.0 };
+    for &stage in STEP {
+        // The state every stage starts from is the CPU's.
+        gpu.upload_state(&cpu);
+        let before_p = cpu.model.particles.clone();
+        let before_mv = cpu.mv.clone();
+        let needs_cache = lme && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
+        if needs_cache {
+            // GPU LME passes read (λ, log Z, J⁻¹) from lme_newton, warm-started from the CPU's λ.
+            gpu.run_pass(Pass::LmeNewton);
+        }
+        cpu.run_stage(stage)
+            .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
+        for pass in Pass::for_stage(stage, lme) {
+            gpu.run_pass(*pass);
+        }
+        let sim = gpu.read_sim().unwrap();
+        assert_eq!(
+            sim.fault,
+            lme_mpm::gpu::layout::FAULT_NONE,
+            "{label}: GPU {stage:?} faulted: {:?}",
+            gpu.fault()
+        );
+        let nodes = gpu.read_nodes().unwrap();
+        let col = |k: usize| nodes.iter().map(|n| n[k] as f64).collect::<Vec<f64>>();
+        let cpu_col = |k: usize| -> Vec<f64> {
+            if k < 3 {
+                cpu.mv.iter().map(|n| n[k]).collect()
+            } else {
+                cpu.force.iter().map(|n| n[k - 3]).collect()
+            }
+        };
+        match stage {
+            Stage::Cfl => rep.check(
+                "cfl: dt",
+                (sim.dt as f64 - cpu.dt()).abs() / cpu.dt(),
+                STAGE_TOL,
+            ),
+            Stage::ClearGrid => rep.check(
+                "clear_grid: nodes",
+                nodes
+                    .iter()
+                    .flatten()
+                    .map(|v| v.abs() as f64)
+                    .fold(0.0, f64::max),
+                0.0,
+            ),
+            Stage::ShapeEval if lme => {
+                let gp = gpu.particles().unwrap().clone();
+                let g = &cpu.model.grid;
+                let cp = &cpu.model.particles;
+                let err = (0..cp.len())
+                    .filter(|&i| g.contains(cp.x[i], 0.1 * g.h))
+                    .map(|i| {
+                        (gp.lambda[i][0] - cp.lambda[i][0]).hypot(gp.lambda[i][1] - cp.lambda[i][1])
+                            * g.h
+                    })
+                    .fold(0.0, f64::max);
+                rep.check("lme_newton: lambda * h (0.1 h inside)", err, LAMBDA_TOL);
+            }
+            Stage::ShapeEval => {}
+            Stage::P2g => {
+                rep.check(
+                    "p2g: node mass",
+                    rel_err(&col(0), &cpu_col(0), None),
+                    STAGE_TOL,
+                );
+                rep.check(
+                    "p2g: node momentum x",
+                    rel_err(&col(1), &cpu_col(1), None),
+                    STAGE_TOL,
+                );
+                rep.check(
+                    "p2g: node momentum y",
+                    rel_err(&col(2), &cpu_col(2), None),
+                    STAGE_TOL,
+                );
+            }
+            Stage::GridPredict => {
+                rep.check(
+                    "grid_update predict: vx",
+                    rel_err(&col(1), &cpu_col(1), None),
+                    STAGE_TOL,
+                );
+                rep.check(
+                    "grid_update predict: vy",
+                    rel_err(&col(2), &cpu_col(2), None),
+                    STAGE_TOL,
+                );
+            }
+            Stage::Stress => {
+                let gp = gpu.particles().unwrap().clone();
+                let cp = &cpu.model.particles;
+                rep.check(
+                    "stress: stress change",
+                    rel_err(
+                        &flat3(&gp.stress),
+                        &flat3(&cp.stress),
+                        Some(&flat3(&before_p.stress)),
+                    ),
+                    STAGE_TOL,
+                );
+                // Density relative to its value: f32 stores ρ to 6e-8 of ρ,
+                // which is ~1e-4 of a step's change, so the change itself
+                // cannot be compared more finely than that.
+                rep.check(
+                    "stress: density",
+                    rel_err(&gp.rho, &cp.rho, None),
+                    STAGE_TOL,
+                );
+            }
+            Stage::Forces => {
+                rep.check("forces: fx", rel_err(&col(3), &cpu_col(3), None), STAGE_TOL);
+                rep.check("forces: fy", rel_err(&col(4), &cpu_col(4), None), STAGE_TOL);
+            }
+            Stage::GridCorrect => {
+                let bv: Vec<f64> = before_mv.iter().map(|n| n[1]).collect();
+                rep.check(
+                    "grid_update correct: vx change",
+                    rel_err(&col(1), &cpu_col(1), Some(&bv)),
+                    STAGE_TOL,
+                );
+                rep.check(
+                    "grid_update correct: fixed forces zeroed",
+                    rel_err(&col(4), &cpu_col(4), None),
+                    STAGE_TOL,
+                );
+                let r = gpu.read_reactions().unwrap();
+                let rg = flat2(&r);
+                let rc = flat2(&cpu.reactions);
+                rep.check(
+                    "grid_update correct: reactions",
+                    rel_err(&rg, &rc, None),
+                    STAGE_TOL,
+                );
+            }
+            Stage::G2p => {
+                let gp = gpu.particles().unwrap().clone();
+                let cp = &cpu.model.particles;
+                rep.check(
+                    "g2p: position change",
+                    rel_err(&flat2(&gp.x), &flat2(&cp.x), Some(&flat2(&before_p.x))),
+                    STAGE_TOL,
+                );
+                rep.check(
+                    "g2p: velocity change",
+                    rel_err(&flat2(&gp.v), &flat2(&cp.v), Some(&flat2(&before_p.v))),
+                    STAGE_TOL,
+                );
+                if !cp.a.is_empty() {
+                    rep.check(
+                        "g2p: acceleration",
+                        rel_err(&flat2(&gp.a), &flat2(&cp.a), None),
+                        STAGE_TOL,
+                    );
+                }
+            }
+        }
+    }
+    println!("  worst error / tolerance: {:.3}", rep.worst);
+}
+
+#[test]
+fn stages_match_linear() {
+    parity(
+        "linear fe",
+        &["solver.shape=linear", "solver.integrator=fe"],
+        false,
+    );
+    parity("linear npc", &["solver.shape=linear"], false);
+    parity(
+        "linear npc perturbed",
+        &["solver.shape=linear", "grid.perturb=0.2"],
+        false,
+    );
+}
+
+#[test]
+fn stages_match_ugimp() {
+    parity(
+        "ugimp fe",
+        &["solver.shape=ugimp", "solver.integrator=fe"],
+        false,
+    );
+    parity("ugimp npc", &["solver.shape=ugimp"], false);
+    parity(
+        "ugimp npc perturbed",
+        &["solver.shape=ugimp", "grid.perturb=0.2"],
+        false,
+    );
+}
+
+#[test]
+fn stages_match_lme() {
+    parity(
+        "lme fe",
+        &["solver.shape=lme", "solver.integrator=fe"],
+        false,
+    );
+    parity("lme npc", &["solver.shape=lme"], false);
+    parity(
+        "lme npc perturbed",
+        &["solver.shape=lme", "grid.perturb=0.2"],
+        false,
+    );
+    parity(
+        "lme npc corrected",
+        &["solver.shape=lme", "solver.npc_position=corrected"],
+        false,
+    );
+    let stored = GpuOptions { lme_stored: true };
+    parity_with(
+        "lme npc, weights stored per slot",
+        &["solver.shape=lme"],
+        false,
+        stored,
+    );
+    parity_with(
+        "lme fe perturbed, weights stored per slot",
+        &[
+            "solver.shape=lme",
+            "solver.integrator=fe",
+            "grid.perturb=0.2",
+        ],
+        false,
+        stored,
+    );
+}
+
+#[test]
+fn stages_match_with_compare_exchange_atomics() {
+    parity("lme npc, CAS atomics", &["solver.shape=lme"], true);
+    parity(
+        "linear fe, CAS atomics",
+        &["solver.shape=linear", "solver.integrator=fe"],
+        true,
+    );
+}
