@@ -1,8 +1,9 @@
 // Stage `g2p`: particle update and checks.
 // FE:  v += Δt Σ N f/m;  u += Δt Σ N v_I.
 // NPC: a = Σ N f/m;  v += Δt a;  u += Δt Σ N v_I (+ ½ Δt² a), v_I corrected or
-//      predicted as NPC_POSITION_* says. Positions live as x0 + u, so f32
-//      displacements keep their precision.
+//      predicted as NPC_POSITION_* says. Positions live as x0 + u, and u is a
+//      compensated (Kahan) sum u − u_lo: a slow, steady motion would otherwise
+//      lose the same fraction of every small increment to f32 rounding.
 // CPU twin: src/cpu/g2p.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -10,6 +11,7 @@
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
 @group(0) @binding({{B_U}}) var<storage, read_write> u: array<vec2<f32>>;
+@group(0) @binding({{B_U_LO}}) var<storage, read_write> u_lo: array<vec2<f32>>;
 @group(0) @binding({{B_V}}) var<storage, read_write> v: array<vec2<f32>>;
 #if NPC
 @group(0) @binding({{B_A}}) var<storage, read_write> a: array<vec2<f32>>;
@@ -49,7 +51,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
     a[p] = acc;
 #endif
-    let up = u[p] + du;
+    let y = du - u_lo[p];
+    let up = u[p] + y;
+    u_lo[p] = (up - u[p]) - y;
     v[p] = vp;
     u[p] = up;
     if !(is_finite(up.x) && is_finite(up.y) && is_finite(vp.x) && is_finite(vp.y)) {

@@ -285,3 +285,45 @@ pub fn ratio_table(r: &[Ratio]) -> String {
     }
     s
 }
+
+/// Log-log chart of particle-steps per second against particle count, one
+/// line per backend and case; writes `<stem>.png` and `<stem>.svg`.
+pub fn chart(points: &[Point], stem: &std::path::Path) -> Result<()> {
+    use crate::chart::{LineChart, Series};
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for p in points {
+        let k = (short_backend(&p.backend), p.case.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let cases: Vec<&String> = {
+        let mut c: Vec<&String> = keys.iter().map(|k| &k.1).collect();
+        c.dedup();
+        c.sort();
+        c.dedup();
+        c
+    };
+    let mut c = LineChart::new(
+        "Throughput of whole steps (NPC)",
+        "particles",
+        "particle-steps per second",
+    )
+    .log_log();
+    for (backend, case) in &keys {
+        let pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| &short_backend(&p.backend) == backend && &p.case == case)
+            .map(|p| (p.particles as f64, p.particle_steps_per_second))
+            .collect();
+        let color = cases.iter().position(|c| *c == case).unwrap_or(0);
+        let s = Series::line(format!("{backend} {case}"), pts, color).markers();
+        c.series.push(if backend == "cpu" { s } else { s.dashed() });
+    }
+    c.save(stem)
+}
+
+/// "cpu" or "gpu" from a backend's full name.
+fn short_backend(name: &str) -> String {
+    name.split([' ', ':']).next().unwrap_or(name).to_string()
+}

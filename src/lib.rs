@@ -9,6 +9,7 @@
 
 pub mod backend;
 pub mod bench;
+pub mod chart;
 pub mod cpu;
 pub mod docgen;
 pub mod error;

@@ -306,8 +306,25 @@ fn bench(
     {
         return fail(&e);
     }
+    if let Err(e) = bench::chart(&points, &out.join("bench")) {
+        return fail(&e);
+    }
     if let Some(doc) = doc {
         let name = format!("{backends:?}").to_lowercase();
+        let charts = doc
+            .parent()
+            .unwrap_or(std::path::Path::new("."))
+            .join("charts");
+        if let Err(e) = std::fs::create_dir_all(&charts).map_err(|e| lme_mpm::Error::Io {
+            action: "cannot create",
+            path: charts.clone(),
+            source: e,
+        }) {
+            return fail(&e);
+        }
+        if let Err(e) = bench::chart(&points, &charts.join(format!("bench-{name}"))) {
+            return fail(&e);
+        }
         let adapters: Vec<String> = points
             .iter()
             .filter(|p| p.backend.starts_with("gpu"))
@@ -334,6 +351,9 @@ fn bench(
             body.push('\n');
             body.push_str(&bench::ratio_table(&ratios));
         }
+        body.push_str(&format!(
+            "\n![particle-steps per second against particles](charts/bench-{name}.png)\n"
+        ));
         let section = format!("bench-{name}");
         if let Err(e) = lme_mpm::docgen::replace_section(doc, &section, &body) {
             return fail(&e);

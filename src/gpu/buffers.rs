@@ -22,6 +22,7 @@ pub enum Buf {
     Constraints,
     X0,
     U,
+    ULo,
     V,
     A,
     Mass,
@@ -41,13 +42,14 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 22] = [
+    pub const ALL: [Buf; 23] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
         Buf::Constraints,
         Buf::X0,
         Buf::U,
+        Buf::ULo,
         Buf::V,
         Buf::A,
         Buf::Mass,
@@ -154,6 +156,7 @@ impl Buffers {
         let u: Vec<f32> =
             flat2(&mut (0..n).map(|i| f32x2([p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]])));
         data.push((Buf::U, bytes(&u)));
+        data.push((Buf::ULo, vec![0u8; 8 * n]));
         data.push((Buf::V, bytes(&flat2(&mut p.v.iter().map(|v| f32x2(*v))))));
         if matches!(model.integrator, Integrator::Npc { .. }) {
             data.push((Buf::A, bytes(&flat2(&mut p.a.iter().map(|v| f32x2(*v))))));
