@@ -332,15 +332,20 @@ fn bench(
             .collect::<std::collections::BTreeSet<_>>()
             .into_iter()
             .collect();
+        // The command as given, so the table says how to remake it.
+        let command: Vec<String> = std::iter::once("lme-mpm".to_string())
+            .chain(std::env::args().skip(1))
+            .collect();
+        let with_gpu = if adapters.is_empty() {
+            String::new()
+        } else {
+            format!(" and {}", adapters.join(", "))
+        };
         let mut body = format!(
-            "Measured {} on {}{} with `lme-mpm bench --backend {name} --seconds {seconds}` (release build).\n\n{}\n",
+            "Measured {} on {}{with_gpu} with `{}` (release build).\n\n{}\n",
             bench::today(),
             bench::machine(),
-            if adapters.is_empty() {
-                String::new()
-            } else {
-                format!(" and {}", adapters.join(", "))
-            },
+            command.join(" "),
             bench::TABLE_HEADER
         );
         for p in &points {
