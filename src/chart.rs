@@ -6,6 +6,7 @@
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::colors::colormaps::ColorMap;
 use std::path::Path;
 use std::sync::Once;
 
@@ -279,6 +280,225 @@ impl LineChart {
                     b.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
                         .map_err(|e| e.to_string())?
                 )
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One panel of a particle image: positions and the value that colours them.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    pub title: String,
+    /// (x, y, value) per particle (m, m, any unit).
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+/// Panels of particles coloured by a value (viridis), on a grid of
+/// `cols` columns, with one shared colour scale and a colour bar.
+#[derive(Debug, Clone)]
+pub struct ParticleImage {
+    pub title: String,
+    pub value_label: String,
+    pub panels: Vec<Panel>,
+    pub cols: usize,
+    /// Colour scale (values outside are clamped).
+    pub range: (f64, f64),
+    /// Pixels per panel.
+    pub panel_size: (u32, u32),
+}
+
+impl ParticleImage {
+    /// Writes `<stem>.png` (a particle image is too heavy for SVG).
+    pub fn save(&self, stem: &Path) -> Result<()> {
+        register_font();
+        let png = stem.with_extension("png");
+        let rows = self.panels.len().div_ceil(self.cols.max(1));
+        let (pw, ph) = self.panel_size;
+        let size = (pw * self.cols as u32 + 90, ph * rows as u32 + 40);
+        let root = BitMapBackend::new(&png, size).into_drawing_area();
+        self.draw(&root, rows).map_err(|e| err(&png, e))?;
+        root.present().map_err(|e| err(&png, e))
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        rows: usize,
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        use plotters::style::colors::colormaps::ViridisRGB;
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let root = root
+            .titled(&self.title, ("sans-serif", 18))
+            .map_err(|e| e.to_string())?;
+        let (w, h) = root.dim_in_pixel();
+        let (plots, bar) = root.split_horizontally(w - 90);
+        let cells = plots.split_evenly((rows, self.cols.max(1)));
+        let (lo, hi) = self.range;
+        let norm = |v: f64| ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
+        for (panel, area) in self.panels.iter().zip(cells.iter()) {
+            let (x0, x1, y0, y1) = panel.points.iter().fold(
+                (
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ),
+                |b, p| (b.0.min(p.0), b.1.max(p.0), b.2.min(p.1), b.3.max(p.1)),
+            );
+            if !x0.is_finite() {
+                continue;
+            }
+            // Same scale on both axes.
+            let span = (x1 - x0).max(y1 - y0) * 1.04 + 1e-12;
+            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            let mut chart = ChartBuilder::on(area)
+                .caption(&panel.title, ("sans-serif", 14))
+                .margin(6)
+                .build_cartesian_2d(
+                    cx - 0.5 * span..cx + 0.5 * span,
+                    cy - 0.5 * span..cy + 0.5 * span,
+                )
+                .map_err(|e| e.to_string())?;
+            let (aw, _) = area.dim_in_pixel();
+            let n_side = (panel.points.len() as f64).sqrt().max(1.0);
+            let r = ((aw as f64 / n_side) * 0.45).clamp(1.0, 4.0) as i32;
+            chart
+                .draw_series(panel.points.iter().map(|p| {
+                    let c: RGBColor = ViridisRGB.get_color(norm(p.2) as f32);
+                    Circle::new((p.0, p.1), r, c.filled())
+                }))
+                .map_err(|e| e.to_string())?;
+        }
+        // Colour bar.
+        let steps = 100;
+        let bar = bar.margin(30, 30, 10, 40);
+        let (_, bh) = bar.dim_in_pixel();
+        for k in 0..steps {
+            let f = k as f64 / (steps - 1) as f64;
+            let c: RGBColor = ViridisRGB.get_color(f as f32);
+            let y = (bh as f64 * (1.0 - f)) as i32;
+            let half = (bh as i32 / steps).max(1);
+            bar.draw(&Rectangle::new([(0, y - half), (14, y + half)], c.filled()))
+                .map_err(|e| e.to_string())?;
+        }
+        let style = ("sans-serif", 12).into_font().color(&BLACK);
+        bar.draw(&Text::new(format!("{hi:.3}"), (18, 0), style.clone()))
+            .map_err(|e| e.to_string())?;
+        bar.draw(&Text::new(
+            format!("{lo:.3}"),
+            (18, bh as i32 - 12),
+            style.clone(),
+        ))
+        .map_err(|e| e.to_string())?;
+        bar.draw(&Text::new(
+            self.value_label.clone(),
+            (0, bh as i32 + 8),
+            style,
+        ))
+        .map_err(|e| e.to_string())?;
+        let _ = h;
+        Ok(())
+    }
+}
+
+/// How a cell of a status grid is coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Failed,
+    Error,
+    Missing,
+}
+
+/// A table of coloured cells with short texts (the stability map).
+#[derive(Debug, Clone)]
+pub struct StatusGrid {
+    pub title: String,
+    pub rows: Vec<String>,
+    pub cols: Vec<String>,
+    /// `cells[r][c]`.
+    pub cells: Vec<Vec<(Status, String)>>,
+}
+
+impl StatusGrid {
+    /// Writes `<stem>.png` and `<stem>.svg`.
+    pub fn save(&self, stem: &Path) -> Result<()> {
+        register_font();
+        let (cw, rh, lw, th) = (118u32, 44u32, 150u32, 70u32);
+        let size = (
+            lw + cw * self.cols.len() as u32 + 10,
+            th + rh * self.rows.len() as u32 + 10,
+        );
+        let png = stem.with_extension("png");
+        let svg = stem.with_extension("svg");
+        {
+            let root = BitMapBackend::new(&png, size).into_drawing_area();
+            self.draw(&root, (cw, rh, lw, th))
+                .map_err(|e| err(&png, e))?;
+            root.present().map_err(|e| err(&png, e))?;
+        }
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        self.draw(&root, (cw, rh, lw, th))
+            .map_err(|e| err(&svg, e))?;
+        root.present().map_err(|e| err(&svg, e))
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        (cw, rh, lw, th): (u32, u32, u32, u32),
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let font = |s: u32| ("sans-serif", s).into_font().color(&BLACK);
+        root.draw(&Text::new(self.title.clone(), (10, 8), font(17)))
+            .map_err(|e| e.to_string())?;
+        for (c, name) in self.cols.iter().enumerate() {
+            let x = (lw + cw * c as u32) as i32 + 4;
+            for (k, line) in name.split('\n').enumerate() {
+                root.draw(&Text::new(
+                    line.to_string(),
+                    (x, 34 + 14 * k as i32),
+                    font(12),
+                ))
+                .map_err(|e| e.to_string())?;
+            }
+        }
+        for (r, name) in self.rows.iter().enumerate() {
+            let y = (th + rh * r as u32) as i32;
+            root.draw(&Text::new(
+                name.clone(),
+                (10, y + rh as i32 / 2 - 7),
+                font(13),
+            ))
+            .map_err(|e| e.to_string())?;
+            for (c, (status, text)) in self.cells[r].iter().enumerate() {
+                let x = (lw + cw * c as u32) as i32;
+                let fill = match status {
+                    Status::Ok => RGBColor(190, 230, 190),
+                    Status::Failed => RGBColor(240, 170, 160),
+                    Status::Error => RGBColor(200, 200, 200),
+                    Status::Missing => RGBColor(245, 245, 245),
+                };
+                root.draw(&Rectangle::new(
+                    [(x + 1, y + 1), (x + cw as i32 - 1, y + rh as i32 - 1)],
+                    fill.filled(),
+                ))
+                .map_err(|e| e.to_string())?;
+                for (k, line) in text.split('\n').take(3).enumerate() {
+                    root.draw(&Text::new(
+                        line.to_string(),
+                        (x + 5, y + 5 + 13 * k as i32),
+                        font(11),
+                    ))
+                    .map_err(|e| e.to_string())?;
+                }
             }
         }
         Ok(())

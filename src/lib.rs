@@ -9,6 +9,7 @@
 
 pub mod backend;
 pub mod bench;
+pub mod cases;
 pub mod chart;
 pub mod cpu;
 pub mod docgen;
@@ -24,5 +25,6 @@ pub mod run;
 pub mod scene;
 pub mod shape;
 pub mod solver;
+pub mod study;
 
 pub use error::{Error, Result, SceneError};

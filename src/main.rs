@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use lme_mpm::run::{self, BackendChoice, RunOptions};
 use lme_mpm::scene::{Override, Scene};
 use lme_mpm::solver::RunStatus;
+use lme_mpm::study::{StudyBackend, StudyName, StudyOptions};
 use lme_mpm::{Error, SceneError};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -47,6 +48,31 @@ enum Command {
     },
     /// List GPU adapters: backend, device type, float-atomic support, key limits.
     Info,
+    /// Run one of the papers' comparisons (or all): CSV tables and charts in
+    /// --out, and (full runs) the study's section of docs/verification.md.
+    Study {
+        /// dyka, block, plate-impact, stability or all.
+        #[arg(value_enum)]
+        name: StudyName,
+        /// auto = the CPU path, plus the GPU when a hardware adapter exists.
+        #[arg(long, value_enum, default_value_t = StudyBackend::Auto)]
+        backend: StudyBackend,
+        /// Output folder; each study writes into <out>/<study>/.
+        #[arg(long, default_value = "out/study")]
+        out: PathBuf,
+        /// A reduced sweep that runs in a few minutes (does not touch the docs).
+        #[arg(long)]
+        quick: bool,
+        /// Runs at once (default: one per core).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Markdown file whose study sections are regenerated.
+        #[arg(long, default_value = "docs/verification.md")]
+        doc: PathBuf,
+        /// Do not touch the docs.
+        #[arg(long)]
+        no_doc: bool,
+    },
     /// Measure particle-steps per second of whole steps on a synthetic scene,
     /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
     Bench {
@@ -148,6 +174,41 @@ fn main() -> ExitCode {
             }
         }
         Command::Info => info(),
+        Command::Study {
+            name,
+            backend,
+            out,
+            quick,
+            jobs,
+            doc,
+            no_doc,
+        } => {
+            let opts = StudyOptions {
+                backend,
+                out,
+                quick,
+                jobs: jobs
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                doc: (!no_doc).then_some(doc),
+                progress: std::io::stderr().is_terminal(),
+            };
+            match lme_mpm::study::run(name, &opts) {
+                Ok(reports) => {
+                    for r in &reports {
+                        let failed = r.results.iter().filter(|j| !j.completed()).count();
+                        eprintln!(
+                            "study {}: {} runs, {} did not complete; outputs in {}",
+                            r.study.slug(),
+                            r.results.len(),
+                            failed,
+                            opts.out.join(r.study.slug()).display()
+                        );
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&e),
+            }
+        }
         Command::Bench {
             backend,
             adapter,

@@ -119,6 +119,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let schedule = Schedule {
         sample_interval: scene.sample_interval,
         vtk_interval: scene.file.output.vtk_interval,
+        ..Default::default()
     };
     let t_drive = Instant::now();
     let status = solver::drive(backend.as_mut(), schedule, &mut writer)?;

@@ -86,10 +86,29 @@ impl Observer for Recorder {
 }
 
 /// When to sample and snapshot (s).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Default)]
 pub struct Schedule {
     pub sample_interval: f64,
+    /// Snapshots every this often (plus one at t = 0).
     pub vtk_interval: Option<f64>,
+    /// Snapshots at these times too, each taken at the first step end at or after it.
+    pub snapshot_times: Vec<f64>,
+}
+
+impl Schedule {
+    /// The next snapshot due after time `t` (`k_vtk` counts periodic ones).
+    fn next_snapshot(&self, k_vtk: u64, t: f64) -> f64 {
+        let periodic = self
+            .vtk_interval
+            .map_or(f64::INFINITY, |i| k_vtk as f64 * i);
+        let listed = self
+            .snapshot_times
+            .iter()
+            .copied()
+            .filter(|&s| s > t)
+            .fold(f64::INFINITY, f64::min);
+        periodic.min(listed)
+    }
 }
 
 /// Runs `backend` to the model's t_end, sampling on `schedule`. Returns how
@@ -116,9 +135,7 @@ pub fn drive(
             return Ok(RunStatus::Completed);
         }
         let next_sample = k_sample as f64 * schedule.sample_interval;
-        let next_vtk = schedule
-            .vtk_interval
-            .map_or(f64::INFINITY, |i| k_vtk as f64 * i);
+        let next_vtk = schedule.next_snapshot(k_vtk, t);
         let stop = next_sample.min(next_vtk).min(t_end);
         match backend.advance(stop) {
             Ok(()) => {}
@@ -149,9 +166,9 @@ pub fn drive(
                 });
             }
         }
-        if let Some(iv) = schedule.vtk_interval {
-            if t >= next_vtk {
-                obs.snapshot(backend);
+        if t >= next_vtk {
+            obs.snapshot(backend);
+            if let Some(iv) = schedule.vtk_interval {
                 while k_vtk as f64 * iv <= t {
                     k_vtk += 1;
                 }

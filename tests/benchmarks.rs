@@ -147,6 +147,7 @@ fn free_fall(position: &str, shape: &str) -> (f64, f64) {
         Schedule {
             sample_interval: 0.1,
             vtk_interval: None,
+            ..Default::default()
         },
         &mut Recorder::default(),
     )

@@ -24,6 +24,7 @@ fn run_on(backend: &mut dyn Backend, scene: &lme_mpm::scene::Scene) -> Outcome {
     let schedule = Schedule {
         sample_interval: scene.sample_interval,
         vtk_interval: None,
+        ..Default::default()
     };
     let status = solver::drive(backend, schedule, &mut rec).unwrap();
     assert_eq!(status, RunStatus::Completed, "{}", backend.name());

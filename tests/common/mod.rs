@@ -38,6 +38,7 @@ pub fn run(name: &str, sets: &[&str]) -> Run {
     let schedule = Schedule {
         sample_interval: scene.sample_interval,
         vtk_interval: None,
+        ..Default::default()
     };
     let status = solver::drive(&mut backend, schedule, &mut recorder).unwrap();
     let t = backend.time();

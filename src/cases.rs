@@ -1,0 +1,9 @@
+//! The scene files in `cases/`, compiled into the binary so studies run
+//! from any folder. Each is also an ordinary file users can copy and edit.
+
+pub const DYKA_BAR: &str = include_str!("../cases/dyka_bar.toml");
+pub const ELASTIC_BLOCK: &str = include_str!("../cases/elastic_block.toml");
+pub const PLATE_IMPACT: &str = include_str!("../cases/plate_impact.toml");
+
+/// Dyka's bar length (m), as in `cases/dyka_bar.toml`.
+pub const DYKA_L: f64 = 0.1333;

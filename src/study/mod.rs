@@ -1,0 +1,217 @@
+//! `lme-mpm study NAME`: the papers' comparisons as one command each. A
+//! study builds its jobs (method × resolution × backend), runs them spread
+//! over the cores, writes `results.csv` and charts (PNG, SVG) to its output
+//! folder, and regenerates its section of docs/verification.md.
+
+pub mod block;
+pub mod dyka;
+pub mod plate;
+pub mod runner;
+pub mod stability;
+
+use crate::error::{Error, Result};
+use crate::run::BackendChoice;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Which study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StudyName {
+    /// Dyka's bar: 7 cell sizes × linear, uGIMP, LME γ = 2, 3, 4 × FE, NPC.
+    Dyka,
+    /// Elastic block: linear, uGIMP, LME γ = 0.8 and 3 (NPC).
+    Block,
+    /// 2D plate impact: FE vs NPC fields; regular vs perturbed grids.
+    PlateImpact,
+    /// Stability map: shape × integrator × case × resolution.
+    Stability,
+    /// All four, in that order.
+    All,
+}
+
+impl StudyName {
+    pub fn slug(self) -> &'static str {
+        match self {
+            StudyName::Dyka => "dyka",
+            StudyName::Block => "block",
+            StudyName::PlateImpact => "plate-impact",
+            StudyName::Stability => "stability",
+            StudyName::All => "all",
+        }
+    }
+}
+
+/// `--backend` of a study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StudyBackend {
+    /// The CPU path, plus the GPU when a hardware GPU adapter exists.
+    Auto,
+    Cpu,
+    Gpu,
+    /// The CPU path and any GPU adapter (software included).
+    Both,
+}
+
+#[derive(Debug, Clone)]
+pub struct StudyOptions {
+    pub backend: StudyBackend,
+    /// Each study writes into `<out>/<study>/`.
+    pub out: PathBuf,
+    /// The reduced sweep (a few minutes); never touches the docs.
+    pub quick: bool,
+    /// Simulations run at once.
+    pub jobs: usize,
+    /// Markdown file whose study sections are regenerated (full runs only).
+    pub doc: Option<PathBuf>,
+    pub progress: bool,
+}
+
+/// What a study produced.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub study: StudyName,
+    /// Markdown for the study's section of docs/verification.md.
+    pub markdown: String,
+    /// Charts written (PNG, SVG), to copy next to the doc.
+    pub charts: Vec<PathBuf>,
+    pub results: Vec<runner::JobResult>,
+}
+
+/// The backends a study's jobs run on.
+pub fn backends(b: StudyBackend) -> Vec<BackendChoice> {
+    match b {
+        StudyBackend::Cpu => return vec![BackendChoice::Cpu],
+        StudyBackend::Gpu => return vec![BackendChoice::Gpu],
+        _ => {}
+    }
+    let adapters = crate::gpu::context::adapters();
+    let hardware = adapters.iter().any(|a| !a.is_software());
+    match b {
+        StudyBackend::Cpu => vec![BackendChoice::Cpu],
+        StudyBackend::Gpu => vec![BackendChoice::Gpu],
+        StudyBackend::Auto if hardware => vec![BackendChoice::Cpu, BackendChoice::Gpu],
+        StudyBackend::Auto => vec![BackendChoice::Cpu],
+        StudyBackend::Both if !adapters.is_empty() => vec![BackendChoice::Cpu, BackendChoice::Gpu],
+        StudyBackend::Both => vec![BackendChoice::Cpu],
+    }
+}
+
+pub fn backend_slug(b: BackendChoice) -> &'static str {
+    match b {
+        BackendChoice::Cpu => "cpu",
+        BackendChoice::Gpu => "gpu",
+        BackendChoice::Auto => "auto",
+    }
+}
+
+/// Runs one study (or all) and writes its outputs.
+pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
+    let names = match name {
+        StudyName::All => vec![
+            StudyName::Dyka,
+            StudyName::Block,
+            StudyName::PlateImpact,
+            StudyName::Stability,
+        ],
+        n => vec![n],
+    };
+    let backends = backends(opts.backend);
+    let mut reports = Vec::new();
+    for n in names {
+        let dir = opts.out.join(n.slug());
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io("cannot create", &dir, e))?;
+        let jobs = match n {
+            StudyName::Dyka => dyka::jobs(opts.quick, &backends),
+            StudyName::Block => block::jobs(opts.quick, &backends),
+            StudyName::PlateImpact => plate::jobs(opts.quick, &backends),
+            StudyName::Stability => stability::jobs(opts.quick, &backends),
+            StudyName::All => unreachable!(),
+        };
+        if opts.progress {
+            eprintln!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
+        }
+        let results = runner::run_jobs(jobs, opts.jobs, opts.progress);
+        crate::output::write_atomic(
+            &dir.join("results.csv"),
+            runner::results_csv(&results).as_bytes(),
+        )?;
+        let (markdown, charts) = match n {
+            StudyName::Dyka => dyka::report(&results, &dir, opts.quick)?,
+            StudyName::Block => block::report(&results, &dir, opts.quick)?,
+            StudyName::PlateImpact => plate::report(&results, &dir, opts.quick)?,
+            StudyName::Stability => stability::report(&results, &dir, opts.quick)?,
+            StudyName::All => unreachable!(),
+        };
+        crate::output::write_atomic(&dir.join("report.md"), markdown.as_bytes())?;
+        if let (Some(doc), false) = (&opts.doc, opts.quick) {
+            publish(doc, n, &markdown, &charts)?;
+        }
+        reports.push(Report {
+            study: n,
+            markdown,
+            charts,
+            results,
+        });
+    }
+    Ok(reports)
+}
+
+/// Copies the charts next to `doc` (into `charts/`) and replaces the study's section.
+fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Result<()> {
+    let dir = doc.parent().unwrap_or(Path::new(".")).join("charts");
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io("cannot create", &dir, e))?;
+    for c in charts {
+        let name = c.file_name().expect("chart files have names");
+        std::fs::copy(c, dir.join(name)).map_err(|e| Error::io("cannot copy", c, e))?;
+    }
+    let stamp = format!(
+        "Generated {} by `lme-mpm study {}` on {}.\n\n",
+        crate::bench::today(),
+        n.slug(),
+        crate::bench::machine()
+    );
+    crate::docgen::replace_section(doc, &format!("study-{}", n.slug()), &(stamp + markdown))
+}
+
+/// Markdown image line for a chart written as `<dir>/<file>`.
+pub fn image(alt: &str, file: &str) -> String {
+    format!("![{alt}](charts/{file})\n")
+}
+
+/// Three significant digits.
+pub fn sig(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32;
+    if (-3..4).contains(&e) {
+        let decimals = (2 - e).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// A markdown table.
+pub fn table(header: &[String], rows: &[Vec<String>]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "| {} |", header.join(" | "));
+    let _ = writeln!(s, "|{}", "---|".repeat(header.len()));
+    for r in rows {
+        let _ = writeln!(s, "| {} |", r.join(" | "));
+    }
+    s
+}
+
+/// Short text for a run that did not complete.
+pub fn failure_text(r: &runner::JobResult) -> String {
+    match &r.outcome {
+        Err(e) => format!("error: {e}"),
+        Ok(d) => match &d.status {
+            crate::solver::RunStatus::Completed => "completed".into(),
+            crate::solver::RunStatus::Unstable { fault, t, .. } => {
+                format!("unstable at {} s ({})", sig(*t), fault.code())
+            }
+        },
+    }
+}

@@ -1,0 +1,190 @@
+//! The studies' quick sweeps, on the CPU path: they run, write their tables
+//! and charts, and show the trends that must hold.
+
+use lme_mpm::exact::Errors;
+use lme_mpm::solver::RunStatus;
+use lme_mpm::study::runner::JobResult;
+use lme_mpm::study::{self, StudyBackend, StudyName, StudyOptions};
+use std::path::PathBuf;
+
+fn run(name: StudyName) -> (Vec<JobResult>, String, PathBuf) {
+    let out = std::env::temp_dir().join(format!(
+        "lme-mpm-study-{}-{}",
+        std::process::id(),
+        name.slug()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    let opts = StudyOptions {
+        backend: StudyBackend::Cpu,
+        out: out.clone(),
+        quick: true,
+        jobs: 2,
+        doc: None,
+        progress: false,
+    };
+    let mut reports = study::run(name, &opts).unwrap();
+    let r = reports.pop().unwrap();
+    let dir = out.join(name.slug());
+    for c in &r.charts {
+        assert!(
+            c.exists() && std::fs::metadata(c).unwrap().len() > 1000,
+            "chart {c:?} missing or empty"
+        );
+    }
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        r.results.len() + 1,
+        "one CSV row per run"
+    );
+    assert!(dir.join("report.md").exists());
+    (r.results, r.markdown, dir)
+}
+
+fn rms(r: &JobResult) -> Option<f64> {
+    match r.data()?.errors.as_ref()? {
+        Errors::Dyka(e) if r.completed() => Some(e.rms_velocity),
+        _ => None,
+    }
+}
+
+#[test]
+fn dyka_quick_npc_beats_fe() {
+    let (results, md, _) = run(StudyName::Dyka);
+    assert!(md.contains("study-dyka-convergence.png") && md.contains("study-dyka-fe-npc.png"));
+    let get = |m: &str, i: &str, h: &str| {
+        results.iter().find(|r| {
+            r.job.tag_value("method") == Some(m)
+                && r.job.tag_value("integrator") == Some(i)
+                && r.job.tag_value("h_mm") == Some(h)
+        })
+    };
+    let hs: Vec<String> = {
+        let mut v: Vec<String> = results
+            .iter()
+            .filter_map(|r| r.job.tag_value("h_mm").map(String::from))
+            .collect();
+        v.dedup();
+        v
+    };
+    for h in &hs {
+        // At each cell size, averaged over the methods where both completed,
+        // NPC's error is at or below FE's (paper Fig. 6).
+        let (mut n, mut f, mut k) = (0.0, 0.0, 0);
+        for (m, _, _) in lme_mpm::study::dyka::METHODS {
+            if let (Some(a), Some(b)) = (
+                get(m, "npc", h).and_then(rms),
+                get(m, "fe", h).and_then(rms),
+            ) {
+                n += a;
+                f += b;
+                k += 1;
+                // For LME, the paper's method, at every single cell size too.
+                if m.starts_with("lme") {
+                    assert!(a <= b, "{m} at {h} mm: NPC {a} > FE {b}");
+                }
+            }
+        }
+        assert!(k > 0, "nothing completed at {h} mm");
+        assert!(
+            n <= f,
+            "at {h} mm NPC's mean error {} exceeds FE's {}",
+            n / k as f64,
+            f / k as f64
+        );
+    }
+}
+
+#[test]
+fn block_quick_lme_completes_and_q4_is_worse() {
+    let (results, md, _) = run(StudyName::Block);
+    let err = |m: &str| {
+        let r = results
+            .iter()
+            .find(|r| r.job.tag_value("method") == Some(m))
+            .unwrap();
+        match r.data().and_then(|d| d.errors.clone()) {
+            Some(Errors::Column(e)) if r.completed() => Some(e.settlement_rel_error),
+            _ => None,
+        }
+    };
+    let (g08, g3) = (
+        err("lme-g0.8").expect("LME γ=0.8 completes"),
+        err("lme-g3").expect("LME γ=3 completes"),
+    );
+    assert!(g08 < 0.03 && g3 < 0.03, "LME settlement errors {g08}, {g3}");
+    if let Some(q4) = err("linear") {
+        assert!(
+            q4 > 3.0 * g08.max(g3),
+            "Q4 {q4} should be far worse than LME"
+        );
+    }
+    assert!(md.contains("study-block-settlement.png"));
+}
+
+#[test]
+fn plate_quick_compares_grids() {
+    let (results, md, _) = run(StudyName::PlateImpact);
+    for shape in ["lme", "ugimp"] {
+        for grid in ["regular", "perturbed"] {
+            let r = results
+                .iter()
+                .find(|r| {
+                    r.job.tag_value("shape") == Some(shape) && r.job.tag_value("grid") == Some(grid)
+                })
+                .unwrap();
+            assert!(
+                r.completed(),
+                "{shape} {grid}: {:?}",
+                r.data().map(|d| d.status_text())
+            );
+        }
+    }
+    assert!(md.contains("RMS |v_perturbed − v_regular|"));
+    assert!(md.contains("study-plate-fe-npc.png") && md.contains("study-plate-perturbed.png"));
+}
+
+#[test]
+fn stability_quick_records_every_failure() {
+    let (results, md, dir) = run(StudyName::Stability);
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let mut failures = 0;
+    for r in &results {
+        let d = r
+            .data()
+            .unwrap_or_else(|| panic!("{}: {:?}", r.job.label, r.outcome));
+        if let RunStatus::Unstable { t, .. } = d.status {
+            failures += 1;
+            assert!(t < d.t_end, "{}: unstable at t_end?", r.job.label);
+            let row = csv
+                .lines()
+                .find(|l| l.starts_with(&format!("{},", r.job.label)))
+                .unwrap();
+            assert!(
+                row.contains(",unstable,\"") && !row.contains(",unstable,\"\""),
+                "{row}"
+            );
+        }
+    }
+    // Each failure is a red cell of the map with its time and reason.
+    assert_eq!(md.matches("**unstable** at").count(), failures);
+    // Q4 on the perturbed plate is a failure our solver finds: detected and reported.
+    let q4 = results
+        .iter()
+        .find(|r| {
+            r.job.tag_value("method") == Some("linear NPC") && r.job.label.ends_with("perturbed")
+        })
+        .unwrap();
+    assert!(
+        !q4.completed(),
+        "Q4 on the perturbed plate should be detected as unstable"
+    );
+    // LME completes everything in the quick map.
+    for r in results.iter().filter(|r| {
+        r.job
+            .tag_value("method")
+            .is_some_and(|m| m.starts_with("LME"))
+    }) {
+        assert!(r.completed(), "{} did not complete", r.job.label);
+    }
+}
