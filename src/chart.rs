@@ -292,6 +292,9 @@ pub struct Panel {
     pub title: String,
     /// (x, y, value) per particle (m, m, any unit).
     pub points: Vec<(f64, f64, f64)>,
+    /// Side of the square drawn for each particle (m): the particle spacing,
+    /// so the particles tile the body.
+    pub size: f64,
 }
 
 /// Panels of particles coloured by a value (viridis), on a grid of
@@ -363,13 +366,15 @@ impl ParticleImage {
                     cy - 0.5 * span..cy + 0.5 * span,
                 )
                 .map_err(|e| e.to_string())?;
-            let (aw, _) = area.dim_in_pixel();
-            let n_side = (panel.points.len() as f64).sqrt().max(1.0);
-            let r = ((aw as f64 / n_side) * 0.45).clamp(1.0, 4.0) as i32;
+            // Slightly larger than the spacing, so pixel rounding leaves no gaps.
+            let half = 0.6 * panel.size;
             chart
                 .draw_series(panel.points.iter().map(|p| {
                     let c: RGBColor = ViridisRGB.get_color(norm(p.2) as f32);
-                    Circle::new((p.0, p.1), r, c.filled())
+                    Rectangle::new(
+                        [(p.0 - half, p.1 - half), (p.0 + half, p.1 + half)],
+                        c.filled(),
+                    )
                 }))
                 .map_err(|e| e.to_string())?;
         }

@@ -140,7 +140,7 @@ fn plate_quick_compares_grids() {
             );
         }
     }
-    assert!(md.contains("RMS |v_perturbed − v_regular|"));
+    assert!(md.contains("RMS of (v perturbed − v regular) / V0"));
     assert!(md.contains("study-plate-fe-npc.png") && md.contains("study-plate-perturbed.png"));
 }
 

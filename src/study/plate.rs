@@ -83,12 +83,14 @@ fn find<'a>(
     })
 }
 
-fn speed_panel(title: String, p: &Particles) -> Panel {
+/// Particles coloured by speed, each a square of the seeding spacing (2 × 2 per cell).
+fn speed_panel(title: String, p: &Particles, h: f64) -> Panel {
     Panel {
         title,
         points: (0..p.len())
             .map(|i| (p.x[i][0], p.x[i][1], p.v[i][0].hypot(p.v[i][1])))
             .collect(),
+        size: 0.5 * h,
     }
 }
 
@@ -158,6 +160,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             panels.push(speed_panel(
                 format!("{} t = {} s", integ.to_uppercase(), sig(*t)),
                 p,
+                hh,
             ));
             row.push(sig(intra_cell_scatter(p, hh)));
         }
@@ -208,10 +211,12 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                 Some((d, p)) => panels.push(speed_panel(
                     format!("{name}, {grid} grid, t = {} s", sig(d.t)),
                     p,
+                    hh,
                 )),
                 None => panels.push(Panel {
                     title: format!("{name}, {grid}: no result"),
                     points: Vec::new(),
+                    size: hh,
                 }),
             }
         }
@@ -255,7 +260,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     ));
     let header = vec![
         "method".to_string(),
-        "RMS |v_perturbed − v_regular| / V0 at 2.66 s".to_string(),
+        "RMS of (v perturbed − v regular) / V0 at 2.66 s".to_string(),
     ];
     let _ = writeln!(
         md,
@@ -265,5 +270,20 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
          grid but not linear reproduction (docs/methods.md); Q4 there is isoparametric.\n",
         table(&header, &rows)
     );
+    // Which of LME and uGIMP the perturbation moved less.
+    let num = |name: &str| {
+        rows.iter()
+            .find(|r| r[0] == name)
+            .and_then(|r| r[1].parse::<f64>().ok())
+    };
+    if let (Some(l), Some(u)) = (num("LME γ = 3"), num("uGIMP")) {
+        let _ = writeln!(
+            md,
+            "Here the perturbation moves LME's velocities {} than uGIMP's ({} against {} of V0).\n",
+            if l < u { "less" } else { "no less" },
+            sig(l),
+            sig(u)
+        );
+    }
     Ok((md, charts))
 }
