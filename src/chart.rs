@@ -104,6 +104,8 @@ pub struct LineChart {
     pub series: Vec<Series>,
     /// Pixels.
     pub size: (u32, u32),
+    /// Where the legend goes (pick the corner the data leave empty).
+    pub legend: SeriesLabelPosition,
 }
 
 impl LineChart {
@@ -120,6 +122,7 @@ impl LineChart {
             log_y: false,
             series: Vec::new(),
             size: (800, 500),
+            legend: SeriesLabelPosition::UpperLeft,
         }
     }
 
@@ -256,7 +259,7 @@ impl LineChart {
                         .background_style(WHITE.mix(0.85))
                         .border_style(RGBColor(200, 200, 200))
                         .label_font(("sans-serif", 12))
-                        .position(SeriesLabelPosition::UpperLeft)
+                        .position(self.legend.clone())
                         .draw()
                         .map_err(|e| e.to_string())?;
                 }

@@ -178,6 +178,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         }
     }
     conv.size = (900, 560);
+    conv.legend = plotters::chart::SeriesLabelPosition::LowerRight;
     conv.save(&dir.join("study-dyka-convergence"))?;
     charts
         .extend(["study-dyka-convergence.png", "study-dyka-convergence.svg"].map(|f| dir.join(f)));
@@ -213,6 +214,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         }
     }
     front.size = (900, 560);
+    front.legend = plotters::chart::SeriesLabelPosition::LowerLeft;
     front.save(&dir.join("study-dyka-front"))?;
     charts.extend(["study-dyka-front.png", "study-dyka-front.svg"].map(|f| dir.join(f)));
 
