@@ -3,8 +3,7 @@
 // every step (cheap), so the reduction never sees a stale maximum.
 // CPU twin: src/cpu/cfl.rs.
 #include "shared/common.wgsl"
-#include "shared/material_linear_elastic.wgsl"
-#include "shared/material_bindings.wgsl"
+#include "shared/material.wgsl"
 
 @group(0) @binding({{B_V}}) var<storage, read> v: array<vec2<f32>>;
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;

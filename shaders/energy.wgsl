@@ -2,8 +2,10 @@
 // Σ m |g| |u| on gravity's work, reduced per workgroup then added into
 // energy_out[0..3]. CPU twin: src/cpu/energy.rs.
 #include "shared/common.wgsl"
-#include "shared/material_linear_elastic.wgsl"
-#include "shared/material_bindings.wgsl"
+#include "shared/material.wgsl"
+#if DEF_GRAD
+@group(0) @binding({{B_DEF_GRAD}}) var<storage, read> def_grad: array<vec4<f32>>;
+#endif
 
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
 @group(0) @binding({{B_V}}) var<storage, read> v: array<vec2<f32>>;
@@ -15,6 +17,14 @@
 #include "shared/atomics.wgsl" ARR=energy_out FN=energy_add
 
 var<workgroup> wg: array<vec4<f32>, 256>;
+
+fn particle_def_grad(p: u32) -> vec4<f32> {
+#if DEF_GRAD
+    return def_grad[p];
+#else
+    return vec4<f32>(1.0, 0.0, 0.0, 1.0);
+#endif
+}
 
 @compute @workgroup_size(256)
 fn main(
@@ -29,7 +39,7 @@ fn main(
         let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
         e = vec4<f32>(
             0.5 * m * dot(v[p], v[p]),
-            m / rho[p] * strain_energy_density(material_of(p), s),
+            m / rho[p] * strain_energy_density(material_of(p), s, particle_def_grad(p)),
             m * length(params.gravity) * length(u[p]),
             0.0,
         );

@@ -1,5 +1,7 @@
-// Stage `forces`: f_I += −V_p σ_p ∇N_I + N_I m_p b(t) with atomics,
-// V_p = m_p/ρ_p. CPU twin: src/cpu/forces.rs.
+// Stage `forces`: f_I += −V_p σ_p ∇N_I + N_I m_p b(t + Δt) with atomics,
+// V_p = m_p/ρ_p; b is gravity plus, with MMS, the manufactured solution's
+// source term. The stress is already at the step's end, so are the loads.
+// CPU twin: src/cpu/forces.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -13,15 +15,7 @@
 
 #include "shared/atomics.wgsl" ARR=node_acc FN=node_add
 
-// Gravity at time t (paper eq. 45 when ramped).
-fn gravity_at(t: f32) -> vec2<f32> {
-    let period = params.ramp_period;
-    if period > 0.0 && t <= 0.5 * period {
-        let pi = 3.14159265358979;
-        return params.gravity * 0.5 * (sin(2.0 * pi * t / period - 0.5 * pi) + 1.0);
-    }
-    return params.gravity;
-}
+#include "shared/body_force.wgsl"
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -32,7 +26,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let m = mass[p];
     let vol = m / rho[p];
     let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
-    let b = m * gravity_at(sim.t + sim.t_lo);
+    let b = m * body_force(p, sim.t + sim.t_lo + sim.dt);
     let c = shape_ctx(p, x0[p] + u[p]);
     for (var k = 0u; k < STENCIL; k++) {
         let w = shape_node(c, k);

@@ -18,6 +18,9 @@ fn main() {
         return;
     }
     var dt = params.cfl_h / cmax;
+    if params.fixed_dt > 0.0 {
+        dt = params.fixed_dt;
+    }
     if dt >= rem_end * (1.0 - 1e-6) {
         dt = rem_end;
         sim.final_step = 1u;

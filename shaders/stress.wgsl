@@ -1,10 +1,13 @@
-// Stage `stress`: Δε = Δt sym(Σ v_I ⊗ ∇N_I), ρ ← ρ/(1 + tr Δε), σ += D:Δε.
-// CPU twin: src/cpu/stress.rs.
+// Stage `stress`: L = Σ v_I ⊗ ∇N_I, then the material's update over Δt
+// (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F)),
+// and ρ ← ρ / (V_new / V_old). CPU twin: src/cpu/stress.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
-#include "shared/material_linear_elastic.wgsl"
-#include "shared/material_bindings.wgsl"
+#include "shared/material.wgsl"
+#if DEF_GRAD
+@group(0) @binding({{B_DEF_GRAD}}) var<storage, read_write> def_grad: array<vec4<f32>>;
+#endif
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
@@ -31,22 +34,26 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
     }
     let dt = sim.dt;
-    let de = vec3<f32>(dt * l.x, dt * l.w, 0.5 * dt * (l.y + l.z));
-    let jac = 1.0 + de.x + de.y;
-    if !is_finite(jac) {
-        report_fault(FAULT_NON_FINITE_STRAIN, p);
+#if DEF_GRAD
+    let f = def_grad[p];
+#else
+    let f = vec4<f32>(1.0, 0.0, 0.0, 1.0);
+#endif
+    let s0 = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+    let up = material_update(material_of(p), l, dt, s0, f);
+    if up.fault != 0u {
+        report_fault(up.fault, p);
         return;
     }
-    if jac <= 0.0 {
-        report_fault(FAULT_DENSITY, p);
-        return;
-    }
-    rho[p] = rho[p] / jac;
-    let s = update_stress(material_of(p), vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]), de);
+    let s = up.s;
     if !(is_finite(s.x) && is_finite(s.y) && is_finite(s.z)) {
         report_fault(FAULT_NON_FINITE_STRESS, p);
         return;
     }
+    rho[p] = rho[p] / up.j;
+#if DEF_GRAD
+    def_grad[p] = up.f;
+#endif
     stress[3u * p] = s.x;
     stress[3u * p + 1u] = s.y;
     stress[3u * p + 2u] = s.z;

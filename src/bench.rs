@@ -44,11 +44,24 @@ pub fn standard_cases() -> Vec<Case> {
 }
 
 /// Extra cases: LME with weights stored per slot on the GPU (the
-/// alternative to recomputing them from λ in each pass).
+/// alternative to recomputing them from λ in each pass), and the B-splines
+/// with and without MLS reconstruction.
 pub fn extra_cases() -> Vec<Case> {
     let mut stored = Case::new("lme-g3-stored", &["solver.shape=lme", "solver.lme_gamma=3"]);
     stored.gpu.lme_stored = true;
-    vec![stored]
+    vec![
+        stored,
+        Case::new("bspline2", &["solver.shape=bspline2"]),
+        Case::new("bspline3", &["solver.shape=bspline3"]),
+        Case::new(
+            "bspline2-mls",
+            &["solver.shape=bspline2", "solver.mls=true"],
+        ),
+        Case::new(
+            "bspline3-mls",
+            &["solver.shape=bspline3", "solver.mls=true"],
+        ),
+    ]
 }
 
 /// A square of `cells`² cells, 2×2 particles per cell, h = 1 m, resting on

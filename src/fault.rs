@@ -14,6 +14,9 @@ pub enum FaultKind {
     /// Kinetic + strain energy grew past `ENERGY_RUNAWAY` times the energy the
     /// run could have received (initial energy plus a bound on the work of gravity).
     EnergyRunaway { ratio: f64 },
+    /// MLS: the moment matrix at a Gauss point (m) is singular, fewer than
+    /// three non-collinear particles within its 3h support.
+    MlsSingular { at: [f64; 2] },
 }
 
 /// The first problem a step found.
@@ -50,6 +53,7 @@ impl Fault {
             FaultKind::NonFinite { .. } => "non_finite",
             FaultKind::NonPositiveDensity => "non_positive_density",
             FaultKind::EnergyRunaway { .. } => "energy_runaway",
+            FaultKind::MlsSingular { .. } => "mls_singular",
         }
     }
 }
@@ -65,6 +69,11 @@ impl std::fmt::Display for Fault {
             FaultKind::EnergyRunaway { ratio } => write!(
                 f,
                 "energy runaway: kinetic + strain energy is {ratio:.1} times what the loads could supply"
+            )?,
+            FaultKind::MlsSingular { at } => write!(
+                f,
+                "MLS reconstruction singular at the Gauss point ({:.4}, {:.4}) m: fewer than 3 non-collinear particles within 3h",
+                at[0], at[1]
             )?,
         }
         if let Some(p) = self.particle {

@@ -51,7 +51,7 @@ enum Command {
     /// Run one of the papers' comparisons (or all): CSV tables and charts in
     /// --out, and (full runs) the study's section of docs/verification.md.
     Study {
-        /// dyka, block, plate-impact, stability or all.
+        /// dyka, block, plate-impact, stability, mms or all.
         #[arg(value_enum)]
         name: StudyName,
         /// auto = the CPU path, plus the GPU when a hardware adapter exists.
@@ -86,7 +86,8 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
         particles: Vec<usize>,
         /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
-        /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed).
+        /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed),
+        /// bspline2, bspline3, bspline2-mls, bspline3-mls.
         #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
         cases: Vec<String>,
         /// Seconds of stepping per point (after one warm-up step).
@@ -98,6 +99,9 @@ enum Command {
         /// Also rewrite the measured tables in this markdown file (e.g. docs/performance.md).
         #[arg(long)]
         doc: Option<PathBuf>,
+        /// Name of the doc section and chart (`bench-NAME`); default: the --backend value.
+        #[arg(long)]
+        section: Option<String>,
     },
 }
 
@@ -217,6 +221,7 @@ fn main() -> ExitCode {
             seconds,
             out,
             doc,
+            section,
         } => bench(
             backend,
             adapter.as_deref(),
@@ -224,7 +229,7 @@ fn main() -> ExitCode {
             &cases,
             seconds,
             &out,
-            doc.as_deref(),
+            doc.as_deref().map(|d| (d, section.as_deref())),
         ),
         Command::Check { scene, set } => {
             let scene = match load(&scene, &set) {
@@ -308,7 +313,7 @@ fn bench(
     cases: &[String],
     seconds: f64,
     out: &std::path::Path,
-    doc: Option<&std::path::Path>,
+    doc: Option<(&std::path::Path, Option<&str>)>,
 ) -> ExitCode {
     use lme_mpm::bench;
     let all: Vec<_> = bench::standard_cases()
@@ -370,8 +375,8 @@ fn bench(
     if let Err(e) = bench::chart(&points, &out.join("bench")) {
         return fail(&e);
     }
-    if let Some(doc) = doc {
-        let name = format!("{backends:?}").to_lowercase();
+    if let Some((doc, section)) = doc {
+        let name = section.map_or_else(|| format!("{backends:?}").to_lowercase(), String::from);
         let charts = doc
             .parent()
             .unwrap_or(std::path::Path::new("."))

@@ -187,6 +187,8 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         npc_gamma: npc.then_some(solver.npc_gamma),
         npc_position: npc.then_some(solver.npc_position),
         cfl: solver.cfl,
+        dt: solver.dt,
+        mls: solver.mls,
         h: model.grid.h,
         perturb: model.grid.perturb,
         energy: final_sample
@@ -354,7 +356,49 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         ),
         Shape::Ugimp(u) => format!("ugimp (lp = {:.4} h)", u.lp_h),
         Shape::Linear => "linear".to_string(),
+        Shape::Bspline(b) => format!("B-spline of degree {} (open knots)", b.degree),
     };
+    let shape = if model.mls {
+        format!(
+            "{shape}, MLS reconstruction at {} Gauss points",
+            crate::cpu::mls::gauss_points(&model.shape, g)
+        )
+    } else {
+        shape
+    };
+    let step_rule = match model.fixed_dt {
+        Some(fixed) => {
+            // Courant number of the fixed step at t = 0.
+            let c = crate::cpu::cfl::max_speed(
+                &model.particles.v,
+                &model.particles.rho,
+                &model.particles.body,
+                &model.materials,
+                &model.body_material,
+            );
+            format!(
+                "dt = {fixed} s fixed (Courant number {:.3} at t = 0)",
+                c * fixed / g.min_spacing()
+            )
+        }
+        None => format!("cfl = {}", s.cfl),
+    };
+    let materials = scene
+        .file
+        .materials
+        .iter()
+        .map(|(n, m)| {
+            let model = serde_json::to_value(m.model)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default();
+            format!(
+                "{n} ({model}, E = {} Pa, nu = {}, rho = {} kg/m^3)",
+                m.youngs_modulus, m.nu, m.density
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
     let integrator = match model.integrator {
         crate::model::Integrator::Fe => "fe".to_string(),
         crate::model::Integrator::Npc { gamma, position } => {
@@ -365,8 +409,9 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         "scene {name}: valid\n{desc}\
          particles   {np}\n\
          grid        {nx} x {ny} nodes, h = {h} m, from ({x0}, {y0}) to ({x1}, {y1}) m{pert}\n\
+         materials   {materials}\n\
          shape       {shape}\n\
-         integrator  {integrator}, cfl = {cfl}\n\
+         integrator  {integrator}, {step_rule}\n\
          time        t_end = {t_end} s, first dt = {dt:.4e} s, about {steps:.0} steps\n\
          work        about {work:.3e} particle-steps\n\
          memory      {bpp:.0} bytes per particle on the CPU path\n\
@@ -392,7 +437,6 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         } else {
             String::new()
         },
-        cfl = s.cfl,
         t_end = s.t_end,
         steps = (s.t_end / dt).ceil(),
         work = (s.t_end / dt).ceil() * model.particles.len() as f64,
@@ -410,9 +454,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             .map(|p| format!("{} -> particle {}", p.name, p.particle))
             .collect::<Vec<_>>()
             .join(", "),
-        exact = scene
-            .file
-            .exact
-            .map_or("none".to_string(), |e| format!("{e:?}")),
+        exact = scene.file.exact.map_or("none".to_string(), |e| {
+            serde_json::to_value(e)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_else(|| format!("{e:?}"))
+        }),
     )
 }

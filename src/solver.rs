@@ -51,7 +51,7 @@ pub const STEP: &[Stage] = &[
 
 /// A run stops as unstable when kinetic + strain energy exceeds this many
 /// times the energy the run could have received (initial energy plus the
-/// bound on gravity's work). Stable elastic runs stay at or below 1 (energy
+/// bound on gravity's work, plus a manufactured field's peak energy). Stable elastic runs stay at or below 1 (energy
 /// is conserved or dissipated); 10 leaves room for round-off and for the
 /// bound's slack without missing an exponential blow-up.
 pub const ENERGY_RUNAWAY: f64 = 10.0;
@@ -123,6 +123,13 @@ pub fn drive(
     let first = backend.sample()?;
     let e0 = first.energy;
     let scale = energy_floor(backend);
+    // A manufactured body force supplies (and takes back) the exact field's energy.
+    let supplied = {
+        let m = backend.model();
+        m.manufactured
+            .as_ref()
+            .map_or(0.0, |mms| mms.peak_energy(&m.particles))
+    };
     obs.sample(&first);
     if schedule.vtk_interval.is_some() {
         obs.snapshot(backend);
@@ -158,7 +165,7 @@ pub fn drive(
             while k_sample as f64 * schedule.sample_interval <= t {
                 k_sample += 1;
             }
-            if let Some(fault) = runaway(&e0, &s.energy, scale) {
+            if let Some(fault) = runaway(&e0, &s.energy, supplied, scale) {
                 return Ok(RunStatus::Unstable {
                     fault,
                     t,
@@ -188,8 +195,8 @@ fn energy_floor(backend: &mut dyn Backend) -> f64 {
     1e-12 * mc2
 }
 
-fn runaway(e0: &Energy, e: &Energy, floor: f64) -> Option<Fault> {
-    let available = e0.kinetic + e0.strain + e.gravity_work_bound;
+fn runaway(e0: &Energy, e: &Energy, supplied: f64, floor: f64) -> Option<Fault> {
+    let available = e0.kinetic + e0.strain + e.gravity_work_bound + supplied;
     let now = e.kinetic + e.strain;
     (now > floor && now > ENERGY_RUNAWAY * available).then(|| Fault {
         particle: None,

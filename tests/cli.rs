@@ -47,6 +47,7 @@ fn dyka_text() -> String {
 #[test]
 fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
     let dyka = common::case("dyka_bar.toml");
+    let mms = common::case("aligned_vibration.toml");
     let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
         (
             "malformed toml",
@@ -143,6 +144,48 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
             ),
             vec![],
             "bodies.dot` is empty",
+        ),
+        (
+            "mls with uGIMP",
+            mms.clone(),
+            vec!["solver.shape=ugimp"],
+            "solver.mls",
+        ),
+        (
+            "mls with LME",
+            mms.clone(),
+            vec!["solver.shape=lme"],
+            "solver.mls",
+        ),
+        (
+            "B-spline on a perturbed grid",
+            mms.clone(),
+            vec!["solver.mls=false", "grid.perturb=0.1"],
+            "grid.perturb",
+        ),
+        (
+            "manufactured amplitude too large",
+            mms.clone(),
+            vec!["manufactured.amplitude=0.2"],
+            "manufactured.amplitude",
+        ),
+        (
+            "manufactured with a linear elastic material",
+            mms.clone(),
+            vec!["materials.rubber.model=linear_elastic"],
+            "neo_hookean",
+        ),
+        (
+            "manufactured with gravity",
+            mms.clone(),
+            vec!["gravity.g=[0, -9.81]"],
+            "gravity",
+        ),
+        (
+            "negative fixed dt",
+            mms.clone(),
+            vec!["solver.dt=-1e-5"],
+            "solver.dt",
         ),
     ];
     for (what, scene, sets, needle) in cases {

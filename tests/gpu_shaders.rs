@@ -55,24 +55,63 @@ fn variants() -> Vec<Variant> {
         },
     ];
     let mut out = Vec::new();
-    for shape in [ShapeKind::Linear, ShapeKind::Ugimp, ShapeKind::Lme] {
+    for shape in [
+        ShapeKind::Linear,
+        ShapeKind::Ugimp,
+        ShapeKind::Lme,
+        ShapeKind::Bspline2,
+        ShapeKind::Bspline3,
+    ] {
         for integrator in integrators {
             for perturbed in [false, true] {
+                if perturbed && matches!(shape, ShapeKind::Bspline2 | ShapeKind::Bspline3) {
+                    continue; // B-splines need a regular grid.
+                }
                 for multi_material in [false, true] {
                     for atomics in [AtomicMode::Float, AtomicMode::CompareExchange] {
                         for lme_stored in [false, true] {
                             if lme_stored && shape != ShapeKind::Lme {
                                 continue;
                             }
-                            out.push(Variant {
-                                shape,
-                                integrator,
-                                perturbed,
-                                multi_material,
-                                atomics,
-                                lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
-                                lme_stored,
-                            });
+                            // Linear elastic, Neo-Hookean, or both (with several materials).
+                            for (linear_elastic, neo_hookean) in
+                                [(true, false), (false, true), (true, true)]
+                            {
+                                if linear_elastic && neo_hookean && !multi_material {
+                                    continue;
+                                }
+                                // MLS (linear and B-splines on regular grids), and the
+                                // manufactured body force (one Neo-Hookean material).
+                                for (mls, mms) in
+                                    [(false, false), (true, false), (false, true), (true, true)]
+                                {
+                                    let mls_ok = !perturbed
+                                        && matches!(
+                                            shape,
+                                            ShapeKind::Linear
+                                                | ShapeKind::Bspline2
+                                                | ShapeKind::Bspline3
+                                        );
+                                    if (mls && !mls_ok)
+                                        || (mms && (linear_elastic || multi_material))
+                                    {
+                                        continue;
+                                    }
+                                    out.push(Variant {
+                                        shape,
+                                        integrator,
+                                        perturbed,
+                                        multi_material,
+                                        atomics,
+                                        lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
+                                        lme_stored,
+                                        linear_elastic,
+                                        neo_hookean,
+                                        mms,
+                                        mls,
+                                    });
+                                }
+                            }
                         }
                     }
                 }
@@ -115,6 +154,10 @@ fn every_pass_validates_in_every_variant() {
                 !has(Buf::Mat) || v.multi_material,
                 "{pass:?} {v:?}: material index with one material"
             );
+            assert!(
+                !(has(Buf::MlsCount) || has(Buf::MlsOrder) || has(Buf::MlsCoef)) || v.mls,
+                "{pass:?} {v:?}: MLS buffers without MLS"
+            );
             checked += 1;
         }
     }
@@ -125,7 +168,13 @@ fn every_pass_validates_in_every_variant() {
 fn pass_uses_shape(pass: Pass) -> bool {
     matches!(
         pass,
-        Pass::LmeNewton | Pass::P2g | Pass::Stress | Pass::Forces | Pass::G2p
+        Pass::LmeNewton
+            | Pass::P2g
+            | Pass::Stress
+            | Pass::Forces
+            | Pass::G2p
+            | Pass::MlsP2g
+            | Pass::MlsForces
     )
 }
 
@@ -161,11 +210,12 @@ fn shared_structs_match_rust_layouts() {
     let module = pipelines::validate(&src, "cfl.wgsl", v.atomics).unwrap();
     let params = rust_fields!(Params; n_particles, n_nodes, nx, ny, h, inv_h, cfl_h, mass_eps, t_end_hi, t_end_lo,
         gravity, ramp_period, npc_gamma, p2g_accel, edge_margin, grid_w, grid_hgt, lme_beta, lme_r2, lme_tol,
-        lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials);
+        lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials, fixed_dt, mms_amp, mms_origin,
+        mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off);
     assert_eq!(wgsl_struct(&module, "Params"), params);
     let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault, lme_iters);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
-    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu);
+    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model);
     assert_eq!(wgsl_struct(&module, "Material"), mat);
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);

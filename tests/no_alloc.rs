@@ -1,6 +1,7 @@
 //! The CPU path allocates nothing per step: buffers are made when the
 //! backend is built (and the scatter scratch on its first use). Counted with
-//! a global allocator over whole steps of every shape and integrator.
+//! a global allocator over whole steps of every shape and integrator, with
+//! and without MLS.
 
 mod common;
 
@@ -40,12 +41,21 @@ fn allocations(threads: usize) -> Vec<(String, usize)> {
         .unwrap();
     pool.install(|| {
         let mut out = Vec::new();
-        for sets in [
-            &["solver.shape=lme"][..],
-            &["solver.shape=linear", "solver.integrator=fe"],
-            &["solver.shape=ugimp"],
+        for (case, sets) in [
+            ("elastic_block.toml", &["solver.shape=lme"][..]),
+            (
+                "elastic_block.toml",
+                &["solver.shape=linear", "solver.integrator=fe"],
+            ),
+            ("elastic_block.toml", &["solver.shape=ugimp"]),
+            // B-spline, Neo-Hookean F, manufactured body force, MLS.
+            ("aligned_vibration.toml", &["grid.h=0.125"]),
+            (
+                "aligned_vibration.toml",
+                &["grid.h=0.125", "solver.mls=false", "solver.shape=bspline3"],
+            ),
         ] {
-            let scene = common::scene("elastic_block.toml", sets);
+            let scene = common::scene(case, sets);
             let mut b = CpuBackend::new(Model::new(&scene).unwrap());
             // Warm-up: the pool's threads start and the scatter scratch is sized.
             for _ in 0..3 {
@@ -56,19 +66,26 @@ fn allocations(threads: usize) -> Vec<(String, usize)> {
                 b.step().unwrap();
             }
             let n = ALLOCATIONS.load(Ordering::SeqCst) - before;
-            out.push((format!("{sets:?}"), n));
+            out.push((format!("{case} {sets:?}"), n));
         }
         out
     })
 }
 
+/// Allocations allowed in `STEPS` steps. Our code makes none; rayon's
+/// work-stealing deques can resize their buffers a few times when the
+/// machine is loaded and jobs queue up differently (we saw 2 to 4 in 500
+/// steps with another simulation running, 0 on an idle machine). A per-step
+/// allocation would show as 500 or more.
+const ALLOWED: usize = 10;
+
 #[test]
 fn steps_do_not_allocate() {
-    // One thread, and two (the private-grid scatter path): none at all.
+    // One thread, and two (the private-grid scatter path).
     for threads in [1, 2] {
         for (what, n) in allocations(threads) {
-            assert_eq!(
-                n, 0,
+            assert!(
+                n <= ALLOWED,
                 "{what}: {n} allocations in {STEPS} steps on {threads} thread(s)"
             );
         }

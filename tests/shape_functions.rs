@@ -309,3 +309,59 @@ fn lme_newton_failure_is_reported_not_nan() {
         ShapeFault::OutsideGrid
     );
 }
+
+#[test]
+fn bsplines_satisfy_the_identities_inside_and_at_the_open_knot_boundary() {
+    // With open knot vectors the basis "positions" that reproduce linear
+    // fields are the Greville abscissae (nodes away from the edge, pulled in
+    // next to it), so reproduction is checked against those.
+    use lme_mpm::shape::bspline::{Bspline, greville};
+    let g = grid(0.0);
+    for degree in [2, 3] {
+        let shape = Shape::Bspline(Bspline { degree });
+        let mut worst = [0.0f64; 4];
+        for x in points(&g, 0.0, 400, 23) {
+            let mut nodes = vec![0u32; shape.max_nodes()];
+            let mut w = vec![[0.0; 3]; shape.max_nodes()];
+            let n = shape
+                .eval(&g, x, &mut [0.0; 2], &mut nodes, &mut w)
+                .unwrap();
+            let (mut s, mut rx, mut gs, mut gm) = (0.0, [0.0; 2], [0.0; 2], [[0.0; 2]; 2]);
+            for k in 0..n {
+                let node = nodes[k] as usize;
+                let xa = [
+                    g.min[0] + g.h * greville(node % g.nx, g.nx, degree),
+                    g.min[1] + g.h * greville(node / g.nx, g.ny, degree),
+                ];
+                assert!(w[k][0] >= -TOL_CLOSED);
+                s += w[k][0];
+                for d in 0..2 {
+                    rx[d] += w[k][0] * xa[d];
+                    gs[d] += w[k][1 + d];
+                    for e in 0..2 {
+                        gm[d][e] += (xa[d] - x[d]) * w[k][1 + e];
+                    }
+                }
+            }
+            let errs = [
+                (s - 1.0).abs(),
+                (rx[0] - x[0]).hypot(rx[1] - x[1]) / g.h,
+                gs[0].hypot(gs[1]) * g.h,
+                (gm[0][0] - 1.0)
+                    .abs()
+                    .max((gm[1][1] - 1.0).abs())
+                    .max(gm[0][1].abs())
+                    .max(gm[1][0].abs()),
+            ];
+            for (w, e) in worst.iter_mut().zip(errs) {
+                *w = w.max(e);
+            }
+        }
+        for (name, w) in ["unity", "reproduction", "gradient sum", "gradient moment"]
+            .iter()
+            .zip(worst)
+        {
+            assert!(w <= TOL_CLOSED, "bspline{degree}: {name} error {w:.3e}");
+        }
+    }
+}

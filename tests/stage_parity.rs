@@ -62,11 +62,46 @@ lme_gamma = 3.0
 t_end = 1.0
 "#;
 
+/// The manufactured aligned vibration on a unit square, 6 cells a side.
+const MMS_SCENE: &str = r#"
+[grid]
+h = 0.16666666666666666
+[materials.m]
+model = "neo_hookean"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.b]
+material = "m"
+ppc = 3
+rects = [[0.0, 0.0, 1.0, 1.0]]
+[constraints.left]
+min = [-inf, -inf]
+max = [0.0, inf]
+fix = "x"
+[constraints.bottom]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "y"
+[manufactured]
+solution = "aligned_vibration"
+amplitude = 0.1
+[solver]
+shape = "bspline2"
+dt = 1e-5
+t_end = 0.2
+"#;
+
 /// A model with random particle state: positions anywhere valid, on cell
-/// edges, near the edge of the grid and on the pinned (interior Dirichlet) nodes.
+/// edges, near the edge of the grid and on the pinned (interior Dirichlet)
+/// nodes; deformation gradients within 0.1 of I where the material has one.
 fn random_model(sets: &[&str], seed: u64) -> Model {
+    random_model_of(SCENE, sets, seed)
+}
+
+fn random_model_of(text: &str, sets: &[&str], seed: u64) -> Model {
     let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-    let scene = Scene::from_str(SCENE, "parity scene", "parity", &o).unwrap();
+    let scene = Scene::from_str(text, "parity scene", "parity", &o).unwrap();
     let mut m = Model::new(&scene).unwrap();
     let g = m.grid.clone();
     // uGIMP on a perturbed grid needs its particle square inside the grid in
@@ -94,7 +129,7 @@ fn random_model(sets: &[&str], seed: u64) -> Model {
             3 => x[0] = lo[0] + margin,
             4 => x[1] = hi[1] - margin,
             // On a pinned node.
-            5 => x = [2.0, 1.0 + 0.5 * (i % 3) as f64],
+            5 if g.contains([2.0, 2.0], margin) => x = [2.0, 1.0 + 0.5 * (i % 3) as f64],
             _ => {}
         }
         p.x[i] = x;
@@ -109,6 +144,10 @@ fn random_model(sets: &[&str], seed: u64) -> Model {
         p.mass[i] *= rng.range(0.5, 1.5);
         if !p.a.is_empty() {
             p.a[i] = [rng.range(-50.0, 50.0), rng.range(-50.0, 50.0)];
+        }
+        if !p.f.is_empty() {
+            let mut d = || rng.range(-0.1, 0.1);
+            p.f[i] = [1.0 + d(), d(), d(), 1.0 + d()];
         }
     }
     m
@@ -160,13 +199,18 @@ fn parity(label: &str, sets: &[&str], force_cas: bool) {
 }
 
 fn parity_with(label: &str, sets: &[&str], force_cas: bool, opts: GpuOptions) {
+    parity_of(label, random_model(sets, 42), force_cas, opts, 0.0);
+}
+
+/// Runs every stage once on both backends from `model`'s state at time `t`.
+fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f64) {
     let Some(ctx) = common::gpu::open(label, force_cas) else {
         return;
     };
     println!("{label} ({:?} atomics)", ctx.atomics);
-    let model = random_model(sets, 42);
     let lme = matches!(model.shape, lme_mpm::shape::Shape::Lme(_));
     let mut cpu = CpuBackend::new(model.clone());
+    cpu.set_time(t);
     let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
     let mut rep = Report { worst: 0.0 };
     for &stage in STEP {
@@ -181,7 +225,7 @@ fn parity_with(label: &str, sets: &[&str], force_cas: bool, opts: GpuOptions) {
         }
         cpu.run_stage(stage)
             .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
-        for pass in Pass::for_stage(stage, lme) {
+        for pass in Pass::for_stage(stage, lme, cpu.model.mls) {
             gpu.run_pass(*pass);
         }
         let sim = gpu.read_sim().unwrap();
@@ -405,4 +449,70 @@ fn stages_match_with_compare_exchange_atomics() {
         &["solver.shape=linear", "solver.integrator=fe"],
         true,
     );
+}
+
+#[test]
+fn stages_match_bspline() {
+    parity(
+        "bspline2 fe",
+        &["solver.shape=bspline2", "solver.integrator=fe"],
+        false,
+    );
+    parity("bspline3 npc", &["solver.shape=bspline3"], false);
+    parity(
+        "bspline2 npc, neo-hookean",
+        &["solver.shape=bspline2", "materials.m.model=neo_hookean"],
+        false,
+    );
+}
+
+#[test]
+fn stages_match_mls() {
+    parity(
+        "bspline2 npc mls",
+        &["solver.shape=bspline2", "solver.mls=true"],
+        false,
+    );
+    parity(
+        "bspline3 fe mls, neo-hookean",
+        &[
+            "solver.shape=bspline3",
+            "solver.mls=true",
+            "solver.integrator=fe",
+            "materials.m.model=neo_hookean",
+        ],
+        false,
+    );
+    parity(
+        "linear npc mls",
+        &["solver.shape=linear", "solver.mls=true"],
+        false,
+    );
+    parity(
+        "bspline2 npc mls, CAS atomics",
+        &["solver.shape=bspline2", "solver.mls=true"],
+        true,
+    );
+}
+
+/// The manufactured body force at t = 0.0137 s (u near its peak), with and
+/// without MLS: `forces` checks it against the CPU's f64 evaluation.
+#[test]
+fn stages_match_manufactured_body_force() {
+    for (label, sets) in [
+        ("mms bspline2 npc", &[][..]),
+        ("mms bspline2 npc mls", &["solver.mls=true"][..]),
+        (
+            "mms linear fe",
+            &["solver.shape=linear", "solver.integrator=fe"][..],
+        ),
+    ] {
+        let mut m = random_model_of(MMS_SCENE, sets, 7);
+        // The source term scales with the displacement: start from stress-free
+        // particles so the forces are the body force's alone.
+        for s in &mut m.particles.stress {
+            *s = [0.0; 3];
+        }
+        parity_of(label, m, false, GpuOptions::default(), 0.0137);
+    }
 }

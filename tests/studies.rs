@@ -188,3 +188,42 @@ fn stability_quick_records_every_failure() {
         assert!(r.completed(), "{} did not complete", r.job.label);
     }
 }
+
+#[test]
+fn mms_quick_every_method_converges_or_reports_why_not() {
+    let (results, md, _) = run(StudyName::Mms);
+    assert!(md.contains("study-mms-u.png") && md.contains("study-mms-front.png"));
+    assert_eq!(
+        results.len(),
+        lme_mpm::study::mms::METHODS.len() * lme_mpm::study::mms::CELLS_QUICK.len()
+    );
+    for (label, _, _, _) in lme_mpm::study::mms::METHODS {
+        let get = |n: &str| {
+            results
+                .iter()
+                .find(|r| {
+                    r.job.tag_value("method") == Some(label) && r.job.tag_value("cells") == Some(n)
+                })
+                .expect("every run is listed")
+        };
+        let (coarse, fine) = (get("8"), get("16"));
+        for r in [coarse, fine] {
+            // Every run either completes or stops with a recorded reason.
+            let d = r
+                .data()
+                .unwrap_or_else(|| panic!("{label}: {:?}", r.outcome));
+            assert!(
+                d.completed() || d.status_text().contains("unstable at"),
+                "{label}"
+            );
+        }
+        // Over one period, refining from 8 to 16 cells lowers the
+        // displacement error of every method that completes both.
+        let e = |r: &JobResult| lme_mpm::study::mms::final_errors(r).map(|e| e.rms_displacement);
+        if let (Some(a), Some(b)) = (e(coarse), e(fine)) {
+            assert!(b < a, "{label}: {a} at 8 cells, {b} at 16");
+        }
+    }
+    // bspline2 + MLS completes both and is in the table.
+    assert!(md.contains("bspline2-mls"));
+}

@@ -5,7 +5,7 @@
 //       if !w.ok { continue; }
 //       ... w.node, w.n, w.dn ...
 //   }
-// Exactly one of shape_linear / shape_ugimp / shape_lme is compiled in.
+// Exactly one of shape_linear / shape_ugimp / shape_lme / shape_bspline is compiled in.
 // Positions are relative to the grid's lower-left node (m).
 
 struct NodeW {
@@ -122,4 +122,6 @@ fn locate(x: vec2<f32>) -> CellPoint {
 #include "shared/shape_ugimp.wgsl"
 #elif SHAPE_LME
 #include "shared/shape_lme.wgsl"
+#elif SHAPE_BSPLINE
+#include "shared/shape_bspline.wgsl"
 #endif

@@ -14,6 +14,8 @@ const FAULT_DENSITY: u32 = 5u;
 const FAULT_LME_FEW_NODES: u32 = 6u;
 const FAULT_LME_NOT_CONVERGED: u32 = 7u;
 const FAULT_LME_SINGULAR: u32 = 8u;
+// MLS moment matrix singular; the index is the Gauss point's, not a particle's.
+const FAULT_MLS_SINGULAR: u32 = 9u;
 
 // Scene constants (uniform), fixed for a run.
 struct Params {
@@ -56,6 +58,23 @@ struct Params {
     n_groups: u32,
     n_probes: u32,
     n_materials: u32,
+    // Fixed Δt (s); 0 = from the CFL condition.
+    fixed_dt: f32,
+    // Manufactured aligned vibration (flag MMS): amplitude A (m), the square's
+    // lower-left corner (m, grid-relative), k = 2π/L (1/m), ω = cπ/L (rad/s),
+    // λ/ρ0 and μ/ρ0 (m²/s²), c² = E/ρ0 (m²/s²).
+    mms_amp: f32,
+    mms_origin: vec2<f32>,
+    mms_k: f32,
+    mms_omega: f32,
+    mms_lame: f32,
+    mms_shear: f32,
+    mms_c2: f32,
+    // MLS (flag MLS): integration cells along x and y; interior breaks sit
+    // at k + mls_break_off (lattice units), the first at 0, the last at n − 1.
+    mls_spans_x: u32,
+    mls_spans_y: u32,
+    mls_break_off: f32,
 }
 
 // Run state on the device (storage, read_write), read back at sample times.
@@ -89,7 +108,8 @@ struct Material {
     p_modulus: f32,
     youngs: f32,
     nu: f32,
-    _pad0: f32,
+    // MODEL_LINEAR_ELASTIC or MODEL_NEO_HOOKEAN (shared/material.wgsl).
+    model: u32,
     _pad1: f32,
     _pad2: f32,
 }

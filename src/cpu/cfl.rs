@@ -6,7 +6,8 @@ use crate::material::Material;
 use crate::model::Model;
 use rayon::prelude::*;
 
-/// Δt of a step starting at `t`, and whether it is the last: a step that
+/// Δt of a step starting at `t` (the CFL condition, or the scene's fixed
+/// `solver.dt`), and whether it is the last: a step that
 /// would reach within 1e-6 of t_end is shortened to land on it exactly
 /// (the same rule as shaders/step_begin.wgsl).
 pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
@@ -18,7 +19,9 @@ pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
         &model.materials,
         &model.body_material,
     );
-    let dt = model.cfl * model.grid.min_spacing() / c;
+    let dt = model
+        .fixed_dt
+        .unwrap_or(model.cfl * model.grid.min_spacing() / c);
     let rem = model.t_end - t;
     if dt >= rem * (1.0 - 1e-6) {
         (rem, true)

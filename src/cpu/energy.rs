@@ -25,7 +25,11 @@ pub fn energy(model: &Model) -> Energy {
             let d = [p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]];
             Energy {
                 kinetic: 0.5 * p.mass[i] * (v[0] * v[0] + v[1] * v[1]),
-                strain: p.volume(i) * model.material_of(i).strain_energy_density(&p.stress[i]),
+                strain: p.volume(i)
+                    * model.material_of(i).strain_energy_density(
+                        &p.stress[i],
+                        p.f.get(i).unwrap_or(&[1.0, 0.0, 0.0, 1.0]),
+                    ),
                 gravity_work_bound: p.mass[i] * g * d[0].hypot(d[1]),
             }
         })

@@ -4,19 +4,21 @@
 
 use super::{ShapeCache, scatter::Scatter};
 
-/// `g` is the body force per unit mass at this step (m/s²).
+/// `body(p)` is particle p's body force per unit mass at this step (m/s²):
+/// gravity, plus a manufactured solution's source term when there is one.
 pub fn forces(
     cache: &ShapeCache,
     stress: &[[f64; 3]],
     mass: &[f64],
     rho: &[f64],
-    g: [f64; 2],
+    body: &(dyn Fn(usize) -> [f64; 2] + Sync),
     force: &mut [[f64; 2]],
     scatter: &mut Scatter<2>,
 ) {
     scatter.run(force, mass.len(), |p, acc| {
         let vol = mass[p] / rho[p];
         let s = stress[p];
+        let g = body(p);
         let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
         let (nodes, w) = cache.particle(p);
         for (&node, wk) in nodes.iter().zip(w) {

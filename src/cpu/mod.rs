@@ -8,6 +8,7 @@ pub mod energy;
 pub mod forces;
 pub mod g2p;
 pub mod grid_update;
+pub mod mls;
 pub mod p2g;
 pub mod scatter;
 pub mod shape_eval;
@@ -61,6 +62,8 @@ pub struct CpuBackend {
     pub reactions: Vec<[f64; 2]>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
+    /// Gauss points and fits when the scene asks for MLS reconstruction.
+    pub mls: Option<mls::Mls>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -87,6 +90,10 @@ impl CpuBackend {
             reactions: vec![[0.0; 2]; model.constraints.groups.len()],
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
+            mls: model.mls.then(|| {
+                mls::Mls::new(&model.shape, &model.grid, n)
+                    .expect("shape functions are defined at Gauss points inside a regular grid")
+            }),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -109,6 +116,15 @@ impl CpuBackend {
         if !p.lambda.is_empty() {
             per += 16.0;
         }
+        if !p.f.is_empty() {
+            per += 32.0;
+        }
+        if model.mls {
+            // Sort order and cells per particle, the Gauss points' share.
+            let slots = model.shape.max_nodes() as f64;
+            let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 11.0;
+            per += 12.0 + mls::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
+        }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
         // Nodes: [m, qx, qy] and [fx, fy] in f64.
@@ -123,6 +139,12 @@ impl CpuBackend {
     /// Time step of the step in progress, or of the last one (s).
     pub fn dt(&self) -> f64 {
         self.dt
+    }
+
+    /// Sets the time reached (s), e.g. to check time-dependent loads at a
+    /// chosen instant.
+    pub fn set_time(&mut self, t: f64) {
+        self.t = t;
     }
 
     /// One step: the stages of `solver::STEP` in order. The time advances
@@ -156,6 +178,9 @@ impl CpuBackend {
             }
             Stage::P2g => {
                 let a_factor = if npc { (1.0 - gamma) * self.dt } else { 0.0 };
+                if let Some(mls) = &mut self.mls {
+                    return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
+                }
                 p2g::p2g(
                     &self.cache,
                     &p.mass,
@@ -178,15 +203,30 @@ impl CpuBackend {
                 &m.body_material,
                 &mut p.stress,
                 &mut p.rho,
+                &mut p.f,
             )?,
             Stage::Forces => {
-                let g = m.gravity.map_or([0.0; 2], |g| g.at(self.t));
+                // The stress is already at the step's end (t + Δt), so are the loads.
+                let t = self.t + self.dt;
+                let g = m.gravity.map_or([0.0; 2], |g| g.at(t));
+                let (mms, x0) = (&m.manufactured, &p.x0);
+                let body = move |i: usize| match mms {
+                    None => g,
+                    Some(s) => {
+                        let b = s.body_force(x0[i], t);
+                        [g[0] + b[0], g[1] + b[1]]
+                    }
+                };
+                if let Some(mls) = &mut self.mls {
+                    mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+                    return Ok(());
+                }
                 forces::forces(
                     &self.cache,
                     &p.stress,
                     &p.mass,
                     &p.rho,
-                    g,
+                    &body,
                     &mut self.force,
                     &mut self.force_scatter,
                 );

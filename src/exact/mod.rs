@@ -3,6 +3,7 @@
 
 pub mod column;
 pub mod dyka;
+pub mod mms;
 
 use crate::model::{Model, Particles};
 use crate::scene::{ExactKind, Scene};
@@ -14,6 +15,7 @@ use serde::Serialize;
 pub enum Errors {
     Dyka(dyka::DykaErrors),
     Column(column::ColumnErrors),
+    Mms(mms::MmsErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact solution.
@@ -29,5 +31,10 @@ pub fn score(
         ExactKind::ElasticColumn => {
             Errors::Column(column::ElasticColumn::from_scene(scene, model).score(particles, t))
         }
+        ExactKind::AlignedVibration => Errors::Mms(
+            mms::AlignedVibration::from_scene(scene)
+                .expect("validated: a manufactured scene")
+                .score(particles, t),
+        ),
     }
 }

@@ -6,7 +6,10 @@
 
 use super::GpuOptions;
 use super::context::GpuContext;
-use super::layout::{GpuConstraint, GpuMaterial, NODE_STRIDE, PROBE_STRIDE, Params, Sim};
+use super::layout::{
+    GpuConstraint, GpuMaterial, MODEL_LINEAR_ELASTIC, MODEL_NEO_HOOKEAN, NODE_STRIDE, PROBE_STRIDE,
+    Params, Sim,
+};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::model::{FIX_X, FIX_Y, Integrator, Model};
@@ -33,16 +36,23 @@ pub enum Buf {
     LmeCache,
     LmeNodes,
     LmeW,
+    DefGrad,
     NodeAcc,
     NodePos,
     Reactions,
     ProbeIdx,
     ProbeOut,
     EnergyOut,
+    MlsCount,
+    MlsStart,
+    MlsOrder,
+    MlsCell,
+    MlsOcc,
+    MlsCoef,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 23] = [
+    pub const ALL: [Buf; 30] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -60,12 +70,19 @@ impl Buf {
         Buf::LmeCache,
         Buf::LmeNodes,
         Buf::LmeW,
+        Buf::DefGrad,
         Buf::NodeAcc,
         Buf::NodePos,
         Buf::Reactions,
         Buf::ProbeIdx,
         Buf::ProbeOut,
         Buf::EnergyOut,
+        Buf::MlsCount,
+        Buf::MlsStart,
+        Buf::MlsOrder,
+        Buf::MlsCell,
+        Buf::MlsOcc,
+        Buf::MlsCoef,
     ];
 
     pub fn binding(self) -> u32 {
@@ -97,6 +114,9 @@ pub struct Buffers {
     pub n_nodes: usize,
     pub n_probes: usize,
     pub n_groups: usize,
+    /// MLS: grid cells and Gauss points (0 without MLS).
+    pub n_cells: usize,
+    pub n_gauss: usize,
 }
 
 fn f32x2(v: [f64; 2]) -> [f32; 2] {
@@ -136,15 +156,21 @@ impl Buffers {
         let mats: Vec<GpuMaterial> = model
             .materials
             .iter()
-            .map(|m| match m {
-                Material::LinearElastic(e) => GpuMaterial {
-                    lame: e.lame as f32,
-                    shear: e.shear as f32,
-                    p_modulus: e.p_modulus as f32,
-                    youngs: e.youngs as f32,
-                    nu: e.nu as f32,
-                    _pad: [0.0; 3],
-                },
+            .map(|m| {
+                let (lame, shear) = m.lame_shear();
+                let (youngs, nu, model) = match m {
+                    Material::LinearElastic(e) => (e.youngs, e.nu, MODEL_LINEAR_ELASTIC),
+                    Material::NeoHookean(e) => (e.youngs, e.nu, MODEL_NEO_HOOKEAN),
+                };
+                GpuMaterial {
+                    lame: lame as f32,
+                    shear: shear as f32,
+                    p_modulus: (lame + 2.0 * shear) as f32,
+                    youngs: youngs as f32,
+                    nu: nu as f32,
+                    model,
+                    _pad: [0.0; 2],
+                }
             })
             .collect();
         data.push((Buf::Materials, bytemuck::cast_slice(&mats).to_vec()));
@@ -187,6 +213,10 @@ impl Buffers {
                 data.push((Buf::LmeCache, vec![0u8; 16 * n]));
             }
         }
+        if !p.f.is_empty() {
+            let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
+            data.push((Buf::DefGrad, bytes(&f)));
+        }
         data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * g.n_nodes()]));
         if g.is_perturbed() {
             data.push((
@@ -208,6 +238,16 @@ impl Buffers {
             vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
         ));
         data.push((Buf::EnergyOut, vec![0u8; 16]));
+        if model.mls {
+            let cells = (g.nx - 1) * (g.ny - 1);
+            let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
+            data.push((Buf::MlsCount, vec![0u8; 4 * cells]));
+            data.push((Buf::MlsStart, vec![0u8; 4 * (cells + 1)]));
+            data.push((Buf::MlsOrder, vec![0u8; 4 * n]));
+            data.push((Buf::MlsCell, vec![0u8; 4 * n]));
+            data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
+            data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
+        }
 
         let limit = ctx.limits.max_storage_buffer_binding_size;
         let max_buf = ctx.limits.max_buffer_size;
@@ -244,6 +284,16 @@ impl Buffers {
             n_nodes: g.n_nodes(),
             n_probes: model.probes.len(),
             n_groups: groups,
+            n_cells: if model.mls {
+                (g.nx - 1) * (g.ny - 1)
+            } else {
+                0
+            },
+            n_gauss: if model.mls {
+                4 * (params.mls_spans_x * params.mls_spans_y) as usize
+            } else {
+                0
+            },
         })
     }
 }

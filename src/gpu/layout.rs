@@ -35,8 +35,19 @@ pub struct Params {
     pub n_groups: u32,
     pub n_probes: u32,
     pub n_materials: u32,
+    pub fixed_dt: f32,
+    pub mms_amp: f32,
+    pub mms_origin: [f32; 2],
+    pub mms_k: f32,
+    pub mms_omega: f32,
+    pub mms_lame: f32,
+    pub mms_shear: f32,
+    pub mms_c2: f32,
+    pub mls_spans_x: u32,
+    pub mls_spans_y: u32,
+    pub mls_break_off: f32,
 }
-const _: () = assert!(std::mem::size_of::<Params>() == 112);
+const _: () = assert!(std::mem::size_of::<Params>() == 160);
 
 /// Run state on the device. Atomic fields of the WGSL struct are plain u32 here.
 #[repr(C)]
@@ -65,8 +76,14 @@ pub struct GpuMaterial {
     pub p_modulus: f32,
     pub youngs: f32,
     pub nu: f32,
-    pub _pad: [f32; 3],
+    /// `MODEL_LINEAR_ELASTIC` or `MODEL_NEO_HOOKEAN`.
+    pub model: u32,
+    pub _pad: [f32; 2],
 }
+
+/// Material model codes (shared/material.wgsl).
+pub const MODEL_LINEAR_ELASTIC: u32 = 0;
+pub const MODEL_NEO_HOOKEAN: u32 = 1;
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 32);
 
 #[repr(C)]
@@ -98,6 +115,8 @@ pub const FAULT_DENSITY: u32 = 5;
 pub const FAULT_LME_FEW_NODES: u32 = 6;
 pub const FAULT_LME_NOT_CONVERGED: u32 = 7;
 pub const FAULT_LME_SINGULAR: u32 = 8;
+/// The index field holds the Gauss point, not a particle.
+pub const FAULT_MLS_SINGULAR: u32 = 9;
 
 /// Splits an f64 into a two-float sum hi + lo (for times in f32).
 pub fn split_f64(v: f64) -> (f32, f32) {

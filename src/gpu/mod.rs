@@ -57,6 +57,9 @@ pub struct GpuBackend {
     fresh: bool,
     /// First Δt, computed on the host, to size the first batch (s).
     dt_hint: f64,
+    /// The last stop time `advance` reached (s): the device's two-float time
+    /// can sit one f32 rounding below it.
+    t_floor: f64,
 }
 
 impl GpuBackend {
@@ -79,6 +82,7 @@ impl GpuBackend {
             sim: buffers::initial_sim(),
             fresh: true,
             dt_hint,
+            t_floor: 0.0,
         };
         b.sim = b.read_sim()?;
         Ok(b)
@@ -218,6 +222,10 @@ impl GpuBackend {
                 bytemuck::cast_slice(&f2(&p.lambda)),
             );
         }
+        if !p.f.is_empty() {
+            let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
+            q.write_buffer(self.buffers.get(Buf::DefGrad), 0, bytemuck::cast_slice(&f));
+        }
         let rho: Vec<f32> = p.rho.iter().map(|r| *r as f32).collect();
         q.write_buffer(self.buffers.get(Buf::Rho), 0, bytemuck::cast_slice(&rho));
         let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
@@ -253,12 +261,24 @@ impl GpuBackend {
             ..buffers::initial_sim()
         };
         self.write_sim(&sim);
+        self.t_floor = 0.0;
         self.model.particles = p.clone();
         self.fresh = false;
     }
 
     fn fault_of(&self, word: u32) -> Fault {
         let particle = (word >> 4) as usize;
+        if word & 0xf == FAULT_MLS_SINGULAR {
+            let at = crate::cpu::mls::gauss_point_position(
+                &self.model.shape,
+                &self.model.grid,
+                particle,
+            );
+            return Fault {
+                particle: None,
+                kind: FaultKind::MlsSingular { at },
+            };
+        }
         let kind = match word & 0xf {
             FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
             FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
@@ -272,7 +292,14 @@ impl GpuBackend {
                 iterations: self.params.lme_max_iter,
                 residual: None,
             }),
-            _ => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+            FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+            code => FaultKind::NonFinite {
+                field: if code == 0 {
+                    "unknown (fault code 0)"
+                } else {
+                    "unknown fault code"
+                },
+            },
         };
         Fault::at(particle, kind)
     }
@@ -283,7 +310,7 @@ impl GpuBackend {
     }
 
     fn t(&self) -> f64 {
-        self.sim.t as f64 + self.sim.t_lo as f64
+        (self.sim.t as f64 + self.sim.t_lo as f64).max(self.t_floor)
     }
 
     /// Most LME Newton iterations any particle has taken in one step.
@@ -313,6 +340,15 @@ pub fn params(model: &Model) -> Params {
         crate::scene::Ramp::None => 0.0,
         crate::scene::Ramp::Sine => g.period as f32,
     });
+    let mms = model.manufactured.as_ref();
+    let mls_spans = [
+        crate::cpu::mls::breaks(&model.shape, g.nx).len() as u32 - 1,
+        crate::cpu::mls::breaks(&model.shape, g.ny).len() as u32 - 1,
+    ];
+    let mls_break_off = match &model.shape {
+        Shape::Bspline(b) => 0.5 * (b.degree as f32 - 1.0),
+        _ => 0.0,
+    };
     let (mut lme_beta, mut lme_r2, mut lme_tol, mut lme_reach) = (0.0, 0.0, 0.0, 0.0);
     if let Shape::Lme(l) = &model.shape {
         lme_beta = l.beta as f32;
@@ -351,6 +387,22 @@ pub fn params(model: &Model) -> Params {
         n_groups: model.constraints.groups.len() as u32,
         n_probes: model.probes.len() as u32,
         n_materials: model.materials.len() as u32,
+        fixed_dt: model.fixed_dt.map_or(0.0, |dt| dt as f32),
+        mms_amp: mms.map_or(0.0, |m| m.amplitude as f32),
+        mms_origin: mms.map_or([0.0; 2], |m| {
+            [
+                (m.origin[0] - g.min[0]) as f32,
+                (m.origin[1] - g.min[1]) as f32,
+            ]
+        }),
+        mms_k: mms.map_or(0.0, |m| (2.0 * std::f64::consts::PI / m.length) as f32),
+        mms_omega: mms.map_or(0.0, |m| (m.c * std::f64::consts::PI / m.length) as f32),
+        mms_lame: mms.map_or(0.0, |m| (m.material.lame / m.material.density) as f32),
+        mms_shear: mms.map_or(0.0, |m| (m.material.shear / m.material.density) as f32),
+        mms_c2: mms.map_or(0.0, |m| (m.c * m.c) as f32),
+        mls_spans_x: mls_spans[0],
+        mls_spans_y: mls_spans[1],
+        mls_break_off,
     }
 }
 
@@ -373,8 +425,10 @@ impl Backend for GpuBackend {
 
     fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt> {
         let t_end = self.model.t_end;
-        let target = t_stop.min(t_end);
-        let (hi, lo) = split_f64(target);
+        let (hi, lo) = split_f64(t_stop.min(t_end));
+        // The device compares with the two-float target, which can sit an
+        // f32 rounding of `lo` below the f64 one.
+        let target = hi as f64 + lo as f64;
         self.ctx.queue.write_buffer(
             self.buffers.get(Buf::Sim),
             12,
@@ -383,6 +437,8 @@ impl Backend for GpuBackend {
         loop {
             let t = self.t();
             if t >= target {
+                // Reached as the device counts: report the stop time itself.
+                self.t_floor = self.t_floor.max(t_stop.min(t_end));
                 return Ok(());
             }
             let dt = if self.sim.dt > 0.0 {
@@ -480,6 +536,10 @@ impl Backend for GpuBackend {
             if lme {
                 want.push(Buf::Lambda);
             }
+            let def_grad = !self.model.particles.f.is_empty();
+            if def_grad {
+                want.push(Buf::DefGrad);
+            }
             let b = self.read(&want)?;
             let f = |k: usize| -> &[f32] { bytemuck::cast_slice(&b[k]) };
             let p = &mut self.model.particles;
@@ -507,6 +567,18 @@ impl Backend for GpuBackend {
                 let l = f(k);
                 for i in 0..n {
                     p.lambda[i] = [l[2 * i] as f64, l[2 * i + 1] as f64];
+                }
+                k += 1;
+            }
+            if def_grad {
+                let g = f(k);
+                for i in 0..n {
+                    p.f[i] = [
+                        g[4 * i] as f64,
+                        g[4 * i + 1] as f64,
+                        g[4 * i + 2] as f64,
+                        g[4 * i + 3] as f64,
+                    ];
                 }
             }
             self.fresh = true;

@@ -21,9 +21,15 @@ pub enum Pass {
     ClearGrid,
     LmeNewton,
     P2g,
+    MlsClear,
+    MlsBin,
+    MlsScan,
+    MlsFill,
+    MlsP2g,
     GridPredict,
     Stress,
     Forces,
+    MlsForces,
     GridCorrect,
     G2p,
     StepEnd,
@@ -39,18 +45,28 @@ enum Domain {
     Nodes,
     One,
     Probes,
+    /// Grid cells or integration cells, whichever are more (MLS).
+    Cells,
+    /// Gauss points (MLS).
+    GaussPoints,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 13] = [
+    pub const ALL: [Pass; 19] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
         Pass::LmeNewton,
         Pass::P2g,
+        Pass::MlsClear,
+        Pass::MlsBin,
+        Pass::MlsScan,
+        Pass::MlsFill,
+        Pass::MlsP2g,
         Pass::GridPredict,
         Pass::Stress,
         Pass::Forces,
+        Pass::MlsForces,
         Pass::GridCorrect,
         Pass::G2p,
         Pass::StepEnd,
@@ -73,12 +89,20 @@ impl Pass {
             Pass::StepEnd => "step_end.wgsl",
             Pass::Probes => "probes.wgsl",
             Pass::Energy => "energy.wgsl",
+            Pass::MlsClear => "mls_clear.wgsl",
+            Pass::MlsBin => "mls_bin.wgsl",
+            Pass::MlsScan => "mls_scan.wgsl",
+            Pass::MlsFill => "mls_fill.wgsl",
+            Pass::MlsP2g => "mls_p2g.wgsl",
+            Pass::MlsForces => "mls_forces.wgsl",
         }
     }
 
     fn domain(self) -> Domain {
         match self {
-            Pass::StepBegin | Pass::StepEnd => Domain::One,
+            Pass::StepBegin | Pass::StepEnd | Pass::MlsScan => Domain::One,
+            Pass::MlsClear => Domain::Cells,
+            Pass::MlsP2g | Pass::MlsForces => Domain::GaussPoints,
             Pass::ClearGrid | Pass::GridPredict | Pass::GridCorrect => Domain::Nodes,
             Pass::Probes => Domain::Probes,
             _ => Domain::Particles,
@@ -88,13 +112,22 @@ impl Pass {
     /// The GPU passes that do a solver stage. `Cfl` is the reduction plus
     /// the one-invocation Δt/stop pass; shape evaluation is a pass of its
     /// own only for LME (the others are evaluated inline where used).
-    pub fn for_stage(stage: Stage, lme: bool) -> &'static [Pass] {
+    /// With MLS, `p2g` and `forces` work at Gauss points.
+    pub fn for_stage(stage: Stage, lme: bool, mls: bool) -> &'static [Pass] {
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
             Stage::ShapeEval if lme => &[Pass::LmeNewton],
             Stage::ShapeEval => &[],
+            Stage::P2g if mls => &[
+                Pass::MlsClear,
+                Pass::MlsBin,
+                Pass::MlsScan,
+                Pass::MlsFill,
+                Pass::MlsP2g,
+            ],
             Stage::P2g => &[Pass::P2g],
+            Stage::Forces if mls => &[Pass::MlsForces],
             Stage::GridPredict => &[Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
@@ -116,11 +149,27 @@ pub struct Variant {
     pub lme_side: u32,
     /// LME weights stored per slot (`GpuOptions::lme_stored`).
     pub lme_stored: bool,
+    /// Material models compiled in.
+    pub linear_elastic: bool,
+    pub neo_hookean: bool,
+    /// A manufactured solution's body force is applied.
+    pub mms: bool,
+    /// MLS reconstruction at Gauss points.
+    pub mls: bool,
 }
 
 impl Variant {
     pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
+        use crate::material::Material;
         Variant {
+            linear_elastic: model
+                .materials
+                .iter()
+                .any(|m| matches!(m, Material::LinearElastic(_))),
+            neo_hookean: model
+                .materials
+                .iter()
+                .any(|m| matches!(m, Material::NeoHookean(_))),
             lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
             shape: model.shape.kind(),
             integrator: model.integrator,
@@ -128,6 +177,8 @@ impl Variant {
             multi_material: model.materials.len() > 1,
             atomics,
             lme_side: lme_side(model),
+            mms: model.manufactured.is_some(),
+            mls: model.mls,
         }
     }
 
@@ -141,10 +192,19 @@ impl Variant {
         d.flag("SHAPE_LINEAR", self.shape == ShapeKind::Linear)
             .flag("SHAPE_UGIMP", self.shape == ShapeKind::Ugimp)
             .flag("SHAPE_LME", self.shape == ShapeKind::Lme)
+            .flag(
+                "SHAPE_BSPLINE",
+                matches!(self.shape, ShapeKind::Bspline2 | ShapeKind::Bspline3),
+            )
             .flag("PERTURBED", self.perturbed)
             .flag("MULTI_MATERIAL", self.multi_material)
             .flag("FLOAT_ATOMICS", self.atomics == AtomicMode::Float)
-            .flag("LME_STORED", self.lme_stored);
+            .flag("LME_STORED", self.lme_stored)
+            .flag("MAT_LINEAR_ELASTIC", self.linear_elastic)
+            .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
+            .flag("DEF_GRAD", self.neo_hookean)
+            .flag("MMS", self.mms)
+            .flag("MLS", self.mls);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
@@ -158,12 +218,30 @@ impl Variant {
             },
         );
         d.value("LME_SIDE", self.lme_side);
+        d.value(
+            "BSPLINE_DEGREE",
+            match self.shape {
+                ShapeKind::Bspline2 => 2,
+                ShapeKind::Bspline3 => 3,
+                _ => 1,
+            },
+        );
         d
     }
 
     /// Whether the scene needs this pass.
     pub fn uses(&self, pass: Pass) -> bool {
-        pass != Pass::LmeNewton || self.shape == crate::scene::ShapeKind::Lme
+        match pass {
+            Pass::LmeNewton => self.shape == crate::scene::ShapeKind::Lme,
+            Pass::MlsClear
+            | Pass::MlsBin
+            | Pass::MlsScan
+            | Pass::MlsFill
+            | Pass::MlsP2g
+            | Pass::MlsForces => self.mls,
+            Pass::P2g | Pass::Forces => !self.mls,
+            _ => true,
+        }
     }
 }
 
@@ -253,8 +331,11 @@ pub struct Pipelines {
     n_particles: u32,
     n_nodes_or_groups: u32,
     n_probes: u32,
+    n_cells: u32,
+    n_gauss: u32,
     max_groups: u32,
     pub lme: bool,
+    pub mls: bool,
 }
 
 impl Pipelines {
@@ -358,8 +439,11 @@ impl Pipelines {
             n_particles: buffers.n_particles as u32,
             n_nodes_or_groups: buffers.n_nodes.max(2 * buffers.n_groups) as u32,
             n_probes: buffers.n_probes as u32,
+            n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
+            n_gauss: buffers.n_gauss as u32,
             max_groups: ctx.limits.max_compute_workgroups_per_dimension,
             lme,
+            mls: model.mls,
         })
     }
 
@@ -373,6 +457,8 @@ impl Pipelines {
             Domain::Probes => (self.n_probes.div_ceil(64).max(1), 1),
             Domain::Particles => grid_2d(self.n_particles, self.max_groups),
             Domain::Nodes => grid_2d(self.n_nodes_or_groups, self.max_groups),
+            Domain::Cells => grid_2d(self.n_cells, self.max_groups),
+            Domain::GaussPoints => grid_2d(self.n_gauss, self.max_groups),
         };
         cpass.set_pipeline(&b.pipeline);
         cpass.set_bind_group(0, &b.bind_group, &[]);
@@ -382,7 +468,7 @@ impl Pipelines {
     /// Records the passes of one whole step, in `solver::STEP` order.
     pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
         for stage in crate::solver::STEP {
-            for pass in Pass::for_stage(*stage, self.lme) {
+            for pass in Pass::for_stage(*stage, self.lme, self.mls) {
                 self.dispatch(cpass, *pass);
             }
         }

@@ -54,8 +54,40 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/shape_lme.wgsl"),
     ),
     (
+        "shared/shape_bspline.wgsl",
+        include_str!("../../shaders/shared/shape_bspline.wgsl"),
+    ),
+    (
+        "shared/material.wgsl",
+        include_str!("../../shaders/shared/material.wgsl"),
+    ),
+    (
+        "shared/body_force.wgsl",
+        include_str!("../../shaders/shared/body_force.wgsl"),
+    ),
+    (
+        "shared/mls.wgsl",
+        include_str!("../../shaders/shared/mls.wgsl"),
+    ),
+    (
+        "mls_clear.wgsl",
+        include_str!("../../shaders/mls_clear.wgsl"),
+    ),
+    ("mls_bin.wgsl", include_str!("../../shaders/mls_bin.wgsl")),
+    ("mls_scan.wgsl", include_str!("../../shaders/mls_scan.wgsl")),
+    ("mls_fill.wgsl", include_str!("../../shaders/mls_fill.wgsl")),
+    ("mls_p2g.wgsl", include_str!("../../shaders/mls_p2g.wgsl")),
+    (
+        "mls_forces.wgsl",
+        include_str!("../../shaders/mls_forces.wgsl"),
+    ),
+    (
         "shared/material_linear_elastic.wgsl",
         include_str!("../../shaders/shared/material_linear_elastic.wgsl"),
+    ),
+    (
+        "shared/material_neo_hookean.wgsl",
+        include_str!("../../shaders/shared/material_neo_hookean.wgsl"),
     ),
     (
         "step_begin.wgsl",

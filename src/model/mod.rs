@@ -104,7 +104,14 @@ pub struct Model {
     pub cfl: f64,
     /// End time (s).
     pub t_end: f64,
+    /// Fixed time step (s) in place of the CFL condition.
+    pub fixed_dt: Option<f64>,
+    /// MLS reconstruction at Gauss points (`solver.mls`).
+    pub mls: bool,
     pub probes: Vec<Probe>,
+    /// A manufactured solution's body force, applied to every particle at
+    /// its reference position each step.
+    pub manufactured: Option<crate::exact::mms::AlignedVibration>,
 }
 
 impl Model {
@@ -165,6 +172,18 @@ impl Model {
         let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
         let nx = ((hi[0] - lo[0]) / h).round() as usize + 1;
         let ny = ((hi[1] - lo[1]) / h).round() as usize + 1;
+        if let Shape::Bspline(b) = &shape {
+            if nx < b.degree + 2 || ny < b.degree + 2 {
+                return Err(SceneError::invalid(
+                    "grid.h",
+                    format!(
+                        "gives {nx} x {ny} nodes; degree-{} B-splines need at least {} per direction",
+                        b.degree,
+                        b.degree + 2
+                    ),
+                ));
+            }
+        }
         if nx < 2 || ny < 2 {
             return Err(SceneError::invalid(
                 "grid.max",
@@ -222,6 +241,7 @@ impl Model {
             |b| velocities[b as usize],
             matches!(integrator, Integrator::Npc { .. }),
             matches!(shape, Shape::Lme(_)),
+            materials.iter().any(Material::needs_deformation_gradient),
         );
 
         let constraints = build_constraints(scene, &grid)?;
@@ -230,6 +250,14 @@ impl Model {
             ramp: g.ramp,
             period: g.ramp_period.unwrap_or(0.0),
         });
+        // A manufactured solution sets each particle's initial velocity.
+        let manufactured = crate::exact::mms::AlignedVibration::from_scene(scene);
+        let mut particles = particles;
+        if let Some(m) = &manufactured {
+            for i in 0..particles.len() {
+                particles.v[i] = m.velocity(particles.x0[i], 0.0);
+            }
+        }
         let probes = f
             .output
             .probes
@@ -253,7 +281,10 @@ impl Model {
             integrator,
             cfl: f.solver.cfl,
             t_end: f.solver.t_end,
+            fixed_dt: f.solver.dt,
+            mls: f.solver.mls,
             probes,
+            manufactured,
         })
     }
 

@@ -19,6 +19,8 @@ pub struct Particles {
     pub stress: Vec<[f64; 3]>,
     /// LME Lagrange multiplier λ (1/m); LME only, else empty.
     pub lambda: Vec<[f64; 2]>,
+    /// Deformation gradient [xx, xy, yx, yy]; only when a material needs it, else empty.
+    pub f: Vec<[f64; 4]>,
     /// Body index (scene order).
     pub body: Vec<u32>,
     /// Initial position (m).
@@ -34,6 +36,7 @@ impl Particles {
         velocity: impl Fn(u32) -> [f64; 2],
         with_acceleration: bool,
         with_lambda: bool,
+        with_f: bool,
     ) -> Self {
         let n = seeds.len();
         let rho: Vec<f64> = seeds.iter().map(|s| density(s.body)).collect();
@@ -50,6 +53,11 @@ impl Particles {
             stress: vec![[0.0; 3]; n],
             lambda: if with_lambda {
                 vec![[0.0; 2]; n]
+            } else {
+                Vec::new()
+            },
+            f: if with_f {
+                vec![[1.0, 0.0, 0.0, 1.0]; n]
             } else {
                 Vec::new()
             },

@@ -13,7 +13,7 @@ pub struct Summary {
     pub status: &'static str,
     /// Why the run stopped early (unstable only).
     pub reason: Option<String>,
-    /// Machine-friendly reason: left_grid, lme_newton, non_finite, non_positive_density, energy_runaway.
+    /// Machine-friendly reason: left_grid, lme_newton, non_finite, non_positive_density, energy_runaway, mls_singular.
     pub reason_code: Option<&'static str>,
     /// Particle that showed the fault first, if one did.
     pub unstable_particle: Option<usize>,
@@ -34,10 +34,14 @@ pub struct Summary {
     pub bytes_per_particle: f64,
     pub shape: ShapeKind,
     pub lme_gamma: Option<f64>,
+    /// MLS reconstruction at Gauss points.
+    pub mls: bool,
     pub integrator: IntegratorKind,
     pub npc_gamma: Option<f64>,
     pub npc_position: Option<NpcPosition>,
     pub cfl: f64,
+    /// Fixed time step (s); null when Δt comes from the CFL condition.
+    pub dt: Option<f64>,
     /// Grid spacing (m).
     pub h: f64,
     pub perturb: f64,

@@ -16,6 +16,9 @@ pub struct SceneFile {
     pub description: String,
     /// Exact solution the run is scored against, if any.
     pub exact: Option<ExactKind>,
+    /// A manufactured solution driving the scene (body force, initial velocity)
+    /// and scoring it; sets `exact` to the solution's kind.
+    pub manufactured: Option<ManufacturedSpec>,
     pub grid: GridSpec,
     /// Materials by name.
     pub materials: BTreeMap<String, MaterialSpec>,
@@ -63,6 +66,8 @@ fn default_seed() -> u64 {
 pub enum MaterialModel {
     /// Small-strain increments, plane strain, Hooke's law.
     LinearElastic,
+    /// Compressible Neo-Hookean on the deformation gradient (finite strain).
+    NeoHookean,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -173,6 +178,10 @@ pub enum ShapeKind {
     Ugimp,
     /// Local max-ent (Arroyo & Ortiz), β = γ/h².
     Lme,
+    /// Quadratic B-splines (open knot vectors at the grid's edge).
+    Bspline2,
+    /// Cubic B-splines (open knot vectors at the grid's edge).
+    Bspline3,
 }
 
 /// Time integrators.
@@ -224,6 +233,14 @@ pub struct SolverSpec {
     pub cfl: f64,
     /// End time (s). Required.
     pub t_end: f64,
+    /// Fixed time step (s), in place of the CFL condition (the manufactured
+    /// solution study uses the paper's 1e-5 s). Default: none, Δt from `cfl`.
+    pub dt: Option<f64>,
+    /// Moving-least-squares reconstruction (B-spline paper): mass, momentum,
+    /// body force and stress reconstructed at 2 × 2 Gauss points per cell and
+    /// integrated there. With `bspline2`, `bspline3`, `linear` or `lme`. Default false.
+    #[serde(default)]
+    pub mls: bool,
 }
 
 fn default_shape() -> ShapeKind {
@@ -291,4 +308,23 @@ pub enum ExactKind {
     DykaBar,
     /// Elastic column on a fixed base under (ramped) gravity (Andersen's block).
     ElasticColumn,
+    /// The manufactured 2D aligned vibration (set by `[manufactured]`).
+    AlignedVibration,
+}
+
+/// Manufactured solutions known to the code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ManufacturedKind {
+    /// B-spline paper eq. 38: u = A [sin(2πX/L) sin(cπt/L), sin(2πY/L) sin(cπt/L + π)],
+    /// c = sqrt(E/ρ0), on a square of side L, Neo-Hookean.
+    AlignedVibration,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ManufacturedSpec {
+    pub solution: ManufacturedKind,
+    /// Displacement amplitude A (m), below L/(2π) so that det F stays positive.
+    pub amplitude: f64,
 }

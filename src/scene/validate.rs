@@ -35,7 +35,7 @@ fn finite_point(key: &str, p: &[f64]) -> Result<(), SceneError> {
     Ok(())
 }
 
-pub(super) fn check(file: SceneFile, default_name: &str) -> Result<Scene, SceneError> {
+pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, SceneError> {
     let name = file
         .name
         .clone()
@@ -123,6 +123,12 @@ pub(super) fn check(file: SceneFile, default_name: &str) -> Result<Scene, SceneE
         ));
     }
 
+    if matches!(s.shape, ShapeKind::Bspline2 | ShapeKind::Bspline3) && g.perturb != 0.0 {
+        return Err(SceneError::invalid(
+            "grid.perturb",
+            "must be 0 with B-spline shapes: their knot vectors need a regular grid",
+        ));
+    }
     if s.shape == ShapeKind::Lme {
         finite("solver.lme_gamma", s.lme_gamma)?;
         let (gmin, gmax) = (
@@ -300,6 +306,46 @@ pub(super) fn check(file: SceneFile, default_name: &str) -> Result<Scene, SceneE
         finite_point(&format!("output.probes.{pname}"), p)?;
     }
 
+    // --- manufactured solution ---------------------------------------------
+    if let Some(m) = &file.manufactured {
+        check_manufactured(&file, m)?;
+        match file.exact {
+            None | Some(ExactKind::AlignedVibration) => {
+                file.exact = Some(ExactKind::AlignedVibration)
+            }
+            Some(other) => {
+                return Err(SceneError::invalid(
+                    "exact",
+                    format!(
+                        "is {other:?} but [manufactured] scores the run against its own solution: drop `exact`"
+                    ),
+                ));
+            }
+        }
+    } else if file.exact == Some(ExactKind::AlignedVibration) {
+        return Err(SceneError::invalid(
+            "exact",
+            "= \"aligned_vibration\" needs a [manufactured] section",
+        ));
+    }
+    if let Some(dt) = s.dt {
+        positive("solver.dt", dt)?;
+    }
+    if s.mls && matches!(s.shape, ShapeKind::Ugimp | ShapeKind::Lme) {
+        return Err(SceneError::invalid(
+            "solver.mls",
+            "works with bspline2, bspline3 and linear only: MLS integrates at Gauss points of \
+             polynomial cells, where uGIMP's particle-domain averages have no meaning and LME's \
+             non-polynomial functions are not integrated exactly",
+        ));
+    }
+    if s.mls && g.perturb != 0.0 {
+        return Err(SceneError::invalid(
+            "solver.mls",
+            "needs a regular grid (grid.perturb = 0): its Gauss points sit in the grid's rectangular cells",
+        ));
+    }
+
     // --- exact solution applicability -------------------------------------
     if let Some(kind) = file.exact {
         check_exact(&file, kind)?;
@@ -354,10 +400,61 @@ fn check_rect_overlaps(file: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
+fn check_manufactured(file: &SceneFile, m: &ManufacturedSpec) -> Result<(), SceneError> {
+    let mat = file.materials.values().collect::<Vec<_>>();
+    if mat.len() != 1 || mat[0].model != MaterialModel::NeoHookean {
+        return Err(SceneError::invalid(
+            "manufactured",
+            "needs exactly one material, of model \"neo_hookean\" (the solution is derived for it)",
+        ));
+    }
+    let rects: Vec<&[f64; 4]> = file.bodies.values().flat_map(|b| b.rects.iter()).collect();
+    let curved = file
+        .bodies
+        .values()
+        .any(|b| !b.disks.is_empty() || !b.polygons.is_empty());
+    let square = rects.len() == 1 && !curved && {
+        let r = rects[0];
+        ((r[2] - r[0]) - (r[3] - r[1])).abs() <= 1e-9 * (r[2] - r[0])
+    };
+    if !square {
+        return Err(SceneError::invalid(
+            "manufactured",
+            "needs one body made of one square rect",
+        ));
+    }
+    if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
+        return Err(SceneError::invalid(
+            "manufactured",
+            "needs no gravity (the body force is the solution's)",
+        ));
+    }
+    if file.bodies.values().any(|b| b.velocity != [0.0, 0.0]) {
+        return Err(SceneError::invalid(
+            "manufactured",
+            "sets the initial velocity itself: leave the bodies' velocity at [0, 0]",
+        ));
+    }
+    let r = rects[0];
+    let limit = (r[2] - r[0]) / (2.0 * std::f64::consts::PI);
+    finite("manufactured.amplitude", m.amplitude)?;
+    if !(m.amplitude > 0.0 && m.amplitude < limit) {
+        return Err(SceneError::invalid(
+            "manufactured.amplitude",
+            format!(
+                "must be in (0, L/(2π) = {limit:.4}) m so that det F stays positive, got {}",
+                m.amplitude
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
     let what = match kind {
         ExactKind::DykaBar => "dyka_bar",
         ExactKind::ElasticColumn => "elastic_column",
+        ExactKind::AlignedVibration => return Ok(()),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -389,6 +486,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ));
     }
     match kind {
+        ExactKind::AlignedVibration => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(

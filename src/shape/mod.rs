@@ -2,6 +2,7 @@
 //! sees with N_a and ∇N_a. One enum, one `eval`; each kind in its own file.
 //! WGSL twins live in `shaders/shared/shape_*.wgsl`.
 
+pub mod bspline;
 pub mod linear;
 pub mod lme;
 pub mod ugimp;
@@ -15,6 +16,7 @@ pub enum Shape {
     Linear,
     Ugimp(ugimp::Ugimp),
     Lme(lme::Lme),
+    Bspline(bspline::Bspline),
 }
 
 /// Why a shape function could not be evaluated at a particle.
@@ -77,6 +79,8 @@ impl Shape {
             ShapeKind::Lme => {
                 Shape::Lme(lme::Lme::new(solver.lme_gamma, solver.lme_tol, h, perturb))
             }
+            ShapeKind::Bspline2 => Shape::Bspline(bspline::Bspline { degree: 2 }),
+            ShapeKind::Bspline3 => Shape::Bspline(bspline::Bspline { degree: 3 }),
         }
     }
 
@@ -85,6 +89,8 @@ impl Shape {
             Shape::Linear => ShapeKind::Linear,
             Shape::Ugimp(_) => ShapeKind::Ugimp,
             Shape::Lme(_) => ShapeKind::Lme,
+            Shape::Bspline(b) if b.degree == 2 => ShapeKind::Bspline2,
+            Shape::Bspline(_) => ShapeKind::Bspline3,
         }
     }
 
@@ -94,6 +100,7 @@ impl Shape {
             Shape::Linear => 4,
             Shape::Ugimp(_) => 9,
             Shape::Lme(l) => l.max_nodes(),
+            Shape::Bspline(b) => b.max_nodes(),
         }
     }
 
@@ -103,16 +110,19 @@ impl Shape {
         match self {
             Shape::Linear | Shape::Ugimp(_) => 1,
             Shape::Lme(l) => l.reach_cells(),
+            // Interior supports span ±(p + 1)/2 cells.
+            Shape::Bspline(_) => 2,
         }
     }
 
     /// Cells the grid keeps beyond a wall (a fixed half-plane): uGIMP's
     /// particle domains reach across the wall's first node line; the
-    /// others need no nodes inside the wall.
+    /// others need no nodes inside the wall (B-splines: the open knot vector
+    /// makes the boundary basis interpolate the wall).
     pub fn wall_ghost_cells(&self) -> usize {
         match self {
             Shape::Ugimp(_) => 1,
-            Shape::Linear | Shape::Lme(_) => 0,
+            Shape::Linear | Shape::Lme(_) | Shape::Bspline(_) => 0,
         }
     }
 
@@ -125,6 +135,7 @@ impl Shape {
             // LME is defined anywhere inside the nodes' convex hull; a particle
             // very close to the hull shows up as a Newton failure instead.
             Shape::Lme(_) => 0.0,
+            Shape::Bspline(_) => 0.0,
         }
     }
 
@@ -145,6 +156,7 @@ impl Shape {
             Shape::Linear => linear::eval(grid, x, nodes, w),
             Shape::Ugimp(u) => u.eval(grid, x, nodes, w),
             Shape::Lme(l) => l.eval(grid, x, lambda, nodes, w).map(|(n, _)| n),
+            Shape::Bspline(b) => b.eval(grid, x, nodes, w),
         }
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod block;
 pub mod dyka;
+pub mod mms;
 pub mod plate;
 pub mod runner;
 pub mod stability;
@@ -25,7 +26,10 @@ pub enum StudyName {
     PlateImpact,
     /// Stability map: shape × integrator × case × resolution.
     Stability,
-    /// All four, in that order.
+    /// Manufactured aligned vibration: 8–64 cells × linear, uGIMP, LME,
+    /// bspline2/3 with and without MLS (about an hour on 2 cores).
+    Mms,
+    /// All five, in that order.
     All,
 }
 
@@ -36,6 +40,7 @@ impl StudyName {
             StudyName::Block => "block",
             StudyName::PlateImpact => "plate-impact",
             StudyName::Stability => "stability",
+            StudyName::Mms => "mms",
             StudyName::All => "all",
         }
     }
@@ -112,6 +117,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Block,
             StudyName::PlateImpact,
             StudyName::Stability,
+            StudyName::Mms,
         ],
         n => vec![n],
     };
@@ -125,6 +131,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Block => block::jobs(opts.quick, &backends),
             StudyName::PlateImpact => plate::jobs(opts.quick, &backends),
             StudyName::Stability => stability::jobs(opts.quick, &backends),
+            StudyName::Mms => mms::jobs(opts.quick, &backends),
             StudyName::All => unreachable!(),
         };
         if opts.progress {
@@ -140,6 +147,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Block => block::report(&results, &dir, opts.quick)?,
             StudyName::PlateImpact => plate::report(&results, &dir, opts.quick)?,
             StudyName::Stability => stability::report(&results, &dir, opts.quick)?,
+            StudyName::Mms => mms::report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
         crate::output::write_atomic(&dir.join("report.md"), markdown.as_bytes())?;

@@ -135,6 +135,7 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
 /// error, the block's settlement error.
 fn error_figure(r: &JobResult) -> Option<String> {
     match r.data()?.errors.as_ref()? {
+        Errors::Mms(e) => Some(format!("u {}", sig(e.rms_displacement))),
         Errors::Dyka(e) => Some(format!("rms {}", sig(e.rms_velocity_relative))),
         Errors::Column(e) => Some(format!("settle {}", sig(e.settlement_rel_error))),
     }

@@ -1,0 +1,20 @@
+// Stage `p2g` with MLS, pass 1 of 5: zero the per-cell particle counts and
+// the integration cells' occupied flags. CPU twin: `Mls::bin` (src/cpu/mls.rs).
+#include "shared/common.wgsl"
+
+@group(0) @binding({{B_MLS_COUNT}}) var<storage, read_write> mls_count: array<u32>;
+@group(0) @binding({{B_MLS_OCC}}) var<storage, read_write> mls_occ: array<u32>;
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = linear_index(gid, nwg);
+    if sim.running == 0u {
+        return;
+    }
+    if i < (params.nx - 1u) * (params.ny - 1u) {
+        mls_count[i] = 0u;
+    }
+    if i < params.mls_spans_x * params.mls_spans_y {
+        mls_occ[i] = 0u;
+    }
+}

@@ -1,0 +1,40 @@
+// Body force per unit mass (m/s²) on particle p at time t (s): gravity
+// (paper eq. 45 when ramped) plus, with MMS, the aligned-vibration source
+// term derived in src/exact/mms.rs (`AlignedVibration::body_force`).
+// Needs the x0 binding.
+
+// Gravity at time t (paper eq. 45 when ramped).
+fn gravity_at(t: f32) -> vec2<f32> {
+    let period = params.ramp_period;
+    if period > 0.0 && t <= 0.5 * period {
+        let pi = 3.14159265358979;
+        return params.gravity * 0.5 * (sin(2.0 * pi * t / period - 0.5 * pi) + 1.0);
+    }
+    return params.gravity;
+}
+
+#if MMS
+// b = (k²/4) u (4μ/ρ0 − c² + 4 (λ (1 − ln J) + μ) / (ρ0 F²)) per direction, at
+// the particle's reference position; u_y runs half a period behind u_x.
+fn mms_body_force(x0p: vec2<f32>, t: f32) -> vec2<f32> {
+    let xr = params.mms_k * (x0p - params.mms_origin);
+    let s = sin(params.mms_omega * t);
+    let ak = params.mms_amp * params.mms_k;
+    let fxx = 1.0 + ak * cos(xr.x) * s;
+    let fyy = 1.0 - ak * cos(xr.y) * s;
+    let u = params.mms_amp * vec2<f32>(sin(xr.x) * s, -sin(xr.y) * s);
+    let lnj = log(fxx * fyy);
+    let lead = 4.0 * params.mms_shear - params.mms_c2;
+    let tail = 4.0 * (params.mms_lame * (1.0 - lnj) + params.mms_shear);
+    let q = 0.25 * params.mms_k * params.mms_k;
+    return q * u * vec2<f32>(lead + tail / (fxx * fxx), lead + tail / (fyy * fyy));
+}
+#endif
+
+fn body_force(p: u32, t: f32) -> vec2<f32> {
+#if MMS
+    return gravity_at(t) + mms_body_force(x0[p], t);
+#else
+    return gravity_at(t);
+#endif
+}

@@ -1,0 +1,189 @@
+//! Tensor-product B-splines of degree 2 or 3 (Cox-de Boor), with open knot
+//! vectors at the grid's edge, one basis function per grid node.
+//!
+//! Per direction, over n nodes the knot vector (in lattice units) is
+//! t_k = 0 for k ≤ p, t_k = n − 1 for k ≥ n, and t_k = k − (p + 1)/2 in
+//! between: quadratic interior knots at cell midpoints, cubic ones at the
+//! nodes. That is the usual uniform B-spline space, clamped at both ends so
+//! the first and last basis functions interpolate the boundary (a fixed
+//! boundary node fixes the boundary exactly, and no ghost nodes are needed).
+//! The basis "positions" that reproduce linear fields are the Greville
+//! abscissae (`greville`), which equal the nodes away from the edge.
+//! WGSL twin: `shaders/shared/shape_bspline.wgsl`.
+
+use super::ShapeFault;
+use crate::model::Grid;
+
+/// Largest degree supported.
+pub const MAX_DEGREE: usize = 3;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bspline {
+    /// 2 (quadratic) or 3 (cubic).
+    pub degree: usize,
+}
+
+/// Knot t_k in lattice units for `n` basis functions of degree `p`.
+#[inline]
+pub fn knot(k: i64, n: usize, p: usize) -> f64 {
+    if k <= p as i64 {
+        0.0
+    } else if k >= n as i64 {
+        (n - 1) as f64
+    } else {
+        k as f64 - 0.5 * (p as f64 + 1.0)
+    }
+}
+
+/// Greville abscissa of basis `i` (lattice units): the point whose linear
+/// function value the basis carries (Σ_i g_i N_i(u) = u).
+pub fn greville(i: usize, n: usize, p: usize) -> f64 {
+    (1..=p).map(|k| knot((i + k) as i64, n, p)).sum::<f64>() / p as f64
+}
+
+/// The p + 1 nonzero basis functions at `u` (lattice units, in [0, n − 1])
+/// and their derivatives d/du: returns (first basis index, values, derivatives).
+pub fn basis(u: f64, n: usize, p: usize) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    // Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
+    let s = ((u + 0.5 * (p as f64 + 1.0)).floor() as i64).clamp(p as i64, n as i64 - 1) as usize;
+    let t = |k: usize| knot(k as i64, n, p);
+    // Cox-de Boor triangle (The NURBS Book, A2.2), keeping degree p − 1 for the derivatives.
+    let mut nb = [0.0; MAX_DEGREE + 1];
+    let mut lower = [0.0; MAX_DEGREE + 1];
+    let (mut left, mut right) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    nb[0] = 1.0;
+    for j in 1..=p {
+        left[j] = u - t(s + 1 - j);
+        right[j] = t(s + j) - u;
+        if j == p {
+            lower = nb;
+        }
+        let mut saved = 0.0;
+        for r in 0..j {
+            let den = right[r + 1] + left[j - r];
+            let temp = if den != 0.0 { nb[r] / den } else { 0.0 };
+            nb[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        nb[j] = saved;
+    }
+    // dN_{i,p} = p (N_{i,p−1} / (t_{i+p} − t_i) − N_{i+1,p−1} / (t_{i+p+1} − t_{i+1})),
+    // where lower[r] is N_{s−p+1+r, p−1}.
+    let first = s - p;
+    let mut dn = [0.0; MAX_DEGREE + 1];
+    for (r, d) in dn.iter_mut().enumerate().take(p + 1) {
+        let i = first + r;
+        let a = if r >= 1 { lower[r - 1] } else { 0.0 };
+        let b = if r < p { lower[r] } else { 0.0 };
+        let da = t(i + p) - t(i);
+        let db = t(i + p + 1) - t(i + 1);
+        *d = p as f64
+            * ((if da != 0.0 { a / da } else { 0.0 }) - (if db != 0.0 { b / db } else { 0.0 }));
+    }
+    (first, nb, dn)
+}
+
+impl Bspline {
+    /// Nodes a particle sees: (p + 1)².
+    pub fn max_nodes(&self) -> usize {
+        (self.degree + 1) * (self.degree + 1)
+    }
+
+    #[inline]
+    pub fn eval(
+        &self,
+        grid: &Grid,
+        x: [f64; 2],
+        nodes: &mut [u32],
+        w: &mut [[f64; 3]],
+    ) -> Result<usize, ShapeFault> {
+        if !grid.contains(x, 0.0) {
+            return Err(ShapeFault::OutsideGrid);
+        }
+        let p = self.degree;
+        let q = grid.logical(x);
+        let (fx, nx, dnx) = basis(q[0], grid.nx, p);
+        let (fy, ny, dny) = basis(q[1], grid.ny, p);
+        let inv_h = 1.0 / grid.h;
+        let mut k = 0;
+        for b in 0..=p {
+            for a in 0..=p {
+                nodes[k] = grid.index(fx + a, fy + b) as u32;
+                w[k] = [
+                    nx[a] * ny[b],
+                    dnx[a] * ny[b] * inv_h,
+                    nx[a] * dny[b] * inv_h,
+                ];
+                k += 1;
+            }
+        }
+        Ok(k)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_a_partition_of_unity_reproducing_linear_functions() {
+        for p in [2, 3] {
+            for n in [p + 1, p + 2, 9] {
+                let mut u = 0.0;
+                while u <= (n - 1) as f64 {
+                    let (first, nb, dn) = basis(u, n, p);
+                    let s: f64 = nb[..=p].iter().sum();
+                    let ds: f64 = dn[..=p].iter().sum();
+                    let g: f64 = (0..=p).map(|r| nb[r] * greville(first + r, n, p)).sum();
+                    let dg: f64 = (0..=p).map(|r| dn[r] * greville(first + r, n, p)).sum();
+                    assert!(
+                        (s - 1.0).abs() < 1e-13 && ds.abs() < 1e-12,
+                        "p {p} n {n} u {u}: {s} {ds}"
+                    );
+                    assert!(
+                        (g - u).abs() < 1e-13 && (dg - 1.0).abs() < 1e-12,
+                        "p {p} n {n} u {u}: {g} {dg}"
+                    );
+                    assert!(nb[..=p].iter().all(|&v| v >= -1e-15));
+                    u += 0.0371;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn derivatives_match_differences_and_the_boundary_interpolates() {
+        for p in [2, 3] {
+            let n = 8;
+            let value = |i: usize, u: f64| {
+                let (first, nb, _) = basis(u, n, p);
+                if i >= first && i <= first + p {
+                    nb[i - first]
+                } else {
+                    0.0
+                }
+            };
+            for i in 0..n {
+                let mut u = 0.013;
+                while u < (n - 1) as f64 - 0.013 {
+                    let (first, _, dn) = basis(u, n, p);
+                    let d = if i >= first && i <= first + p {
+                        dn[i - first]
+                    } else {
+                        0.0
+                    };
+                    let fd = (value(i, u + 1e-6) - value(i, u - 1e-6)) / 2e-6;
+                    assert!((d - fd).abs() < 1e-5, "p {p} i {i} u {u}: {d} vs {fd}");
+                    u += 0.049;
+                }
+            }
+            // Open knots: the end bases are 1 at the ends.
+            assert_eq!(value(0, 0.0), 1.0);
+            assert!((value(n - 1, (n - 1) as f64) - 1.0).abs() < 1e-15);
+            assert_eq!(greville(0, n, p), 0.0);
+            assert_eq!(greville(n - 1, n, p), (n - 1) as f64);
+            // Interior Greville abscissae are the nodes.
+            assert!((greville(n / 2, n, p) - (n / 2) as f64).abs() < 1e-15);
+        }
+    }
+}
