@@ -222,7 +222,15 @@ fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
         .iter()
         .map(|n| {
             let h = format!("grid.h={}", 1.0 / n);
-            let r = run("aligned_vibration.toml", &[&h, "solver.t_end=0.02"]);
+            let r = run(
+                "aligned_vibration.toml",
+                &[
+                    &h,
+                    "solver.shape=bspline2",
+                    "solver.mls=true",
+                    "solver.t_end=0.02",
+                ],
+            );
             assert_eq!(r.status, RunStatus::Completed, "{n} cells");
             match r.errors {
                 Some(lme_mpm::exact::Errors::Mms(e)) => e.rms_displacement,

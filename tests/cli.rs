@@ -148,19 +148,19 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
         (
             "mls with uGIMP",
             mms.clone(),
-            vec!["solver.shape=ugimp"],
+            vec!["solver.shape=ugimp", "solver.mls=true"],
             "solver.mls",
         ),
         (
             "mls with LME",
             mms.clone(),
-            vec!["solver.shape=lme"],
+            vec!["solver.shape=lme", "solver.mls=true"],
             "solver.mls",
         ),
         (
             "B-spline on a perturbed grid",
             mms.clone(),
-            vec!["solver.mls=false", "grid.perturb=0.1"],
+            vec!["grid.perturb=0.1"],
             "grid.perturb",
         ),
         (

@@ -5,7 +5,7 @@
 //! NPC (Fig. 8), the γ sweep (Fig. 9) and uGIMP vs LME (Fig. 10).
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, image, sig, table};
+use super::{backend_slug, backends_of, image, sig, table};
 use crate::cases::{DYKA_BAR, DYKA_L};
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
@@ -144,14 +144,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     let hs: &[f64] = if quick { &H_QUICK } else { &H_FULL };
     let scene = Scene::from_str(DYKA_BAR, "dyka_bar", "dyka_bar", &[])?;
     let exact = DykaBar::from_scene(&scene);
-    let backends: Vec<&str> = {
-        let mut b: Vec<&str> = results
-            .iter()
-            .filter_map(|r| r.job.tag_value("backend"))
-            .collect();
-        b.dedup();
-        b
-    };
+    let backends = backends_of(results);
     let main = backends.first().copied().unwrap_or("cpu");
     let mut charts = Vec::new();
     let mut md = String::new();

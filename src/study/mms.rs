@@ -7,7 +7,7 @@
 //! stress, and displacement error against wall time.
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, image, sig, table};
+use super::{backend_slug, backends_of, image, sig, table};
 use crate::cases::ALIGNED_VIBRATION;
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
@@ -145,14 +145,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         &[],
     )?;
     let exact = AlignedVibration::from_scene(&scene).expect("the case is manufactured");
-    let backends: Vec<&str> = {
-        let mut b: Vec<&str> = results
-            .iter()
-            .filter_map(|r| r.job.tag_value("backend"))
-            .collect();
-        b.dedup();
-        b
-    };
+    let backends = backends_of(results);
     let main = backends.first().copied().unwrap_or("cpu");
     let mut charts = Vec::new();
     let mut md = String::new();

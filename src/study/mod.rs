@@ -27,7 +27,7 @@ pub enum StudyName {
     /// Stability map: shape × integrator × case × resolution.
     Stability,
     /// Manufactured aligned vibration: 8–64 cells × linear, uGIMP, LME,
-    /// bspline2/3 with and without MLS (about an hour on 2 cores).
+    /// bspline2/3 with and without MLS (about 40 minutes on 2 cores).
     Mms,
     /// All five, in that order.
     All,
@@ -107,6 +107,17 @@ pub fn backend_slug(b: BackendChoice) -> &'static str {
         BackendChoice::Gpu => "gpu",
         BackendChoice::Auto => "auto",
     }
+}
+
+/// The backends the study's runs used, in order of first appearance.
+pub fn backends_of(results: &[runner::JobResult]) -> Vec<&str> {
+    let mut b: Vec<&str> = Vec::new();
+    for name in results.iter().filter_map(|r| r.job.tag_value("backend")) {
+        if !b.contains(&name) {
+            b.push(name);
+        }
+    }
+    b
 }
 
 /// Runs one study (or all) and writes its outputs.
