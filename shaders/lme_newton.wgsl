@@ -96,7 +96,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #else
             lme_cache[p] = vec4<f32>(cur.log_z, inv);
 #endif
-            atomicMax(&sim.lme_iters, it);
             return;
         }
         if it == params.lme_max_iter {

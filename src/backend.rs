@@ -2,9 +2,9 @@
 //! in time, report probes, energy and reactions at sample times, and hand
 //! back the particle state at the end.
 
-use crate::cpu::energy::Energy;
 use crate::error::{Error, Result};
-use crate::fault::Fault;
+use crate::model::energy::Energy;
+use crate::model::fault::Fault;
 use crate::model::{Model, Particles};
 
 /// Why `advance` stopped short: the run went unstable (a result), or the
@@ -25,6 +25,22 @@ impl From<Error> for Halt {
     fn from(e: Error) -> Self {
         Halt::Failed(e)
     }
+}
+
+/// A backend's state between stages, in a form either backend can load:
+/// the CPU path hands it to the GPU path in the parity tests
+/// (`GpuBackend::upload_state`).
+#[derive(Debug, Clone)]
+pub struct State {
+    pub particles: Particles,
+    /// Per node: [mass, momentum or velocity x, y] (kg, kg·m/s or m/s).
+    pub mv: Vec<[f64; 3]>,
+    /// Per node: force (N per unit thickness).
+    pub force: Vec<[f64; 2]>,
+    /// Time reached (s).
+    pub t: f64,
+    /// Time step of the step in progress, or of the last one (s).
+    pub dt: f64,
 }
 
 /// State of one probe particle.

@@ -5,9 +5,8 @@
 
 use crate::backend::Backend;
 use crate::error::Result;
-use crate::model::Model;
-use crate::run::{BackendChoice, make_backend};
 use crate::scene::{Override, Scene};
+use crate::simulation::{BackendChoice, BackendSpec, Simulation};
 use std::fmt::Write;
 use std::time::Instant;
 
@@ -164,10 +163,16 @@ pub fn run(
     for case in cases {
         for &n in counts {
             let scene = scene(n, case)?;
-            let model = Model::new(&scene)?;
-            let particles = model.particles.len();
-            let mut backend = make_backend(choice, adapter, model, false, case.gpu)?;
-            let (steps, seconds) = time_steps(backend.as_mut(), min_seconds, 100_000)?;
+            let spec = BackendSpec {
+                choice: Some(choice),
+                adapter: adapter.map(str::to_string),
+                gpu: case.gpu,
+                verbose: false,
+            };
+            let mut sim = Simulation::new(&scene, &spec)?;
+            let backend = sim.backend();
+            let particles = backend.model().particles.len();
+            let (steps, seconds) = time_steps(backend, min_seconds, 100_000)?;
             let p = Point {
                 backend: backend.name(),
                 case: case.label.clone(),

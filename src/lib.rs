@@ -15,15 +15,14 @@ pub mod cpu;
 pub mod docgen;
 pub mod error;
 pub mod exact;
-pub mod fault;
 pub mod gpu;
-pub mod material;
+pub mod limits;
 pub mod model;
 pub mod output;
 pub mod rng;
 pub mod run;
 pub mod scene;
-pub mod shape;
+pub mod simulation;
 pub mod solver;
 pub mod study;
 

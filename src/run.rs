@@ -5,28 +5,17 @@
 use crate::backend::{Backend, Sample};
 use crate::cpu::CpuBackend;
 use crate::error::{Error, Result};
-use crate::exact;
-use crate::gpu::{self, GpuBackend};
 use crate::model::Model;
+use crate::model::shape::Shape;
 use crate::output::{self, csv, summary::Summary, vtk};
 use crate::scene::Scene;
-use crate::shape::Shape;
-use crate::solver::{self, Observer, RunStatus, Schedule};
+pub use crate::simulation::BackendChoice;
+use crate::simulation::{BackendSpec, Simulation};
+use crate::solver::{Observer, RunStatus};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-/// `--backend`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum BackendChoice {
-    /// The GPU when an adapter exists, else the CPU path (says which and why).
-    Auto,
-    /// The f64 CPU reference path.
-    Cpu,
-    /// The wgpu path; fails when no adapter exists.
-    Gpu,
-}
 
 #[derive(Debug, Clone)]
 pub struct RunOptions {
@@ -47,88 +36,31 @@ pub struct Outcome {
     pub summary: Summary,
 }
 
-/// Makes the backend `choice` asks for. `adapter` picks a GPU adapter by
-/// name. `auto` takes a hardware GPU when there is one and otherwise the CPU
-/// path (a software adapter such as llvmpipe is slower than the CPU path);
-/// with `verbose` it says which it took and why.
-pub fn make_backend(
-    choice: BackendChoice,
-    adapter: Option<&str>,
-    model: Model,
-    verbose: bool,
-    gpu_opts: gpu::GpuOptions,
-) -> Result<Box<dyn Backend>> {
-    let req = |allow_software| gpu::context::AdapterRequest {
-        name: adapter.map(str::to_string),
-        allow_software,
-        force_cas: std::env::var_os("LME_MPM_FORCE_CAS").is_some(),
-    };
-    match choice {
-        BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
-        BackendChoice::Gpu => {
-            let ctx = gpu::context::open(&req(true))?;
-            let b = GpuBackend::with_options(ctx, model, gpu_opts)?;
-            if verbose {
-                eprintln!("backend: {}", b.name());
-            }
-            Ok(Box::new(b))
-        }
-        BackendChoice::Auto => match gpu::context::open(&req(false)) {
-            Ok(ctx) => {
-                let b = GpuBackend::with_options(ctx, model, gpu_opts)?;
-                if verbose {
-                    eprintln!("backend: {} (auto: a GPU adapter was found)", b.name());
-                }
-                Ok(Box::new(b))
-            }
-            Err(e) => {
-                if verbose {
-                    let why = match &e {
-                        Error::NoAdapter(m) => m.clone(),
-                        other => other.to_string(),
-                    };
-                    eprintln!(
-                        "backend: CPU path (f64, {} threads); auto found no usable GPU: {why}",
-                        rayon::current_num_threads()
-                    );
-                }
-                Ok(Box::new(CpuBackend::new(model)))
-            }
-        },
-    }
-}
-
 /// Runs `scene` and writes its outputs to `opts.out`.
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let start = Instant::now();
-    let model = Model::new(scene)?;
-    let mut backend = make_backend(
-        opts.backend,
-        opts.adapter.as_deref(),
-        model,
-        opts.verbose,
-        gpu::GpuOptions::default(),
-    )?;
+    let spec = BackendSpec {
+        choice: Some(opts.backend),
+        adapter: opts.adapter.clone(),
+        gpu: Default::default(),
+        verbose: opts.verbose,
+    };
+    let mut sim = Simulation::new(scene, &spec)?;
 
     std::fs::create_dir_all(&opts.out)
         .map_err(|e| Error::io("cannot create output folder", &opts.out, e))?;
     let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
     output::write_atomic(&opts.out.join("scene.resolved.toml"), resolved.as_bytes())?;
 
-    let mut writer = Writer::new(&opts.out, backend.model(), opts.progress);
-    let schedule = Schedule {
-        sample_interval: scene.sample_interval,
-        vtk_interval: scene.file.output.vtk_interval,
-        ..Default::default()
-    };
+    let mut writer = Writer::new(&opts.out, sim.backend_ref().model(), opts.progress);
     let t_drive = Instant::now();
-    let status = solver::drive(backend.as_mut(), schedule, &mut writer)?;
-    let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
+    let driven = sim.drive(&mut writer);
     writer.finish_progress();
-    if let Some(e) = writer.error.take() {
-        return Err(e);
-    }
+    let status = driven?;
+    let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
 
+    let errors = sim.score()?;
+    let backend = sim.backend();
     let t = backend.time();
     let steps = backend.steps();
     let bytes_per_particle = backend.bytes_per_particle();
@@ -136,10 +68,6 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let final_sample = writer.samples.last().cloned();
     let particles = backend.particles()?.clone();
     let model = backend.model().clone();
-    let errors = scene
-        .file
-        .exact
-        .map(|k| exact::score(k, scene, &model, &particles, t));
     let particles = &particles;
     if scene.file.output.particles_csv {
         output::write_atomic(
@@ -227,7 +155,6 @@ struct Writer {
     snapshots: Vec<(f64, String)>,
     last_flush: Instant,
     io_seconds: f64,
-    error: Option<Error>,
     progress: Option<(ProgressBar, Instant)>,
 }
 
@@ -262,7 +189,6 @@ impl Writer {
             snapshots: Vec::new(),
             last_flush: Instant::now(),
             io_seconds: 0.0,
-            error: None,
             progress: bar,
         }
     }
@@ -309,24 +235,18 @@ impl Writer {
 }
 
 impl Observer for Writer {
-    fn sample(&mut self, sample: &Sample) {
+    fn sample(&mut self, sample: &Sample) -> Result<()> {
         self.samples.push(sample.clone());
-        if self.error.is_none() && self.last_flush.elapsed() > FLUSH_EVERY {
-            if let Err(e) = self.flush() {
-                self.error = Some(e);
-            }
+        if self.last_flush.elapsed() > FLUSH_EVERY {
+            self.flush()?;
         }
+        Ok(())
     }
 
-    fn snapshot(&mut self, backend: &mut dyn Backend) {
-        if self.error.is_some() {
-            return;
-        }
+    fn snapshot(&mut self, backend: &mut dyn Backend) -> Result<()> {
         let t = backend.time();
-        let written = backend.particles().and_then(|p| self.write_snapshot(p, t));
-        if let Err(e) = written {
-            self.error = Some(e);
-        }
+        let p = backend.particles()?;
+        self.write_snapshot(p, t)
     }
 
     fn progress(&mut self, fraction: f64) {
@@ -344,7 +264,7 @@ impl Observer for Writer {
 
 /// Text that `lme-mpm check` prints: what the scene will run.
 pub fn describe(scene: &Scene, model: &Model) -> String {
-    let dt = crate::cpu::cfl::time_step(model, 0.0).0;
+    let dt = crate::model::time_step::time_step(model, 0.0).0;
     let bytes_cpu = CpuBackend::bytes_per_particle_of(model);
     let s = scene.solver();
     let g = &model.grid;
@@ -361,7 +281,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let shape = if model.mls {
         format!(
             "{shape}, MLS reconstruction at {} Gauss points",
-            crate::cpu::mls::gauss_points(&model.shape, g)
+            crate::model::gauss::gauss_points(&model.shape, g)
         )
     } else {
         shape
@@ -369,7 +289,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let step_rule = match model.fixed_dt {
         Some(fixed) => {
             // Courant number of the fixed step at t = 0.
-            let c = crate::cpu::cfl::max_speed(
+            let c = crate::model::time_step::max_speed(
                 &model.particles.v,
                 &model.particles.rho,
                 &model.particles.body,

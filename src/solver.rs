@@ -8,9 +8,9 @@
 //! momentum update of Zhang et al.).
 
 use crate::backend::{Backend, Halt, Sample};
-use crate::cpu::energy::Energy;
 use crate::error::Result;
-use crate::fault::{Fault, FaultKind};
+use crate::model::energy::Energy;
+use crate::model::fault::{Fault, FaultKind};
 
 /// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
 /// WGSL twin `shaders/<name>.wgsl` of the same name.
@@ -64,10 +64,11 @@ pub enum RunStatus {
 }
 
 /// Receives a run's samples as they happen (the output writer, or a test).
+/// An error from either call ends the run at once (`drive` returns it).
 pub trait Observer {
-    fn sample(&mut self, sample: &Sample);
+    fn sample(&mut self, sample: &Sample) -> Result<()>;
     /// A snapshot of all particles is due (VTK).
-    fn snapshot(&mut self, backend: &mut dyn Backend);
+    fn snapshot(&mut self, backend: &mut dyn Backend) -> Result<()>;
     /// Progress, as the fraction of t_end reached.
     fn progress(&mut self, _fraction: f64) {}
 }
@@ -79,10 +80,13 @@ pub struct Recorder {
 }
 
 impl Observer for Recorder {
-    fn sample(&mut self, sample: &Sample) {
+    fn sample(&mut self, sample: &Sample) -> Result<()> {
         self.samples.push(sample.clone());
+        Ok(())
     }
-    fn snapshot(&mut self, _backend: &mut dyn Backend) {}
+    fn snapshot(&mut self, _backend: &mut dyn Backend) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// When to sample and snapshot (s).
@@ -113,7 +117,8 @@ impl Schedule {
 
 /// Runs `backend` to the model's t_end, sampling on `schedule`. Returns how
 /// the run ended; an unstable run stops at the step that found the fault.
-/// Errors are failures of the backend itself (a lost GPU device).
+/// Errors are failures of the backend itself (a lost GPU device) or of the
+/// observer (an output that cannot be written); either stops the run at once.
 pub fn drive(
     backend: &mut dyn Backend,
     schedule: Schedule,
@@ -130,9 +135,9 @@ pub fn drive(
             .as_ref()
             .map_or(0.0, |mms| mms.peak_energy(&m.particles))
     };
-    obs.sample(&first);
+    obs.sample(&first)?;
     if schedule.vtk_interval.is_some() {
-        obs.snapshot(backend);
+        obs.snapshot(backend)?;
     }
     let mut k_sample = 1u64;
     let mut k_vtk = 1u64;
@@ -149,7 +154,7 @@ pub fn drive(
             Err(Halt::Failed(e)) => return Err(e),
             Err(Halt::Unstable(fault)) => {
                 let s = backend.sample()?;
-                obs.sample(&s);
+                obs.sample(&s)?;
                 return Ok(RunStatus::Unstable {
                     fault,
                     t: backend.time(),
@@ -161,10 +166,8 @@ pub fn drive(
         obs.progress(t / t_end);
         if t >= next_sample || t >= t_end {
             let s = backend.sample()?;
-            obs.sample(&s);
-            while k_sample as f64 * schedule.sample_interval <= t {
-                k_sample += 1;
-            }
+            obs.sample(&s)?;
+            k_sample = next_multiple(k_sample, schedule.sample_interval, t);
             if let Some(fault) = runaway(&e0, &s.energy, supplied, scale) {
                 return Ok(RunStatus::Unstable {
                     fault,
@@ -174,14 +177,23 @@ pub fn drive(
             }
         }
         if t >= next_vtk {
-            obs.snapshot(backend);
+            obs.snapshot(backend)?;
             if let Some(iv) = schedule.vtk_interval {
-                while k_vtk as f64 * iv <= t {
-                    k_vtk += 1;
-                }
+                k_vtk = next_multiple(k_vtk, iv, t);
             }
         }
     }
+}
+
+/// The smallest k ≥ `k` with k · `interval` > `t`: the index of the next
+/// sample or snapshot time. Jumps straight there (a tiny interval must not
+/// cost one loop turn per interval passed), then settles the rounding.
+fn next_multiple(k: u64, interval: f64, t: f64) -> u64 {
+    let mut k = k.max((t / interval).floor().min(u64::MAX as f64 / 2.0) as u64);
+    while k as f64 * interval <= t {
+        k += 1;
+    }
+    k
 }
 
 /// Energies below this (J/m) are round-off: 1e-12 of Σ m c², the energy

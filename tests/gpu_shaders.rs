@@ -107,6 +107,7 @@ fn variants() -> Vec<Variant> {
                                         lme_stored,
                                         linear_elastic,
                                         neo_hookean,
+                                        def_grad: neo_hookean,
                                         mms,
                                         mls,
                                     });
@@ -213,7 +214,7 @@ fn shared_structs_match_rust_layouts() {
         lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials, fixed_dt, mms_amp, mms_origin,
         mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off);
     assert_eq!(wgsl_struct(&module, "Params"), params);
-    let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault, lme_iters);
+    let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
     let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model);
     assert_eq!(wgsl_struct(&module, "Material"), mat);

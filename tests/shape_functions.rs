@@ -4,10 +4,10 @@
 //! its reported failure.
 
 use lme_mpm::model::Grid;
+use lme_mpm::model::shape::lme::Lme;
+use lme_mpm::model::shape::ugimp::Ugimp;
+use lme_mpm::model::shape::{Shape, ShapeFault, linear};
 use lme_mpm::rng::SplitMix64;
-use lme_mpm::shape::lme::Lme;
-use lme_mpm::shape::ugimp::Ugimp;
-use lme_mpm::shape::{Shape, ShapeFault, linear};
 
 /// Closed-form shapes (Q4, uGIMP) hold the identities to round-off: a few
 /// ulps of the O(1) sums, scaled by h for positions.
@@ -264,7 +264,7 @@ fn lme_newton_converges_from_cold_starts_within_the_cap() {
         }
     }
     assert!(
-        worst <= lme_mpm::shape::lme::NEWTON_MAX_ITER,
+        worst <= lme_mpm::model::shape::lme::NEWTON_MAX_ITER,
         "worst {worst}"
     );
     // A warm start at the solution converges without a single step.
@@ -315,7 +315,7 @@ fn bsplines_satisfy_the_identities_inside_and_at_the_open_knot_boundary() {
     // With open knot vectors the basis "positions" that reproduce linear
     // fields are the Greville abscissae (nodes away from the edge, pulled in
     // next to it), so reproduction is checked against those.
-    use lme_mpm::shape::bspline::{Bspline, greville};
+    use lme_mpm::model::shape::bspline::{Bspline, greville};
     let g = grid(0.0);
     for degree in [2, 3] {
         let shape = Shape::Bspline(Bspline { degree });

@@ -106,7 +106,7 @@ fn random_model_of(text: &str, sets: &[&str], seed: u64) -> Model {
     let g = m.grid.clone();
     // uGIMP on a perturbed grid needs its particle square inside the grid in
     // lattice units, which nodes moved by up to 0.2 h can cost.
-    let lattice = if g.is_perturbed() && matches!(m.shape, lme_mpm::shape::Shape::Ugimp(_)) {
+    let lattice = if g.is_perturbed() && matches!(m.shape, lme_mpm::model::shape::Shape::Ugimp(_)) {
         0.3 * g.h
     } else {
         0.0
@@ -208,14 +208,14 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
         return;
     };
     println!("{label} ({:?} atomics)", ctx.atomics);
-    let lme = matches!(model.shape, lme_mpm::shape::Shape::Lme(_));
+    let lme = matches!(model.shape, lme_mpm::model::shape::Shape::Lme(_));
     let mut cpu = CpuBackend::new(model.clone());
     cpu.set_time(t);
     let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
     let mut rep = Report { worst: 0.0 };
     for &stage in STEP {
         // The state every stage starts from is the CPU's.
-        gpu.upload_state(&cpu);
+        gpu.upload_state(&cpu.state());
         let before_p = cpu.model.particles.clone();
         let before_mv = cpu.mv.clone();
         let needs_cache = lme && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);

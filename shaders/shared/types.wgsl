@@ -96,9 +96,8 @@ struct Sim {
     cmax_bits: atomic<u32>,
     // (particle << 4) | code of the first fault, FAULT_NONE if none.
     fault: atomic<u32>,
-    // Most LME Newton iterations any particle took (diagnostics).
-    lme_iters: atomic<u32>,
-    _pad: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 struct Material {

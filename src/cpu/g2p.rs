@@ -7,10 +7,10 @@
 //! GPU twin: `shaders/g2p.wgsl`.
 
 use super::ShapeCache;
-use crate::fault::{Fault, FaultKind};
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::shape::ShapeFault;
 use crate::model::{Grid, Integrator};
 use crate::scene::NpcPosition;
-use crate::shape::ShapeFault;
 use rayon::prelude::*;
 
 #[derive(Debug, Clone, Copy)]

@@ -9,9 +9,7 @@
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y};
 use rayon::prelude::*;
 
-/// Nodes lighter than this (kg) count as empty. Relative to the lightest
-/// particle: 1e-9 keeps LME tail nodes (N ≳ 1e-6) and drops only round-off.
-pub const MASS_EPS_REL: f64 = 1e-9;
+pub use crate::model::MASS_EPS_REL;
 
 #[inline]
 fn zero_fixed(v: &mut [f64], fix: u8) {

@@ -26,9 +26,10 @@
 //! those within 3h. GPU twin: `shaders/mls_*.wgsl`.
 
 use super::{ShapeCache, scatter::Scatter};
-use crate::fault::{Fault, FaultKind};
 use crate::model::Grid;
-use crate::shape::{Shape, ShapeFault};
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::gauss::{breaks, gauss_point};
+use crate::model::shape::{Shape, ShapeFault};
 use rayon::prelude::*;
 
 /// The quadratic-spline weight of eq. 17, w(r) for r ≥ 0 (support 3/2).
@@ -78,52 +79,6 @@ pub struct Mls {
     pub gp_f: Vec<[f64; 5]>,
     mv_scatter: Scatter<3>,
     f_scatter: Scatter<2>,
-}
-
-/// Integration-cell breaks of `shape` along an axis of `n` nodes (lattice units):
-/// the distinct knots for B-splines, the nodes otherwise.
-pub fn breaks(shape: &Shape, n: usize) -> Vec<f64> {
-    match shape {
-        Shape::Bspline(b) => {
-            let p = b.degree;
-            let mut out: Vec<f64> = (0..(n + p + 1) as i64)
-                .map(|k| crate::shape::bspline::knot(k, n, p))
-                .collect();
-            out.dedup();
-            out
-        }
-        _ => (0..n).map(|i| i as f64).collect(),
-    }
-}
-
-/// Gauss points `Mls::new` makes for `shape` on `grid`.
-pub fn gauss_points(shape: &Shape, grid: &Grid) -> usize {
-    4 * (breaks(shape, grid.nx).len() - 1) * (breaks(shape, grid.ny).len() - 1)
-}
-
-/// Position (m) and weight ω (m²) of Gauss point `g` of the integration
-/// cells with breaks `bx`, `by` (lattice units): g = 4 (sy · spans_x + sx) + k,
-/// k = (−,−), (+,−), (−,+), (+,+).
-fn gauss_point(bx: &[f64], by: &[f64], grid: &Grid, g: usize) -> ([f64; 2], f64) {
-    let span = g / 4;
-    let (sx, sy) = (span % (bx.len() - 1), span / (bx.len() - 1));
-    let (a, b) = (
-        if g % 2 == 1 { 1.0 } else { -1.0 },
-        if g % 4 >= 2 { 1.0 } else { -1.0 },
-    );
-    let gq = 0.5 / 3f64.sqrt();
-    let (x0, x1, y0, y1) = (bx[sx], bx[sx + 1], by[sy], by[sy + 1]);
-    let u = 0.5 * (x0 + x1) + a * gq * (x1 - x0);
-    let v = 0.5 * (y0 + y1) + b * gq * (y1 - y0);
-    (
-        [grid.min[0] + u * grid.h, grid.min[1] + v * grid.h],
-        0.25 * (x1 - x0) * (y1 - y0) * grid.h * grid.h,
-    )
-}
-
-/// Position (m) of Gauss point `g` of `shape` on `grid`.
-pub fn gauss_point_position(shape: &Shape, grid: &Grid, g: usize) -> [f64; 2] {
-    gauss_point(&breaks(shape, grid.nx), &breaks(shape, grid.ny), grid, g).0
 }
 
 impl Mls {
@@ -479,7 +434,7 @@ mod tests {
     /// are their exact integrals over the square.
     #[test]
     fn reproduces_linear_fields_from_scattered_particles() {
-        use crate::shape::bspline::Bspline;
+        use crate::model::shape::bspline::Bspline;
         for shape in [
             Shape::Linear,
             Shape::Bspline(Bspline { degree: 2 }),

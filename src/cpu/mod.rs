@@ -14,9 +14,9 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample};
+use crate::backend::{Backend, Halt, ProbeState, Sample, State};
 use crate::error::Result;
-use crate::fault::Fault;
+use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
 use crate::solver::{STEP, Stage};
 use scatter::Scatter;
@@ -123,7 +123,8 @@ impl CpuBackend {
             // Sort order and cells per particle, the Gauss points' share.
             let slots = model.shape.max_nodes() as f64;
             let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 11.0;
-            per += 12.0 + mls::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
+            per += 12.0
+                + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
@@ -139,6 +140,17 @@ impl CpuBackend {
     /// Time step of the step in progress, or of the last one (s).
     pub fn dt(&self) -> f64 {
         self.dt
+    }
+
+    /// The state as either backend can load it (a copy).
+    pub fn state(&self) -> State {
+        State {
+            particles: self.model.particles.clone(),
+            mv: self.mv.clone(),
+            force: self.force.clone(),
+            t: self.t,
+            dt: self.dt,
+        }
     }
 
     /// Sets the time reached (s), e.g. to check time-dependent loads at a

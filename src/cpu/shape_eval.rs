@@ -5,9 +5,9 @@
 //! inline in each GPU pass.
 
 use super::ShapeCache;
-use crate::fault::{Fault, FaultKind};
 use crate::model::Grid;
-use crate::shape::Shape;
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::shape::Shape;
 use rayon::prelude::*;
 
 pub fn shape_eval(

@@ -6,8 +6,8 @@
 //! GPU twin: `shaders/stress.wgsl`.
 
 use super::ShapeCache;
-use crate::fault::{Fault, FaultKind};
-use crate::material::Material;
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::material::Material;
 use rayon::prelude::*;
 
 #[allow(clippy::too_many_arguments)]

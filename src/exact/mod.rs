@@ -31,10 +31,10 @@ pub fn score(
         ExactKind::ElasticColumn => {
             Errors::Column(column::ElasticColumn::from_scene(scene, model).score(particles, t))
         }
-        ExactKind::AlignedVibration => Errors::Mms(
-            mms::AlignedVibration::from_scene(scene)
-                .expect("validated: a manufactured scene")
-                .score(particles, t),
-        ),
+        ExactKind::AlignedVibration => Errors::Mms(mms::score(
+            &mms::AlignedVibration::from_scene(scene).expect("validated: a manufactured scene"),
+            particles,
+            t,
+        )),
     }
 }

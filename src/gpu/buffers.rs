@@ -11,9 +11,9 @@ use super::layout::{
     Params, Sim,
 };
 use crate::error::{Error, Result};
-use crate::material::Material;
+use crate::model::material::Material;
+use crate::model::shape::Shape;
 use crate::model::{FIX_X, FIX_Y, Integrator, Model};
-use crate::shape::Shape;
 use std::collections::BTreeMap;
 
 /// Every buffer a stage may bind. The binding number is the position here.
@@ -311,8 +311,8 @@ pub fn initial_sim() -> Sim {
         final_step: 0,
         cmax_bits: 0,
         fault: super::layout::FAULT_NONE,
-        lme_iters: 0,
-        _pad: 0,
+        _pad0: 0,
+        _pad1: 0,
     }
 }
 

@@ -63,8 +63,8 @@ pub struct Sim {
     pub final_step: u32,
     pub cmax_bits: u32,
     pub fault: u32,
-    pub lme_iters: u32,
-    pub _pad: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
 }
 const _: () = assert!(std::mem::size_of::<Sim>() == 48);
 

@@ -12,13 +12,12 @@ pub mod layout;
 pub mod pipelines;
 pub mod preprocess;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample};
-use crate::cpu::CpuBackend;
-use crate::cpu::energy::Energy;
+use crate::backend::{Backend, Halt, ProbeState, Sample, State};
 use crate::error::{Error, Result};
-use crate::fault::{Fault, FaultKind};
+use crate::model::energy::Energy;
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::shape::{Shape, ShapeFault};
 use crate::model::{Integrator, Model, Particles};
-use crate::shape::{Shape, ShapeFault};
 use buffers::{Buf, Buffers};
 use context::{AtomicMode, GpuContext};
 use layout::*;
@@ -72,7 +71,7 @@ impl GpuBackend {
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
-        let dt_hint = crate::cpu::cfl::time_step(&model, 0.0).0;
+        let dt_hint = crate::model::time_step::time_step(&model, 0.0).0;
         let mut b = GpuBackend {
             ctx,
             model,
@@ -122,7 +121,7 @@ impl GpuBackend {
     }
 
     /// Copies whole buffers to the host (one staging buffer, one wait).
-    pub fn read(&self, bufs: &[Buf]) -> Result<Vec<Vec<u8>>> {
+    pub fn read(&self, bufs: &[Buf]) -> Result<ReadBack> {
         let sizes: Vec<u64> = bufs.iter().map(|b| self.buffers.get(*b).size()).collect();
         let total: u64 = sizes.iter().sum();
         let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -152,10 +151,10 @@ impl GpuBackend {
         let view = staging
             .get_mapped_range(..)
             .map_err(|e| Error::Gpu(format!("reading a mapped buffer: {e}")))?;
-        let mut out = Vec::with_capacity(bufs.len());
+        let mut out = ReadBack::default();
         let mut off = 0usize;
-        for s in &sizes {
-            out.push(view[off..off + *s as usize].to_vec());
+        for (b, s) in bufs.iter().zip(&sizes) {
+            out.bytes.insert(*b, view[off..off + *s as usize].to_vec());
             off += *s as usize;
         }
         drop(view);
@@ -165,17 +164,14 @@ impl GpuBackend {
 
     /// The device's run state now.
     pub fn read_sim(&self) -> Result<Sim> {
-        let b = self.read(&[Buf::Sim])?;
-        Ok(*bytemuck::from_bytes::<Sim>(
-            &b[0][..std::mem::size_of::<Sim>()],
-        ))
+        Ok(self.read(&[Buf::Sim])?.sim())
     }
 
     /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32).
     pub fn read_nodes(&self) -> Result<Vec<[f32; NODE_STRIDE]>> {
         let b = self.read(&[Buf::NodeAcc])?;
-        let f: &[f32] = bytemuck::cast_slice(&b[0]);
-        Ok(f.chunks_exact(NODE_STRIDE)
+        Ok(b.f32s(Buf::NodeAcc)
+            .chunks_exact(NODE_STRIDE)
             .take(self.buffers.n_nodes)
             .map(|c| c.try_into().expect("chunk of NODE_STRIDE"))
             .collect())
@@ -183,11 +179,22 @@ impl GpuBackend {
 
     /// Reactions per constraint group, as last computed on the device.
     pub fn read_reactions(&self) -> Result<Vec<[f64; 2]>> {
-        let b = self.read(&[Buf::Reactions])?;
-        let f: &[f32] = bytemuck::cast_slice(&b[0]);
-        Ok((0..self.buffers.n_groups)
-            .map(|g| [f[2 * g] as f64, f[2 * g + 1] as f64])
-            .collect())
+        Ok(self
+            .read(&[Buf::Reactions])?
+            .pairs(Buf::Reactions, self.buffers.n_groups))
+    }
+
+    /// Sets the device's stop time (`Sim::t_stop_hi`, `t_stop_lo`: adjacent
+    /// fields, written together) and leaves the rest of `Sim` as it is.
+    fn write_stop(&self, hi: f32, lo: f32) {
+        const _: () = assert!(
+            std::mem::offset_of!(Sim, t_stop_lo) == std::mem::offset_of!(Sim, t_stop_hi) + 4
+        );
+        self.ctx.queue.write_buffer(
+            self.buffers.get(Buf::Sim),
+            std::mem::offset_of!(Sim, t_stop_hi) as u64,
+            bytemuck::cast_slice(&[hi, lo]),
+        );
     }
 
     fn write_sim(&self, sim: &Sim) {
@@ -196,10 +203,10 @@ impl GpuBackend {
             .write_buffer(self.buffers.get(Buf::Sim), 0, bytemuck::bytes_of(sim));
     }
 
-    /// Replaces the device state with a CPU backend's (parity tests): the
-    /// particles, the nodal arrays, the time and the step's Δt.
-    pub fn upload_state(&mut self, cpu: &CpuBackend) {
-        let p = &cpu.model.particles;
+    /// Replaces the device state with `state` (parity tests load the CPU
+    /// path's): the particles, the nodal arrays, the time and the step's Δt.
+    pub fn upload_state(&mut self, state: &State) {
+        let p = &state.particles;
         let q = &self.ctx.queue;
         let f2 = |v: &[[f64; 2]]| {
             v.iter()
@@ -230,10 +237,10 @@ impl GpuBackend {
         q.write_buffer(self.buffers.get(Buf::Rho), 0, bytemuck::cast_slice(&rho));
         let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
         q.write_buffer(self.buffers.get(Buf::Stress), 0, bytemuck::cast_slice(&s));
-        let nodes: Vec<f32> = cpu
+        let nodes: Vec<f32> = state
             .mv
             .iter()
-            .zip(&cpu.force)
+            .zip(&state.force)
             .flat_map(|(m, f)| {
                 [
                     m[0] as f32,
@@ -249,12 +256,12 @@ impl GpuBackend {
             0,
             bytemuck::cast_slice(&nodes),
         );
-        let (t, t_lo) = split_f64(cpu.time());
+        let (t, t_lo) = split_f64(state.t);
         let (sh, sl) = split_f64(self.model.t_end);
         let sim = Sim {
             t,
             t_lo,
-            dt: cpu.dt() as f32,
+            dt: state.dt as f32,
             t_stop_hi: sh,
             t_stop_lo: sl,
             running: 1,
@@ -269,7 +276,7 @@ impl GpuBackend {
     fn fault_of(&self, word: u32) -> Fault {
         let particle = (word >> 4) as usize;
         if word & 0xf == FAULT_MLS_SINGULAR {
-            let at = crate::cpu::mls::gauss_point_position(
+            let at = crate::model::gauss::gauss_point_position(
                 &self.model.shape,
                 &self.model.grid,
                 particle,
@@ -312,11 +319,6 @@ impl GpuBackend {
     fn t(&self) -> f64 {
         (self.sim.t as f64 + self.sim.t_lo as f64).max(self.t_floor)
     }
-
-    /// Most LME Newton iterations any particle has taken in one step.
-    pub fn lme_max_iterations(&self) -> u32 {
-        self.sim.lme_iters
-    }
 }
 
 /// The scene constants the shaders read.
@@ -342,8 +344,8 @@ pub fn params(model: &Model) -> Params {
     });
     let mms = model.manufactured.as_ref();
     let mls_spans = [
-        crate::cpu::mls::breaks(&model.shape, g.nx).len() as u32 - 1,
-        crate::cpu::mls::breaks(&model.shape, g.ny).len() as u32 - 1,
+        crate::model::gauss::breaks(&model.shape, g.nx).len() as u32 - 1,
+        crate::model::gauss::breaks(&model.shape, g.ny).len() as u32 - 1,
     ];
     let mls_break_off = match &model.shape {
         Shape::Bspline(b) => 0.5 * (b.degree as f32 - 1.0),
@@ -364,7 +366,7 @@ pub fn params(model: &Model) -> Params {
         h: g.h as f32,
         inv_h: (1.0 / g.h) as f32,
         cfl_h: (model.cfl * g.min_spacing()) as f32,
-        mass_eps: (crate::cpu::grid_update::MASS_EPS_REL * min_mass) as f32,
+        mass_eps: (crate::model::MASS_EPS_REL * min_mass) as f32,
         t_end_hi,
         t_end_lo,
         gravity,
@@ -379,7 +381,7 @@ pub fn params(model: &Model) -> Params {
         lme_tol,
         lme_reach,
         lme_side: pipelines::lme_side(model),
-        lme_max_iter: crate::shape::lme::NEWTON_MAX_ITER,
+        lme_max_iter: crate::model::shape::lme::NEWTON_MAX_ITER,
         ugimp_lp: match &model.shape {
             Shape::Ugimp(u) => u.lp_h as f32,
             _ => 0.0,
@@ -429,11 +431,7 @@ impl Backend for GpuBackend {
         // The device compares with the two-float target, which can sit an
         // f32 rounding of `lo` below the f64 one.
         let target = hi as f64 + lo as f64;
-        self.ctx.queue.write_buffer(
-            self.buffers.get(Buf::Sim),
-            12,
-            bytemuck::cast_slice(&[hi, lo]),
-        );
+        self.write_stop(hi, lo);
         loop {
             let t = self.t();
             if t >= target {
@@ -467,11 +465,7 @@ impl Backend for GpuBackend {
 
     fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt> {
         let (hi, lo) = split_f64(self.model.t_end);
-        self.ctx.queue.write_buffer(
-            self.buffers.get(Buf::Sim),
-            12,
-            bytemuck::cast_slice(&[hi, lo]),
-        );
+        self.write_stop(hi, lo);
         let mut left = n;
         while left > 0 {
             let k = left.min(MAX_BATCH);
@@ -496,8 +490,8 @@ impl Backend for GpuBackend {
         }
         self.ctx.queue.submit([enc.finish()]);
         let b = self.read(&[Buf::ProbeOut, Buf::EnergyOut, Buf::Reactions, Buf::Sim])?;
-        self.sim = *bytemuck::from_bytes::<Sim>(&b[3][..std::mem::size_of::<Sim>()]);
-        let pr: &[f32] = bytemuck::cast_slice(&b[0]);
+        self.sim = b.sim();
+        let pr = b.f32s(Buf::ProbeOut);
         let origin = self.model.grid.min;
         let probes = (0..self.model.probes.len())
             .map(|k| {
@@ -509,8 +503,7 @@ impl Backend for GpuBackend {
                 }
             })
             .collect();
-        let e: &[f32] = bytemuck::cast_slice(&b[1]);
-        let r: &[f32] = bytemuck::cast_slice(&b[2]);
+        let e = b.f32s(Buf::EnergyOut);
         Ok(Sample {
             t: self.t(),
             probes,
@@ -519,9 +512,7 @@ impl Backend for GpuBackend {
                 strain: e[1] as f64,
                 gravity_work_bound: e[2] as f64,
             },
-            reactions: (0..self.buffers.n_groups)
-                .map(|g| [r[2 * g] as f64, r[2 * g + 1] as f64])
-                .collect(),
+            reactions: b.pairs(Buf::Reactions, self.buffers.n_groups),
         })
     }
 
@@ -541,10 +532,10 @@ impl Backend for GpuBackend {
                 want.push(Buf::DefGrad);
             }
             let b = self.read(&want)?;
-            let f = |k: usize| -> &[f32] { bytemuck::cast_slice(&b[k]) };
             let p = &mut self.model.particles;
             let n = p.len();
-            let (u, u_lo, v, rho, s) = (f(0), f(1), f(2), f(3), f(4));
+            let (u, u_lo, v) = (b.f32s(Buf::U), b.f32s(Buf::ULo), b.f32s(Buf::V));
+            let (rho, s) = (b.f32s(Buf::Rho), b.f32s(Buf::Stress));
             for i in 0..n {
                 // The displacement is the compensated sum u − u_lo.
                 p.x[i] = [
@@ -555,30 +546,16 @@ impl Backend for GpuBackend {
                 p.rho[i] = rho[i] as f64;
                 p.stress[i] = [s[3 * i] as f64, s[3 * i + 1] as f64, s[3 * i + 2] as f64];
             }
-            let mut k = 5;
             if npc {
-                let a = f(k);
-                for i in 0..n {
-                    p.a[i] = [a[2 * i] as f64, a[2 * i + 1] as f64];
-                }
-                k += 1;
+                p.a = b.pairs(Buf::A, n);
             }
             if lme {
-                let l = f(k);
-                for i in 0..n {
-                    p.lambda[i] = [l[2 * i] as f64, l[2 * i + 1] as f64];
-                }
-                k += 1;
+                p.lambda = b.pairs(Buf::Lambda, n);
             }
             if def_grad {
-                let g = f(k);
-                for i in 0..n {
-                    p.f[i] = [
-                        g[4 * i] as f64,
-                        g[4 * i + 1] as f64,
-                        g[4 * i + 2] as f64,
-                        g[4 * i + 3] as f64,
-                    ];
+                let g = b.f32s(Buf::DefGrad);
+                for (i, f) in p.f.iter_mut().enumerate() {
+                    *f = std::array::from_fn(|c| g[4 * i + c] as f64);
                 }
             }
             self.fresh = true;
@@ -592,5 +569,39 @@ impl Backend for GpuBackend {
 
     fn bytes_per_particle(&self) -> f64 {
         self.buffers.bytes() as f64 / self.model.particles.len().max(1) as f64
+    }
+}
+
+/// Buffers copied to the host by `GpuBackend::read`, looked up by name.
+#[derive(Debug, Default)]
+pub struct ReadBack {
+    bytes: std::collections::BTreeMap<Buf, Vec<u8>>,
+}
+
+impl ReadBack {
+    /// The raw bytes of `b`; panics if `b` was not read (a programming error).
+    pub fn bytes(&self, b: Buf) -> &[u8] {
+        self.bytes
+            .get(&b)
+            .unwrap_or_else(|| panic!("buffer {b:?} was not read back"))
+    }
+
+    /// `b` as f32s.
+    pub fn f32s(&self, b: Buf) -> &[f32] {
+        bytemuck::cast_slice(self.bytes(b))
+    }
+
+    /// The first `n` f32 pairs of `b`, widened.
+    pub fn pairs(&self, b: Buf, n: usize) -> Vec<[f64; 2]> {
+        self.f32s(b)
+            .chunks_exact(2)
+            .take(n)
+            .map(|c| [c[0] as f64, c[1] as f64])
+            .collect()
+    }
+
+    /// The `Sim` state.
+    pub fn sim(&self) -> Sim {
+        bytemuck::pod_read_unaligned(&self.bytes(Buf::Sim)[..std::mem::size_of::<Sim>()])
     }
 }

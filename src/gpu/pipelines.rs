@@ -8,9 +8,9 @@ use super::context::{AtomicMode, GpuContext};
 use super::layout::WG;
 use super::preprocess::{self, Defines};
 use crate::error::{Error, Result};
+use crate::model::shape::Shape;
 use crate::model::{Integrator, Model};
 use crate::scene::NpcPosition;
-use crate::shape::Shape;
 use crate::solver::Stage;
 
 /// One GPU pass: a WGSL file and entry point, run over a domain.
@@ -152,6 +152,11 @@ pub struct Variant {
     /// Material models compiled in.
     pub linear_elastic: bool,
     pub neo_hookean: bool,
+    /// Particles carry a deformation gradient F (`Particles::f`, the
+    /// `DefGrad` buffer): some material needs it. Neo-Hookean does today;
+    /// a finite-strain plastic model would too, which is why this is not
+    /// the `neo_hookean` flag.
+    pub def_grad: bool,
     /// A manufactured solution's body force is applied.
     pub mms: bool,
     /// MLS reconstruction at Gauss points.
@@ -160,7 +165,7 @@ pub struct Variant {
 
 impl Variant {
     pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
-        use crate::material::Material;
+        use crate::model::material::Material;
         Variant {
             linear_elastic: model
                 .materials
@@ -170,6 +175,7 @@ impl Variant {
                 .materials
                 .iter()
                 .any(|m| matches!(m, Material::NeoHookean(_))),
+            def_grad: !model.particles.f.is_empty(),
             lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
             shape: model.shape.kind(),
             integrator: model.integrator,
@@ -202,7 +208,7 @@ impl Variant {
             .flag("LME_STORED", self.lme_stored)
             .flag("MAT_LINEAR_ELASTIC", self.linear_elastic)
             .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
-            .flag("DEF_GRAD", self.neo_hookean)
+            .flag("DEF_GRAD", self.def_grad)
             .flag("MMS", self.mms)
             .flag("MLS", self.mls);
         if let Integrator::Npc { position, .. } = self.integrator {

@@ -2,16 +2,29 @@
 //! constraints, loads and solver settings, built from a checked `Scene`.
 //! Everything here is backend-neutral; `cpu::` and `gpu::` step it.
 
+pub mod energy;
+pub mod fault;
+pub mod gauss;
 mod grid;
+pub mod loads;
+pub mod material;
 mod particles;
+pub mod shape;
+pub mod time_step;
 
 pub use grid::Grid;
+pub use loads::{AlignedVibration, Gravity};
 pub use particles::Particles;
 
 use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::{Fix, IntegratorKind, NpcPosition, Ramp, Scene, seed};
-use crate::shape::Shape;
+use crate::model::material::Material;
+use crate::model::shape::Shape;
+use crate::scene::{Fix, IntegratorKind, NpcPosition, Scene, seed};
+
+/// Nodes lighter than this (kg) count as empty. Relative to the lightest
+/// particle: 1e-9 keeps LME tail nodes (N ≳ 1e-6) and drops only round-off.
+/// Both backends scale it by the lightest particle's mass.
+pub const MASS_EPS_REL: f64 = 1e-9;
 
 /// Bit of `Constraints::fix` for a node fixed in x.
 pub const FIX_X: u8 = 1;
@@ -33,32 +46,6 @@ pub struct Constraints {
     /// Per node: `FIX_X | FIX_Y` bits (0 = free).
     pub fix: Vec<u8>,
     pub groups: Vec<ConstraintGroup>,
-}
-
-/// Gravity with its time history.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gravity {
-    /// Full value (m/s²).
-    pub g: [f64; 2],
-    pub ramp: Ramp,
-    /// T of eq. 45 (s); unused without a ramp.
-    pub period: f64,
-}
-
-impl Gravity {
-    /// Gravity at time `t` (m/s²): paper eq. 45 with a sine ramp.
-    pub fn at(&self, t: f64) -> [f64; 2] {
-        let f = match self.ramp {
-            Ramp::None => 1.0,
-            Ramp::Sine if t <= 0.5 * self.period => {
-                0.5 * ((2.0 * std::f64::consts::PI * t / self.period - std::f64::consts::FRAC_PI_2)
-                    .sin()
-                    + 1.0)
-            }
-            Ramp::Sine => 1.0,
-        };
-        [f * self.g[0], f * self.g[1]]
-    }
 }
 
 /// Time integrator with its parameters.
@@ -111,7 +98,7 @@ pub struct Model {
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
-    pub manufactured: Option<crate::exact::mms::AlignedVibration>,
+    pub manufactured: Option<AlignedVibration>,
 }
 
 impl Model {
@@ -251,7 +238,7 @@ impl Model {
             period: g.ramp_period.unwrap_or(0.0),
         });
         // A manufactured solution sets each particle's initial velocity.
-        let manufactured = crate::exact::mms::AlignedVibration::from_scene(scene);
+        let manufactured = AlignedVibration::from_scene(scene);
         let mut particles = particles;
         if let Some(m) = &manufactured {
             for i in 0..particles.len() {

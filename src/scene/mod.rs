@@ -93,15 +93,6 @@ impl Scene {
             .expect("validated: every body names an existing material")
     }
 
-    /// Largest initial speed of any body (m/s).
-    pub fn max_initial_speed(&self) -> f64 {
-        self.file
-            .bodies
-            .values()
-            .map(|b| b.velocity[0].hypot(b.velocity[1]))
-            .fold(0.0, f64::max)
-    }
-
     /// Particle layout of a body, resolving the shape-dependent default.
     pub fn layout(&self, body: &BodySpec) -> Layout {
         body.layout.unwrap_or(match self.file.solver.shape {

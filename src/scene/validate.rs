@@ -6,7 +6,7 @@
 use super::Scene;
 use super::schema::*;
 use crate::error::SceneError;
-use crate::shape::lme;
+use crate::limits;
 
 fn finite(key: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
@@ -132,8 +132,8 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     if s.shape == ShapeKind::Lme {
         finite("solver.lme_gamma", s.lme_gamma)?;
         let (gmin, gmax) = (
-            lme::gamma_min(s.lme_tol),
-            lme::gamma_max(s.lme_tol, g.perturb),
+            limits::lme_gamma_min(s.lme_tol),
+            limits::lme_gamma_max(s.lme_tol, g.perturb),
         );
         if !(s.lme_gamma >= gmin && s.lme_gamma <= gmax) {
             return Err(SceneError::invalid(
@@ -143,7 +143,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
                      (above, the support cannot enclose a cell; below, it spans more than {} cells), got {}",
                     s.lme_tol,
                     g.perturb,
-                    lme::MAX_REACH_CELLS,
+                    limits::LME_MAX_REACH_CELLS,
                     s.lme_gamma
                 ),
             ));

@@ -11,8 +11,8 @@ use crate::error::Result;
 use crate::exact::Errors;
 use crate::exact::column::ElasticColumn;
 use crate::model::Model;
-use crate::run::BackendChoice;
 use crate::scene::Scene;
+use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 

@@ -11,8 +11,8 @@ use crate::chart::{LineChart, Series};
 use crate::error::Result;
 use crate::exact::Errors;
 use crate::exact::dyka::DykaBar;
-use crate::run::BackendChoice;
 use crate::scene::Scene;
+use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 

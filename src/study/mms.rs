@@ -13,8 +13,8 @@ use crate::chart::{LineChart, Series};
 use crate::error::Result;
 use crate::exact::Errors;
 use crate::exact::mms::{AlignedVibration, MmsErrors};
-use crate::run::BackendChoice;
 use crate::scene::Scene;
+use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -110,7 +110,7 @@ pub fn final_errors(r: &JobResult) -> Option<&MmsErrors> {
 fn period_errors(r: &JobResult, exact: &AlignedVibration) -> Option<MmsErrors> {
     let d = r.data()?;
     if let Some((t, p)) = d.snapshots.first() {
-        return Some(exact.score(p, *t));
+        return Some(crate::exact::mms::score(exact, p, *t));
     }
     (d.t_end <= PERIOD * (1.0 + 1e-9))
         .then(|| final_errors(r).cloned())

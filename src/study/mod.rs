@@ -11,7 +11,7 @@ pub mod runner;
 pub mod stability;
 
 use crate::error::{Error, Result};
-use crate::run::BackendChoice;
+use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 

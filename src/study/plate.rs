@@ -11,7 +11,7 @@ use crate::cases::PLATE_IMPACT;
 use crate::chart::{Panel, ParticleImage};
 use crate::error::Result;
 use crate::model::Particles;
-use crate::run::BackendChoice;
+use crate::simulation::BackendChoice;
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

@@ -4,11 +4,11 @@
 //! is a result row, never an abort of the study.
 
 use crate::backend::{Backend, Sample};
-use crate::exact::{self, Errors};
-use crate::model::{Model, Particles};
-use crate::run::{BackendChoice, make_backend};
+use crate::exact::Errors;
+use crate::model::Particles;
 use crate::scene::{Override, Scene};
-use crate::solver::{self, Observer, RunStatus, Schedule};
+use crate::simulation::{BackendChoice, BackendSpec, Simulation};
+use crate::solver::{Observer, RunStatus, Schedule};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::VecDeque;
 use std::sync::Mutex;
@@ -131,19 +131,18 @@ impl JobResult {
 struct Keeper {
     samples: Vec<Sample>,
     snapshots: Vec<(f64, Particles)>,
-    error: Option<String>,
 }
 
 impl Observer for Keeper {
-    fn sample(&mut self, s: &Sample) {
+    fn sample(&mut self, s: &Sample) -> crate::Result<()> {
         self.samples.push(s.clone());
+        Ok(())
     }
-    fn snapshot(&mut self, backend: &mut dyn Backend) {
+    fn snapshot(&mut self, backend: &mut dyn Backend) -> crate::Result<()> {
         let t = backend.time();
-        match backend.particles() {
-            Ok(p) => self.snapshots.push((t, p.clone())),
-            Err(e) => self.error = Some(e.to_string()),
-        }
+        let p = backend.particles()?;
+        self.snapshots.push((t, p.clone()));
+        Ok(())
     }
 }
 
@@ -156,40 +155,37 @@ fn run_one(job: &Job, threads: usize, gpu_lock: &Mutex<()>) -> Result<RunData, S
         .map_err(|e| e.to_string())?;
     let scene = Scene::from_str(job.case, job.case_name, job.case_name, &overrides)
         .map_err(|e| e.to_string())?;
-    let model = Model::new(&scene).map_err(|e| e.to_string())?;
-    let probe_x0 = model
-        .probes
-        .iter()
-        .map(|p| (p.name.clone(), model.particles.x0[p.particle]))
-        .collect();
     // GPU jobs share one adapter: run them one at a time.
     let _gpu = (job.backend != BackendChoice::Cpu)
         .then(|| gpu_lock.lock().unwrap_or_else(|e| e.into_inner()));
-    let mut backend = make_backend(job.backend, None, model, false, Default::default())
-        .map_err(|e| e.to_string())?;
+    let mut sim =
+        Simulation::new(&scene, &BackendSpec::new(job.backend)).map_err(|e| e.to_string())?;
+    let probe_x0 = {
+        let model = sim.backend_ref().model();
+        model
+            .probes
+            .iter()
+            .map(|p| (p.name.clone(), model.particles.x0[p.particle]))
+            .collect()
+    };
     let schedule = Schedule {
-        sample_interval: scene.sample_interval,
-        vtk_interval: None,
         snapshot_times: job.snapshot_times.clone(),
+        vtk_interval: None,
+        ..sim.schedule()
     };
     let mut keeper = Keeper {
         samples: Vec::new(),
         snapshots: Vec::new(),
-        error: None,
     };
     let start = Instant::now();
-    let status =
-        solver::drive(backend.as_mut(), schedule, &mut keeper).map_err(|e| e.to_string())?;
+    let status = sim
+        .drive_with(schedule, &mut keeper)
+        .map_err(|e| e.to_string())?;
     let wall = start.elapsed().as_secs_f64();
-    if let Some(e) = keeper.error {
-        return Err(e);
-    }
+    let errors = sim.score().map_err(|e| e.to_string())?;
+    let backend = sim.backend();
     let t = backend.time();
     let particles = backend.particles().map_err(|e| e.to_string())?.clone();
-    let errors = scene
-        .file
-        .exact
-        .map(|k| exact::score(k, &scene, backend.model(), &particles, t));
     Ok(RunData {
         status,
         t,

@@ -9,7 +9,7 @@ use crate::cases::{DYKA_BAR, DYKA_L, ELASTIC_BLOCK, PLATE_IMPACT};
 use crate::chart::{Status, StatusGrid};
 use crate::error::Result;
 use crate::exact::Errors;
-use crate::run::BackendChoice;
+use crate::simulation::BackendChoice;
 use crate::solver::RunStatus;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

@@ -1,14 +1,12 @@
 //! Helpers shared by the integration tests: run a case file on the CPU path
-//! in memory (no output files) and score it.
+//! in memory (no output files) as a `Simulation`, and score it.
 
 #![allow(dead_code)]
 
-use lme_mpm::backend::Backend;
-use lme_mpm::cpu::CpuBackend;
-use lme_mpm::exact::{self, Errors};
-use lme_mpm::model::Model;
+use lme_mpm::exact::Errors;
 use lme_mpm::scene::{Override, Scene};
-use lme_mpm::solver::{self, Recorder, RunStatus, Schedule};
+use lme_mpm::simulation::{BackendSpec, Simulation};
+use lme_mpm::solver::{Recorder, RunStatus, Schedule};
 use std::path::PathBuf;
 
 pub fn case(name: &str) -> PathBuf {
@@ -24,7 +22,7 @@ pub fn scene(name: &str, sets: &[&str]) -> Scene {
 
 pub struct Run {
     pub status: RunStatus,
-    pub backend: CpuBackend,
+    pub sim: Simulation,
     pub recorder: Recorder,
     pub errors: Option<Errors>,
 }
@@ -32,23 +30,17 @@ pub struct Run {
 /// Runs `name` with overrides on the CPU path and scores it.
 pub fn run(name: &str, sets: &[&str]) -> Run {
     let scene = scene(name, sets);
-    let model = Model::new(&scene).unwrap();
-    let mut backend = CpuBackend::new(model);
+    let mut sim = Simulation::new(&scene, &BackendSpec::cpu()).unwrap();
     let mut recorder = Recorder::default();
     let schedule = Schedule {
-        sample_interval: scene.sample_interval,
         vtk_interval: None,
-        ..Default::default()
+        ..sim.schedule()
     };
-    let status = solver::drive(&mut backend, schedule, &mut recorder).unwrap();
-    let t = backend.time();
-    let errors = scene
-        .file
-        .exact
-        .map(|k| exact::score(k, &scene, &backend.model, &backend.model.particles, t));
+    let status = sim.drive_with(schedule, &mut recorder).unwrap();
+    let errors = sim.score().unwrap();
     Run {
         status,
-        backend,
+        sim,
         recorder,
         errors,
     }

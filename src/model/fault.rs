@@ -1,7 +1,7 @@
 //! Why a run went unstable, and which particle showed it first. A fault is
 //! a result of the run (status `unstable`), never a panic.
 
-use crate::shape::ShapeFault;
+use crate::model::shape::ShapeFault;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FaultKind {

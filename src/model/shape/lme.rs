@@ -8,9 +8,9 @@
 use super::ShapeFault;
 use crate::model::Grid;
 
-/// The support may span at most this many cells from the particle: it bounds
-/// the stencil (and per-particle memory) and sets the smallest γ allowed.
-pub const MAX_REACH_CELLS: f64 = 6.0;
+pub use crate::limits::{
+    LME_MAX_REACH_CELLS as MAX_REACH_CELLS, lme_gamma_max as gamma_max, lme_gamma_min as gamma_min,
+};
 /// Newton stops when |r| ≤ NEWTON_TOL · h and the Newton step
 /// |J⁻¹ r| ≤ NEWTON_TOL / h. The first bounds the linear-reproduction error
 /// (Σ N_a x_a − x = r), the second the gradient-consistency error
@@ -23,20 +23,6 @@ pub const NEWTON_MAX_ITER: u32 = 50;
 const LINE_SEARCH_MAX: u32 = 40;
 /// Armijo constant of the line search.
 const ARMIJO: f64 = 1e-4;
-
-/// Smallest γ whose support stays within `MAX_REACH_CELLS` (0.38 for tol = 1e-6).
-pub fn gamma_min(tol: f64) -> f64 {
-    -tol.ln() / (MAX_REACH_CELLS * MAX_REACH_CELLS)
-}
-
-/// Largest γ for which the support (radius r) holds 3 nodes that are not
-/// collinear around any point. The worst point is the middle of a cell
-/// edge: its two nearest nodes lie on the edge and the next are √5/2 h
-/// away, so r ≥ (√5/2 + √2·perturb)·h, with 2% to spare (10.6 for tol 1e-6).
-pub fn gamma_max(tol: f64, perturb: f64) -> f64 {
-    let reach = 1.02 * (0.5 * 5f64.sqrt() + std::f64::consts::SQRT_2 * perturb);
-    -tol.ln() / (reach * reach)
-}
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lme {

@@ -9,7 +9,7 @@ pub mod neo_hookean;
 pub use linear_elastic::LinearElastic;
 pub use neo_hookean::{DefGrad, NeoHookean};
 
-use crate::fault::FaultKind;
+use crate::model::fault::FaultKind;
 use crate::scene::{MaterialModel, MaterialSpec};
 
 #[derive(Debug, Clone, PartialEq)]

@@ -1,0 +1,22 @@
+//! Bounds that scene validation and the shape functions both need, kept
+//! here so `scene/` checks a scene without reaching into `model::shape`.
+//! Pure numbers and formulas: this module imports nothing.
+
+/// An LME support may span at most this many cells from the particle: it
+/// bounds the stencil (and per-particle memory) and sets the smallest γ allowed.
+pub const LME_MAX_REACH_CELLS: f64 = 6.0;
+
+/// Smallest LME γ whose support stays within `LME_MAX_REACH_CELLS`
+/// (0.38 for tol = 1e-6).
+pub fn lme_gamma_min(tol: f64) -> f64 {
+    -tol.ln() / (LME_MAX_REACH_CELLS * LME_MAX_REACH_CELLS)
+}
+
+/// Largest LME γ for which the support (radius r) holds 3 nodes that are
+/// not collinear around any point. The worst point is the middle of a cell
+/// edge: its two nearest nodes lie on the edge and the next are √5/2 h
+/// away, so r ≥ (√5/2 + √2·perturb)·h, with 2% to spare (10.6 for tol 1e-6).
+pub fn lme_gamma_max(tol: f64, perturb: f64) -> f64 {
+    let reach = 1.02 * (0.5 * 5f64.sqrt() + std::f64::consts::SQRT_2 * perturb);
+    -tol.ln() / (reach * reach)
+}

@@ -1,0 +1,59 @@
+//! The time-step rule both backends follow (paper eq. 43): Δt = CFL · h /
+//! max_p max(|v_p|, c_p), c_p the material's P-wave speed at the particle's
+//! current density, or the scene's fixed `solver.dt`; and the last-step
+//! rule: a step that would reach within `LAST_STEP_REL` of t_end is
+//! shortened to land on it exactly. The CPU stage `cfl` is this rule; its
+//! WGSL twins are `shaders/cfl.wgsl` and `shaders/step_begin.wgsl`.
+
+use crate::model::Model;
+use crate::model::material::Material;
+use rayon::prelude::*;
+
+/// A step of Δt ≥ (1 − LAST_STEP_REL) × (t_end − t) is the last one and
+/// lands on t_end. Mirrored in `shaders/step_begin.wgsl` (checked by
+/// tests/gpu_shaders.rs).
+pub const LAST_STEP_REL: f64 = 1e-6;
+
+/// Δt of a step starting at `t` (s), and whether it is the last.
+pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
+    let p = &model.particles;
+    let c = max_speed(
+        &p.v,
+        &p.rho,
+        &p.body,
+        &model.materials,
+        &model.body_material,
+    );
+    step_of(model, c, t)
+}
+
+/// Δt (s) and whether it is the last, given the largest signal speed `c` (m/s).
+pub fn step_of(model: &Model, c: f64, t: f64) -> (f64, bool) {
+    let dt = model
+        .fixed_dt
+        .unwrap_or(model.cfl * model.grid.min_spacing() / c);
+    let rem = model.t_end - t;
+    if dt >= rem * (1.0 - LAST_STEP_REL) {
+        (rem, true)
+    } else {
+        (dt, false)
+    }
+}
+
+/// Largest signal speed over all particles (m/s).
+pub fn max_speed(
+    v: &[[f64; 2]],
+    rho: &[f64],
+    body: &[u32],
+    materials: &[Material],
+    body_material: &[u32],
+) -> f64 {
+    (v, rho, body)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|(v, &r, &b)| {
+            let c = materials[body_material[b as usize] as usize].wave_speed(r);
+            (v[0] * v[0] + v[1] * v[1]).sqrt().max(c)
+        })
+        .reduce(|| 0.0, f64::max)
+}
