@@ -1,11 +1,21 @@
 //! lme-mpm: a 2D Material Point Method with Local Max-Ent (LME) shape
 //! functions and the Newmark predictor-corrector (NPC) of Molinos et al.,
-//! beside linear (Q4) and uGIMP shape functions and Forward Euler, with a
-//! CPU reference path (f64, rayon) whose stages have WGSL twins.
+//! beside linear (Q4), uGIMP and B-spline (quadratic, cubic, optionally with
+//! MLS reconstruction) shape functions and Forward Euler, with a CPU
+//! reference path (f64, rayon) whose stages have WGSL twins (wgpu).
 //!
-//! A run: `scene::Scene::load` → `model::Model::new` → a `backend::Backend`
-//! (`cpu::CpuBackend`) → `solver::drive` → `output`. The step itself is the
-//! ordered stage list `solver::STEP`.
+//! Layers, bottom up (`tests/layers.rs` keeps them pointing one way):
+//! `limits`, `scene` (the file, validated) → `model` (grid, particles,
+//! shape functions, materials, loads, energy, the time-step rule) →
+//! `backend` (the contract) → `cpu`, `gpu` (the two backends, never
+//! importing each other) → `solver` (the step as a stage list, the driver)
+//! → `simulation` (scene + backend + drive + score: one run) → `exact`
+//! (scoring), `output`, `run`, `study`, `bench` (the commands).
+//!
+//! A run: `scene::Scene::load` → `simulation::Simulation::new` (builds the
+//! `model::Model`, opens a `backend::Backend`) → `Simulation::drive` (the
+//! stages of `solver::STEP`, sampled by an `solver::Observer`) →
+//! `Simulation::score` → `output`.
 
 pub mod backend;
 pub mod bench;

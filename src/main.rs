@@ -1,5 +1,5 @@
-//! The `lme-mpm` command line: run, check. Exit codes: 0 completed,
-//! 2 invalid input, 3 unstable run, 1 anything else.
+//! The `lme-mpm` command line: run, check, info, study, bench. Exit codes:
+//! 0 completed, 2 invalid input, 3 unstable run, 1 anything else.
 
 use clap::{Parser, Subcommand};
 use lme_mpm::run::{self, BackendChoice, RunOptions};
@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME/uGIMP/linear shape functions, FE/NPC time integration, CPU and GPU (wgpu)", long_about = None)]
+#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC time integration, linear elastic and Neo-Hookean materials, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -1,6 +1,6 @@
 //! Every struct shared with WGSL, defined once here with explicit padding
 //! and a compile-time size check. Keep in sync with shaders/shared/types.wgsl;
-//! tests/gpu_layout.rs compares offsets and sizes with naga's reflection.
+//! tests/gpu_shaders.rs compares offsets and sizes with naga's reflection.
 
 use bytemuck::{Pod, Zeroable};
 

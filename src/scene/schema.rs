@@ -238,7 +238,8 @@ pub struct SolverSpec {
     pub dt: Option<f64>,
     /// Moving-least-squares reconstruction (B-spline paper): mass, momentum,
     /// body force and stress reconstructed at 2 × 2 Gauss points per cell and
-    /// integrated there. With `bspline2`, `bspline3`, `linear` or `lme`. Default false.
+    /// integrated there. With `bspline2`, `bspline3` or `linear` on a regular
+    /// grid (uGIMP, LME and perturbed grids are refused). Default false.
     #[serde(default)]
     pub mls: bool,
 }
