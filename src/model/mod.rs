@@ -126,88 +126,8 @@ impl Model {
         let ppc = scene.bodies().next().map(|(_, b)| b.ppc).unwrap_or(2);
         let shape = Shape::new(scene.solver(), h, ppc, f.grid.perturb);
 
-        // Grid extent on the lattice through `anchor`.
-        let snap = |v: f64, a: f64, up: bool| {
-            let q = (v - a) / h;
-            let q = if (q - q.round()).abs() < 1e-9 {
-                q.round()
-            } else {
-                q
-            };
-            a + h * if up { q.ceil() } else { q.floor() }
-        };
-        let (lo, hi) = match (f.grid.min, f.grid.max) {
-            (Some(lo), Some(hi)) => (lo, hi),
-            _ => {
-                let pad = scene.margin + shape.reach_cells() as f64 * h;
-                let mut lo = [bbox[0] - pad, bbox[1] - pad];
-                let mut hi = [bbox[2] + pad, bbox[3] + pad];
-                // A wall stops the grid: nothing moves into it, and nodes
-                // inside it would only pin the body over the support width.
-                let ghost = shape.wall_ghost_cells() as f64 * h;
-                for (axis, upper, at) in walls(scene, bbox) {
-                    if upper {
-                        hi[axis] = hi[axis].min(at + ghost);
-                    } else {
-                        lo[axis] = lo[axis].max(at - ghost);
-                    }
-                }
-                (lo, hi)
-            }
-        };
-        let lo = [snap(lo[0], anchor[0], false), snap(lo[1], anchor[1], false)];
-        let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
-        let nx = ((hi[0] - lo[0]) / h).round() as usize + 1;
-        let ny = ((hi[1] - lo[1]) / h).round() as usize + 1;
-        if let Shape::Bspline(b) = &shape {
-            if nx < b.degree + 2 || ny < b.degree + 2 {
-                return Err(SceneError::invalid(
-                    "grid.h",
-                    format!(
-                        "gives {nx} x {ny} nodes; degree-{} B-splines need at least {} per direction",
-                        b.degree,
-                        b.degree + 2
-                    ),
-                ));
-            }
-        }
-        if nx < 2 || ny < 2 {
-            return Err(SceneError::invalid(
-                "grid.max",
-                "the grid must span at least one cell",
-            ));
-        }
-        if (nx as u64) * (ny as u64) > u32::MAX as u64 / 2 {
-            return Err(SceneError::invalid(
-                "grid.h",
-                format!(
-                    "gives {nx} x {ny} nodes, more than 2^31: use a larger h or a smaller grid"
-                ),
-            ));
-        }
-        let grid = Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed);
-
-        let margin = shape.edge_margin();
-        if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
-            return Err(SceneError::invalid(
-                format!("bodies.{}", body_names[s.body as usize]),
-                format!(
-                    "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
-                     enlarge grid.min/grid.max or drop them to derive the extent",
-                    s.x[0],
-                    s.x[1],
-                    grid.min[0],
-                    grid.min[1],
-                    grid.max()[0],
-                    grid.max()[1],
-                    if margin > 0.0 {
-                        format!(" or within {margin:.6} m of its edge")
-                    } else {
-                        String::new()
-                    }
-                ),
-            ));
-        }
+        let grid = build_grid(scene, &shape, bbox, anchor)?;
+        check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
 
         let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
         let body_material: Vec<u32> = scene
@@ -280,6 +200,107 @@ impl Model {
     pub fn material_of(&self, p: usize) -> &Material {
         &self.materials[self.body_material[self.particles.body[p] as usize] as usize]
     }
+}
+
+/// The grid: `grid.min`/`grid.max` when given, else the bodies' box padded
+/// by the shape's reach and the scene's margin, stopped at walls, snapped
+/// to the lattice through `anchor`; perturbed when the scene asks.
+fn build_grid(
+    scene: &Scene,
+    shape: &Shape,
+    bbox: [f64; 4],
+    anchor: [f64; 2],
+) -> Result<Grid, SceneError> {
+    let f = &scene.file;
+    let h = f.grid.h;
+    // Grid extent on the lattice through `anchor`.
+    let snap = |v: f64, a: f64, up: bool| {
+        let q = (v - a) / h;
+        let q = if (q - q.round()).abs() < 1e-9 {
+            q.round()
+        } else {
+            q
+        };
+        a + h * if up { q.ceil() } else { q.floor() }
+    };
+    let (lo, hi) = match (f.grid.min, f.grid.max) {
+        (Some(lo), Some(hi)) => (lo, hi),
+        _ => {
+            let pad = scene.margin + shape.reach_cells() as f64 * h;
+            let mut lo = [bbox[0] - pad, bbox[1] - pad];
+            let mut hi = [bbox[2] + pad, bbox[3] + pad];
+            // A wall stops the grid: nothing moves into it, and nodes
+            // inside it would only pin the body over the support width.
+            let ghost = shape.wall_ghost_cells() as f64 * h;
+            for (axis, upper, at) in walls(scene, bbox) {
+                if upper {
+                    hi[axis] = hi[axis].min(at + ghost);
+                } else {
+                    lo[axis] = lo[axis].max(at - ghost);
+                }
+            }
+            (lo, hi)
+        }
+    };
+    let lo = [snap(lo[0], anchor[0], false), snap(lo[1], anchor[1], false)];
+    let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
+    let nx = ((hi[0] - lo[0]) / h).round() as usize + 1;
+    let ny = ((hi[1] - lo[1]) / h).round() as usize + 1;
+    if let Shape::Bspline(b) = &shape {
+        if nx < b.degree + 2 || ny < b.degree + 2 {
+            return Err(SceneError::invalid(
+                "grid.h",
+                format!(
+                    "gives {nx} x {ny} nodes; degree-{} B-splines need at least {} per direction",
+                    b.degree,
+                    b.degree + 2
+                ),
+            ));
+        }
+    }
+    if nx < 2 || ny < 2 {
+        return Err(SceneError::invalid(
+            "grid.max",
+            "the grid must span at least one cell",
+        ));
+    }
+    if (nx as u64) * (ny as u64) > u32::MAX as u64 / 2 {
+        return Err(SceneError::invalid(
+            "grid.h",
+            format!("gives {nx} x {ny} nodes, more than 2^31: use a larger h or a smaller grid"),
+        ));
+    }
+    Ok(Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed))
+}
+
+/// Every seeded particle lies inside the grid, `margin` (m) from its edge.
+fn check_inside(
+    grid: &Grid,
+    seeds: &[seed::Seed],
+    body_names: &[String],
+    margin: f64,
+) -> Result<(), SceneError> {
+    if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
+        return Err(SceneError::invalid(
+            format!("bodies.{}", body_names[s.body as usize]),
+            format!(
+                "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
+                 enlarge grid.min/grid.max or drop them to derive the extent",
+                s.x[0],
+                s.x[1],
+                grid.min[0],
+                grid.min[1],
+                grid.max()[0],
+                grid.max()[1],
+                if margin > 0.0 {
+                    format!(" or within {margin:.6} m of its edge")
+                } else {
+                    String::new()
+                }
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Constraints that are walls: a half-plane region beyond the bodies
