@@ -272,6 +272,17 @@ fn completed_run_writes_every_output() {
     let n = s["particles"].as_u64().unwrap() as usize;
     assert!(s["particle_steps_per_second"].as_f64().unwrap() > 0.0);
     assert!(s["errors"]["rms_velocity"].as_f64().unwrap() > 0.0);
+    // Every error figure also relative to the field's scale (5 m/s here).
+    let e = &s["errors"];
+    for (abs, rel) in [
+        ("rms_velocity", "rms_velocity_relative"),
+        ("max_velocity", "max_velocity_relative"),
+    ] {
+        let (a, r) = (e[abs].as_f64().unwrap(), e[rel].as_f64().unwrap());
+        assert!((a / 5.0 - r).abs() < 1e-12 * r, "{abs} {a} vs {rel} {r}");
+    }
+    // The preflight's figures reach the summary.
+    assert!(s["memory_estimate_bytes"].as_u64().unwrap() > 1 << 20);
     assert_eq!(
         s["backend"].as_str().unwrap().split(' ').next(),
         Some("cpu")
