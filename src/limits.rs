@@ -30,3 +30,12 @@ pub const COORD_MAX: f64 = 1e6;
 /// Largest scene file read (bytes): a scene is a few kilobytes; this
 /// stops `lme-mpm check /dev/zero` at once.
 pub const SCENE_FILE_MAX: u64 = 16 << 20;
+
+/// Most shapes (rects, disks, polygons) over all bodies: validation checks
+/// rectangle pairs and seeding checks each point against earlier shapes,
+/// both quadratic in this count.
+pub const MAX_SHAPES: usize = 1000;
+
+/// Most polygon vertices over all bodies (each seeded point is tested
+/// against a polygon's every edge).
+pub const MAX_POLYGON_VERTICES: usize = 10_000;

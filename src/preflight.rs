@@ -242,7 +242,7 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         let c = m.wave_speed(m.density());
         let v = b.velocity[0].hypot(b.velocity[1]);
         let s = c.max(v);
-        if !(s <= c_max) {
+        if s > c_max || s.is_nan() {
             c_max = s;
             c_key = if c >= v {
                 format!("materials.{}.E", b.material)
@@ -407,7 +407,7 @@ pub fn plan(scene: &Scene, limits: &Limits, threads: usize) -> Result<Plan, Scen
             ),
         ));
     }
-    if !(est.steps <= limits.max_steps as f64) {
+    if est.steps > limits.max_steps as f64 || est.steps.is_nan() {
         return Err(SceneError::invalid(
             format!("{}` / `solver.t_end", est.dt_key),
             format!(

@@ -408,6 +408,19 @@ fn absurd_sizes_end_at_once_with_exit_2_naming_the_key() {
     let (dyka, plate) = (dyka.to_str().unwrap(), plate.to_str().unwrap());
     let out = tmp("absurd");
     let out_s = out.to_str().unwrap();
+    // 5,000 touching rectangles: the pairwise overlap check was quadratic.
+    let rects: Vec<String> = (0..5000)
+        .map(|i| format!("[{}, 0, {}, 1]", i, i + 1))
+        .collect();
+    let many = scene_file(
+        &tmp("many-shapes"),
+        &format!(
+            "[grid]\nh = 1.0\n[materials.m]\nmodel = \"linear_elastic\"\ndensity = 1.0\nE = 1.0\n\
+             nu = 0.0\n[bodies.a]\nmaterial = \"m\"\nrects = [{}]\n[solver]\nt_end = 1.0\n",
+            rects.join(", ")
+        ),
+    );
+    let many = many.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["run", dyka, "--set", "grid.h=1e-9"], "grid.h"),
         (vec!["check", dyka, "--set", "grid.h=1e-6"], "grid.h"),
@@ -454,6 +467,7 @@ fn absurd_sizes_end_at_once_with_exit_2_naming_the_key() {
             "grid.margin",
         ),
         (vec!["check", "/dev/zero"], "16 MiB"),
+        (vec!["check", many], "5000 shapes"),
         (
             vec!["run", dyka, "--set", "output.probes.far=[10, 10]"],
             "output.probes.far",

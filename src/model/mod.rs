@@ -296,7 +296,8 @@ pub fn grid_extent(scene: &Scene, shape: &Shape) -> Result<GridExtent, SceneErro
     let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
     let fx = ((hi[0] - lo[0]) / h).round() + 1.0;
     let fy = ((hi[1] - lo[1]) / h).round() + 1.0;
-    if !(fx * fy <= MAX_NODES as f64) {
+    // NaN counts (never from a validated scene) are refused too.
+    if fx * fy > MAX_NODES as f64 || (fx * fy).is_nan() {
         let (key, why) = if f.grid.min.is_some() {
             ("grid.h` / `grid.min` / `grid.max", String::new())
         } else if scene.margin > 0.0 {

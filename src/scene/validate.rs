@@ -270,6 +270,34 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             }
         }
     }
+    let shapes: usize = file
+        .bodies
+        .values()
+        .map(|b| b.rects.len() + b.disks.len() + b.polygons.len())
+        .sum();
+    if shapes > limits::MAX_SHAPES {
+        return Err(SceneError::invalid(
+            "bodies",
+            format!(
+                "hold {shapes} shapes, more than {}: merge rectangles",
+                limits::MAX_SHAPES
+            ),
+        ));
+    }
+    let vertices: usize = file
+        .bodies
+        .values()
+        .flat_map(|b| b.polygons.iter().map(Vec::len))
+        .sum();
+    if vertices > limits::MAX_POLYGON_VERTICES {
+        return Err(SceneError::invalid(
+            "bodies",
+            format!(
+                "hold {vertices} polygon vertices, more than {}",
+                limits::MAX_POLYGON_VERTICES
+            ),
+        ));
+    }
     check_rect_overlaps(&file)?;
 
     // --- constraints ------------------------------------------------------
