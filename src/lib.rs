@@ -29,6 +29,7 @@ pub mod gpu;
 pub mod limits;
 pub mod model;
 pub mod output;
+pub mod preflight;
 pub mod rng;
 pub mod run;
 pub mod scene;

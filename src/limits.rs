@@ -20,3 +20,22 @@ pub fn lme_gamma_max(tol: f64, perturb: f64) -> f64 {
     let reach = 1.02 * (0.5 * 5f64.sqrt() + std::f64::consts::SQRT_2 * perturb);
     -tol.ln() / (reach * reach)
 }
+
+/// Largest |coordinate| (m) a scene may use: shapes, grid corners, origin,
+/// probes and finite constraint bounds. A kilometre-scale scene fits a
+/// thousand times over; beyond this, f64 positions lose the sub-millimetre
+/// resolution a cell needs and counts over the domain overflow.
+pub const COORD_MAX: f64 = 1e6;
+
+/// Largest scene file read (bytes): a scene is a few kilobytes; this
+/// stops `lme-mpm check /dev/zero` at once.
+pub const SCENE_FILE_MAX: u64 = 16 << 20;
+
+/// Most shapes (rects, disks, polygons) over all bodies: validation checks
+/// rectangle pairs and seeding checks each point against earlier shapes,
+/// both quadratic in this count.
+pub const MAX_SHAPES: usize = 1000;
+
+/// Most polygon vertices over all bodies (each seeded point is tested
+/// against a polygon's every edge).
+pub const MAX_POLYGON_VERTICES: usize = 10_000;

@@ -36,15 +36,21 @@ enum Command {
         /// Override a scene key, e.g. --set solver.shape=ugimp --set grid.h=0.0005 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// No progress bar and no result line.
+        /// No progress bar and no result line (warnings and errors still print).
         #[arg(long, short)]
         quiet: bool,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
-    /// Check a scene without running it: prints particles, nodes, time step and memory.
+    /// Check a scene without running it: estimates particles, nodes, steps,
+    /// memory and time from the shapes (refusing what `run` would refuse),
+    /// then builds the model and prints what will run.
     Check {
         scene: PathBuf,
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
     /// List GPU adapters: backend, device type, float-atomic support, key limits.
     Info,
@@ -66,12 +72,11 @@ enum Command {
         /// Runs at once (default: one per core).
         #[arg(long)]
         jobs: Option<usize>,
-        /// Markdown file whose study sections are regenerated.
-        #[arg(long, default_value = "docs/verification.md")]
-        doc: PathBuf,
-        /// Do not touch the docs.
+        /// Also regenerate the study's section of this markdown file (e.g.
+        /// docs/verification.md) and copy its charts to charts/ beside it.
+        /// Without it, a study writes only into --out. Ignored with --quick.
         #[arg(long)]
-        no_doc: bool,
+        doc: Option<PathBuf>,
     },
     /// Measure particle-steps per second of whole steps on a synthetic scene,
     /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
@@ -105,6 +110,46 @@ enum Command {
     },
 }
 
+/// Preflight limits of `run` and `check` (see docs/outputs.md).
+#[derive(clap::Args, Debug, Clone)]
+struct LimitArgs {
+    /// Refuse a run whose estimated peak memory exceeds SIZE (bytes, or with
+    /// K/M/G/T, e.g. 2G). Default: the memory available now (MemAvailable).
+    #[arg(long, value_name = "SIZE", value_parser = lme_mpm::preflight::parse_size)]
+    max_memory: Option<u64>,
+    /// Refuse a run of more than N estimated steps (t_end / first time step).
+    #[arg(long, value_name = "N", default_value_t = lme_mpm::preflight::DEFAULT_MAX_STEPS)]
+    max_steps: u64,
+    /// Refuse a run estimated to take more than H hours at a conservative
+    /// speed of the CPU path. Default: no limit (runs over 1 h only warn).
+    #[arg(long, value_name = "H")]
+    max_hours: Option<f64>,
+    /// Allow more than 1000 VTK snapshots (output.vtk_interval).
+    #[arg(long)]
+    allow_many_snapshots: bool,
+}
+
+impl LimitArgs {
+    fn limits(&self) -> lme_mpm::preflight::Limits {
+        lme_mpm::preflight::Limits {
+            max_memory: self.max_memory,
+            max_steps: self.max_steps,
+            max_hours: self.max_hours,
+            allow_many_snapshots: self.allow_many_snapshots,
+        }
+    }
+}
+
+/// `--adapter` picks among GPU adapters: with `--backend cpu` it would be ignored.
+fn adapter_without_gpu(adapter: &Option<String>, cpu: bool) -> Option<ExitCode> {
+    (adapter.is_some() && cpu).then(|| {
+        eprintln!(
+            "error: --adapter names a GPU adapter, but --backend cpu runs no GPU: drop one of them"
+        );
+        ExitCode::from(2)
+    })
+}
+
 fn load(path: &std::path::Path, set: &[String]) -> Result<Scene, SceneError> {
     let overrides = set
         .iter()
@@ -135,7 +180,11 @@ fn main() -> ExitCode {
             out,
             set,
             quiet,
+            limits,
         } => {
+            if let Some(code) = adapter_without_gpu(&adapter, backend == BackendChoice::Cpu) {
+                return code;
+            }
             let scene = match load(&scene, &set) {
                 Ok(s) => s,
                 Err(e) => return fail(&Error::Scene(e)),
@@ -147,6 +196,7 @@ fn main() -> ExitCode {
                 out: out.clone(),
                 progress: !quiet && std::io::stderr().is_terminal(),
                 verbose: !quiet,
+                limits: limits.limits(),
             };
             match run::run(&scene, &opts) {
                 Ok(outcome) => {
@@ -185,7 +235,6 @@ fn main() -> ExitCode {
             quick,
             jobs,
             doc,
-            no_doc,
         } => {
             let opts = StudyOptions {
                 backend,
@@ -193,7 +242,7 @@ fn main() -> ExitCode {
                 quick,
                 jobs: jobs
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
-                doc: (!no_doc).then_some(doc),
+                doc: doc.clone(),
                 progress: std::io::stderr().is_terminal(),
             };
             match lme_mpm::study::run(name, &opts) {
@@ -207,6 +256,18 @@ fn main() -> ExitCode {
                             failed,
                             opts.out.join(r.study.slug()).display()
                         );
+                    }
+                    match (&doc, quick) {
+                        (Some(d), false) => eprintln!(
+                            "docs: regenerated the study sections of {} and copied the charts to {}",
+                            d.display(),
+                            d.parent()
+                                .unwrap_or(std::path::Path::new("."))
+                                .join("charts")
+                                .display()
+                        ),
+                        (Some(_), true) => eprintln!("docs: untouched (--quick never writes them)"),
+                        (None, _) => eprintln!("docs: untouched (--doc FILE regenerates them)"),
                     }
                     ExitCode::SUCCESS
                 }
@@ -231,14 +292,28 @@ fn main() -> ExitCode {
             &out,
             doc.as_deref().map(|d| (d, section.as_deref())),
         ),
-        Command::Check { scene, set } => {
+        Command::Check { scene, set, limits } => {
             let scene = match load(&scene, &set) {
                 Ok(s) => s,
                 Err(e) => return fail(&Error::Scene(e)),
             };
-            match lme_mpm::model::Model::new(&scene) {
+            // The estimate first, from the shapes alone: a scene too large
+            // to build is refused here, before seeding.
+            let plan = match lme_mpm::preflight::plan(
+                &scene,
+                &limits.limits(),
+                rayon::current_num_threads(),
+            ) {
+                Ok(p) => p,
+                Err(e) => return fail(&Error::Scene(e)),
+            };
+            for w in &plan.warnings {
+                eprintln!("warning: {w}");
+            }
+            match lme_mpm::model::Model::new(&plan.scene) {
                 Ok(model) => {
-                    print!("{}", lme_mpm::run::describe(&scene, &model));
+                    print!("{}", lme_mpm::run::describe(&plan.scene, &model));
+                    print!("{}", lme_mpm::preflight::describe(&plan.estimate));
                     ExitCode::SUCCESS
                 }
                 Err(e) => fail(&Error::Scene(e)),
@@ -316,6 +391,11 @@ fn bench(
     doc: Option<(&std::path::Path, Option<&str>)>,
 ) -> ExitCode {
     use lme_mpm::bench;
+    if let Some(code) =
+        adapter_without_gpu(&adapter.map(String::from), backends == BenchBackends::Cpu)
+    {
+        return code;
+    }
     let all: Vec<_> = bench::standard_cases()
         .into_iter()
         .chain(bench::extra_cases())

@@ -27,6 +27,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Print the backend choice and the result line to stderr.
     pub verbose: bool,
+    /// What the preflight allows (memory, steps, hours, snapshots).
+    pub limits: crate::preflight::Limits,
 }
 
 /// How a run ended, with its summary (also written to summary.json).
@@ -36,9 +38,17 @@ pub struct Outcome {
     pub summary: Summary,
 }
 
-/// Runs `scene` and writes its outputs to `opts.out`.
+/// Runs `scene` and writes its outputs to `opts.out`. The preflight comes
+/// first: a scene that cannot fit or run in the limits is refused before
+/// anything is allocated, and output intervals below a step are clamped
+/// (with a warning on stderr).
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let start = Instant::now();
+    let plan = crate::preflight::plan(scene, &opts.limits, rayon::current_num_threads())?;
+    for w in &plan.warnings {
+        eprintln!("warning: {w}");
+    }
+    let scene = &plan.scene;
     let spec = BackendSpec {
         choice: Some(opts.backend),
         adapter: opts.adapter.clone(),
@@ -139,6 +149,8 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         errors,
         scene_resolved: scene.file.clone(),
         version: env!("CARGO_PKG_VERSION"),
+        memory_estimate_bytes: plan.estimate.memory_bytes.round() as u64,
+        peak_rss_bytes: crate::preflight::peak_rss(),
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     output::write_atomic(&opts.out.join("summary.json"), json.as_bytes())?;

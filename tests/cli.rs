@@ -272,6 +272,17 @@ fn completed_run_writes_every_output() {
     let n = s["particles"].as_u64().unwrap() as usize;
     assert!(s["particle_steps_per_second"].as_f64().unwrap() > 0.0);
     assert!(s["errors"]["rms_velocity"].as_f64().unwrap() > 0.0);
+    // Every error figure also relative to the field's scale (5 m/s here).
+    let e = &s["errors"];
+    for (abs, rel) in [
+        ("rms_velocity", "rms_velocity_relative"),
+        ("max_velocity", "max_velocity_relative"),
+    ] {
+        let (a, r) = (e[abs].as_f64().unwrap(), e[rel].as_f64().unwrap());
+        assert!((a / 5.0 - r).abs() < 1e-12 * r, "{abs} {a} vs {rel} {r}");
+    }
+    // The preflight's figures reach the summary.
+    assert!(s["memory_estimate_bytes"].as_u64().unwrap() > 1 << 20);
     assert_eq!(
         s["backend"].as_str().unwrap().split(' ').next(),
         Some("cpu")
@@ -356,4 +367,206 @@ fn backend_choice_is_said_plainly_and_a_missing_adapter_fails_clearly() {
         "{msg}"
     );
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Runs the binary with `args`, killing it after `limit`; returns the exit
+/// code (None when it had to be killed), stderr and the time it took.
+fn run_timed(args: &[&str], limit: std::time::Duration) -> (Option<i32>, String, f64) {
+    use std::io::Read;
+    let start = std::time::Instant::now();
+    let mut child = bin()
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    let code = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s.code();
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    let mut err = String::new();
+    let _ = child.stderr.take().unwrap().read_to_string(&mut err);
+    (code, err, start.elapsed().as_secs_f64())
+}
+
+/// Every input of issue 10's "Seen" list that used to hang, spin or eat
+/// memory: each ends in under 2 s with exit 2 and a message naming the key,
+/// and writes nothing.
+#[test]
+fn absurd_sizes_end_at_once_with_exit_2_naming_the_key() {
+    /// The issue's bound: these must end within 2 s (they take ~10 ms).
+    const LIMIT: std::time::Duration = std::time::Duration::from_secs(2);
+    let dyka = common::case("dyka_bar.toml");
+    let plate = common::case("plate_impact.toml");
+    let (dyka, plate) = (dyka.to_str().unwrap(), plate.to_str().unwrap());
+    let out = tmp("absurd");
+    let out_s = out.to_str().unwrap();
+    // 5,000 touching rectangles: the pairwise overlap check was quadratic.
+    let rects: Vec<String> = (0..5000)
+        .map(|i| format!("[{}, 0, {}, 1]", i, i + 1))
+        .collect();
+    let many = scene_file(
+        &tmp("many-shapes"),
+        &format!(
+            "[grid]\nh = 1.0\n[materials.m]\nmodel = \"linear_elastic\"\ndensity = 1.0\nE = 1.0\n\
+             nu = 0.0\n[bodies.a]\nmaterial = \"m\"\nrects = [{}]\n[solver]\nt_end = 1.0\n",
+            rects.join(", ")
+        ),
+    );
+    let many = many.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["run", dyka, "--set", "grid.h=1e-9"], "grid.h"),
+        (vec!["check", dyka, "--set", "grid.h=1e-6"], "grid.h"),
+        (vec!["check", plate, "--set", "grid.h=0.01"], "grid.h"),
+        // The same plate on a machine with 1 GiB to spare.
+        (
+            vec!["run", plate, "--set", "grid.h=0.1", "--max-memory", "1G"],
+            "--max-memory",
+        ),
+        (
+            vec!["run", dyka, "--set", "materials.steel.E=1e308"],
+            "materials.steel.E",
+        ),
+        (
+            vec!["check", dyka, "--set", "materials.steel.E=1e308"],
+            "materials.steel.E",
+        ),
+        (vec!["run", dyka, "--set", "solver.dt=1e-20"], "solver.dt"),
+        // Weeks of work: refused when the script says how long it may take.
+        (
+            vec!["run", dyka, "--set", "grid.h=1e-5", "--max-hours", "1"],
+            "grid.h",
+        ),
+        (vec!["run", dyka, "--max-steps", "1000"], "--max-steps 1000"),
+        (
+            vec!["run", dyka, "--set", "output.vtk_interval=1e-12"],
+            "output.vtk_interval",
+        ),
+        (
+            vec![
+                "check",
+                dyka,
+                "--set",
+                "bodies.bar.rects=[[-1e300, 0, 0.1333, 0.001]]",
+            ],
+            "bodies.bar.rects[0]",
+        ),
+        (
+            vec!["run", dyka, "--set", "grid.margin=1e300"],
+            "grid.margin",
+        ),
+        (
+            vec!["run", dyka, "--set", "bodies.impactor.velocity=[-1e300, 0]"],
+            "grid.margin",
+        ),
+        (vec!["check", "/dev/zero"], "16 MiB"),
+        (vec!["check", many], "5000 shapes"),
+        (
+            vec!["run", dyka, "--set", "output.probes.far=[10, 10]"],
+            "output.probes.far",
+        ),
+        (
+            vec!["run", dyka, "--backend", "cpu", "--adapter", "nvidia"],
+            "--adapter",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut args = args;
+        if args[0] == "run" {
+            args.extend(["--quiet", "--out", out_s]);
+        }
+        let (code, msg, secs) = run_timed(&args, LIMIT);
+        assert_eq!(
+            code,
+            Some(2),
+            "{args:?}: exit {code:?} after {secs:.2} s: {msg}"
+        );
+        assert!(secs < LIMIT.as_secs_f64(), "{args:?} took {secs:.2} s");
+        assert!(
+            msg.contains(needle),
+            "{args:?}: message lacks {needle:?}: {msg}"
+        );
+        assert!(!out.exists(), "{args:?}: output folder was created");
+        eprintln!("{:.3} s  {args:?}", secs);
+    }
+}
+
+/// Intervals below the time step run correctly, once per step, with a
+/// warning; they no longer spin in the sampling loop.
+#[test]
+fn intervals_below_a_step_are_clamped_to_one_per_step() {
+    let out = tmp("clamped");
+    let o = run_with(
+        &common::case("dyka_bar.toml"),
+        &out,
+        &[
+            "output.sample_interval=1e-18",
+            "output.vtk_interval=1e-18",
+            "solver.t_end=1e-6",
+        ],
+    );
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{msg}");
+    assert!(
+        msg.contains("output.sample_interval = 1e-18 s is below the time step"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("output.vtk_interval = 1e-18 s is below the time step"),
+        "{msg}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let steps = s["steps"].as_u64().unwrap() as usize;
+    let energy = std::fs::read_to_string(out.join("energy.csv")).unwrap();
+    // A row at t = 0 and one per step (the last step is shortened to t_end).
+    let rows = energy.lines().count() - 1;
+    assert!(
+        (steps..=steps + 1).contains(&rows),
+        "{rows} rows for {steps} steps"
+    );
+    let snaps = std::fs::read_dir(out.join("vtk")).unwrap().count();
+    assert!(
+        (steps..=steps + 2).contains(&snaps),
+        "{snaps} snapshots for {steps} steps"
+    );
+    // The resolved scene says what ran.
+    let resolved = std::fs::read_to_string(out.join("scene.resolved.toml")).unwrap();
+    assert!(!resolved.contains("1e-18"), "{resolved}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `check` prints the preflight figures, and a long run's warning.
+#[test]
+fn check_prints_the_estimate_and_warns_of_long_runs() {
+    let o = bin()
+        .arg("check")
+        .arg(common::case("plate_impact.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("estimate    10000 particles, 57 x 63 = 3591 nodes"),
+        "{text}"
+    );
+    assert!(text.contains("peak memory"), "{text}");
+    let (code, msg, _) = run_timed(
+        &[
+            "check",
+            common::case("dyka_bar.toml").to_str().unwrap(),
+            "--set",
+            "grid.h=2e-5",
+        ],
+        std::time::Duration::from_secs(30),
+    );
+    assert_eq!(code, Some(0), "{msg}");
+    assert!(msg.contains("warning: a long run"), "{msg}");
 }

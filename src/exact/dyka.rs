@@ -32,6 +32,8 @@ pub struct DykaErrors {
     pub rms_velocity_relative: f64,
     /// Largest |v_p − v_exact| (m/s).
     pub max_velocity: f64,
+    /// `max_velocity` divided by the largest initial speed.
+    pub max_velocity_relative: f64,
 }
 
 impl DykaBar {
@@ -120,6 +122,7 @@ impl DykaBar {
             rms_velocity: rms,
             rms_velocity_relative: if vmax > 0.0 { rms / vmax } else { rms },
             max_velocity: max,
+            max_velocity_relative: if vmax > 0.0 { max / vmax } else { max },
         }
     }
 }

@@ -110,6 +110,10 @@ impl Model {
         let h = f.grid.h;
         let bbox = seed::bodies_bbox(scene);
         let anchor = f.grid.origin.unwrap_or([bbox[0], bbox[1]]);
+        let ppc = scene.bodies().next().map(|(_, b)| b.ppc).unwrap_or(2);
+        let shape = Shape::new(scene.solver(), h, ppc, f.grid.perturb);
+        // The extent first: it refuses an unaddressable grid before seeding.
+        let GridExtent { lo, nx, ny } = grid_extent(scene, &shape)?;
         let seeds = seed::seed_particles(scene, anchor, h);
 
         let body_names: Vec<String> = scene.bodies().map(|(n, _)| n.clone()).collect();
@@ -123,11 +127,30 @@ impl Model {
                 ));
             }
         }
-        let ppc = scene.bodies().next().map(|(_, b)| b.ppc).unwrap_or(2);
-        let shape = Shape::new(scene.solver(), h, ppc, f.grid.perturb);
 
-        let grid = build_grid(scene, &shape, bbox, anchor)?;
-        check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
+        let grid = Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed);
+
+        let margin = shape.edge_margin();
+        if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
+            return Err(SceneError::invalid(
+                format!("bodies.{}", body_names[s.body as usize]),
+                format!(
+                    "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
+                     enlarge grid.min/grid.max or drop them to derive the extent",
+                    s.x[0],
+                    s.x[1],
+                    grid.min[0],
+                    grid.min[1],
+                    grid.max()[0],
+                    grid.max()[1],
+                    if margin > 0.0 {
+                        format!(" or within {margin:.6} m of its edge")
+                    } else {
+                        String::new()
+                    }
+                ),
+            ));
+        }
 
         let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
         let body_material: Vec<u32> = scene
@@ -169,12 +192,27 @@ impl Model {
             .output
             .probes
             .iter()
-            .map(|(name, &point)| Probe {
-                name: name.clone(),
-                point,
-                particle: particles.nearest(point),
+            .map(|(name, &point)| {
+                let particle = particles.nearest(point);
+                let x = particles.x[particle];
+                let d = (x[0] - point[0]).hypot(x[1] - point[1]);
+                // A probe off the body would silently track some other point.
+                if d > h {
+                    return Err(SceneError::invalid(
+                        format!("output.probes.{name}"),
+                        format!(
+                            "is {d:.4e} m from the nearest particle, more than one cell (h = {h} m): \
+                             put it on a body"
+                        ),
+                    ));
+                }
+                Ok(Probe {
+                    name: name.clone(),
+                    point,
+                    particle,
+                })
             })
-            .collect();
+            .collect::<Result<_, _>>()?;
 
         Ok(Model {
             grid,
@@ -202,17 +240,29 @@ impl Model {
     }
 }
 
-/// The grid: `grid.min`/`grid.max` when given, else the bodies' box padded
-/// by the shape's reach and the scene's margin, stopped at walls, snapped
-/// to the lattice through `anchor`; perturbed when the scene asks.
-fn build_grid(
-    scene: &Scene,
-    shape: &Shape,
-    bbox: [f64; 4],
-    anchor: [f64; 2],
-) -> Result<Grid, SceneError> {
+/// Where the grid lies: its lower-left node and node counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridExtent {
+    /// Lower-left node on the unperturbed lattice (m).
+    pub lo: [f64; 2],
+    pub nx: usize,
+    pub ny: usize,
+}
+
+/// Most nodes a grid may have: node indices are u32 on both backends, and
+/// the GPU keeps a sign bit free.
+pub const MAX_NODES: u64 = u32::MAX as u64 / 2;
+
+/// The grid extent rule, without seeding: the bodies' bounding box plus
+/// `grid.margin` plus the cells `shape` reaches, stopped at walls, snapped
+/// outward to the lattice through `grid.origin` (or `grid.min`/`grid.max`
+/// when given). Counts are formed in f64 and refused above `MAX_NODES`
+/// before any integer conversion, so an absurd h costs nothing.
+pub fn grid_extent(scene: &Scene, shape: &Shape) -> Result<GridExtent, SceneError> {
     let f = &scene.file;
     let h = f.grid.h;
+    let bbox = seed::bodies_bbox(scene);
+    let anchor = f.grid.origin.unwrap_or([bbox[0], bbox[1]]);
     // Grid extent on the lattice through `anchor`.
     let snap = |v: f64, a: f64, up: bool| {
         let q = (v - a) / h;
@@ -244,9 +294,39 @@ fn build_grid(
     };
     let lo = [snap(lo[0], anchor[0], false), snap(lo[1], anchor[1], false)];
     let hi = [snap(hi[0], anchor[0], true), snap(hi[1], anchor[1], true)];
-    let nx = ((hi[0] - lo[0]) / h).round() as usize + 1;
-    let ny = ((hi[1] - lo[1]) / h).round() as usize + 1;
-    if let Shape::Bspline(b) = &shape {
+    let fx = ((hi[0] - lo[0]) / h).round() + 1.0;
+    let fy = ((hi[1] - lo[1]) / h).round() + 1.0;
+    // NaN counts (never from a validated scene) are refused too.
+    if fx * fy > MAX_NODES as f64 || (fx * fy).is_nan() {
+        let (key, why) = if f.grid.min.is_some() {
+            ("grid.h` / `grid.min` / `grid.max", String::new())
+        } else if scene.margin > 0.0 {
+            (
+                "grid.h` / `grid.margin",
+                format!(
+                    " (the grid spans the bodies plus a margin of {:e} m{})",
+                    scene.margin,
+                    if f.grid.margin.is_none() {
+                        ", the fastest body's speed × solver.t_end"
+                    } else {
+                        ""
+                    }
+                ),
+            )
+        } else {
+            ("grid.h", String::new())
+        };
+        return Err(SceneError::invalid(
+            key,
+            format!(
+                "gives {fx:.3e} x {fy:.3e} = {:.3e} nodes{why}, more than 2^31 (node indices are \
+                 32-bit): use a larger h or a smaller grid",
+                fx * fy
+            ),
+        ));
+    }
+    let (nx, ny) = (fx as usize, fy as usize);
+    if let Shape::Bspline(b) = shape {
         if nx < b.degree + 2 || ny < b.degree + 2 {
             return Err(SceneError::invalid(
                 "grid.h",
@@ -264,43 +344,7 @@ fn build_grid(
             "the grid must span at least one cell",
         ));
     }
-    if (nx as u64) * (ny as u64) > u32::MAX as u64 / 2 {
-        return Err(SceneError::invalid(
-            "grid.h",
-            format!("gives {nx} x {ny} nodes, more than 2^31: use a larger h or a smaller grid"),
-        ));
-    }
-    Ok(Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed))
-}
-
-/// Every seeded particle lies inside the grid, `margin` (m) from its edge.
-fn check_inside(
-    grid: &Grid,
-    seeds: &[seed::Seed],
-    body_names: &[String],
-    margin: f64,
-) -> Result<(), SceneError> {
-    if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
-        return Err(SceneError::invalid(
-            format!("bodies.{}", body_names[s.body as usize]),
-            format!(
-                "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
-                 enlarge grid.min/grid.max or drop them to derive the extent",
-                s.x[0],
-                s.x[1],
-                grid.min[0],
-                grid.min[1],
-                grid.max()[0],
-                grid.max()[1],
-                if margin > 0.0 {
-                    format!(" or within {margin:.6} m of its edge")
-                } else {
-                    String::new()
-                }
-            ),
-        ));
-    }
-    Ok(())
+    Ok(GridExtent { lo, nx, ny })
 }
 
 /// Constraints that are walls: a half-plane region beyond the bodies

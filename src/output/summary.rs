@@ -55,4 +55,9 @@ pub struct Summary {
     /// The scene as run (overrides applied, defaults filled in).
     pub scene_resolved: SceneFile,
     pub version: &'static str,
+    /// Peak resident memory the preflight estimated for the run (bytes).
+    pub memory_estimate_bytes: u64,
+    /// Peak resident memory of the process when the summary was written
+    /// (VmHWM, bytes); null where the OS does not report it.
+    pub peak_rss_bytes: Option<u64>,
 }

@@ -30,10 +30,7 @@ pub struct Scene {
 impl Scene {
     /// Reads `path`, applies `overrides` in order, and checks the result.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Parse {
-            path: path.display().to_string(),
-            message: format!("cannot read the file: {e}"),
-        })?;
+        let text = read_capped(path, crate::limits::SCENE_FILE_MAX)?;
         let stem = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -100,4 +97,26 @@ impl Scene {
             _ => Layout::Gauss,
         })
     }
+}
+
+/// Reads at most `cap` bytes of `path` as UTF-8; a longer file (or an
+/// endless one such as /dev/zero) is refused after reading `cap + 1` bytes.
+fn read_capped(path: &Path, cap: u64) -> Result<String, SceneError> {
+    use std::io::Read;
+    let err = |message: String| SceneError::Parse {
+        path: path.display().to_string(),
+        message,
+    };
+    let file = std::fs::File::open(path).map_err(|e| err(format!("cannot read the file: {e}")))?;
+    let mut bytes = Vec::new();
+    file.take(cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| err(format!("cannot read the file: {e}")))?;
+    if bytes.len() as u64 > cap {
+        return Err(err(format!(
+            "is larger than {} MiB: not a scene file",
+            cap >> 20
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| err(format!("is not UTF-8 text: {e}")))
 }

@@ -35,6 +35,23 @@ fn finite_point(key: &str, p: &[f64]) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// A position or length (m): finite and within ±`limits::COORD_MAX`.
+fn coord(key: &str, p: &[f64]) -> Result<(), SceneError> {
+    for &v in p {
+        finite(key, v)?;
+        if v.abs() > limits::COORD_MAX {
+            return Err(SceneError::invalid(
+                key,
+                format!(
+                    "holds {v:e} m, beyond the ±{:e} m a scene may span",
+                    limits::COORD_MAX
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, SceneError> {
     let name = file
         .name
@@ -75,11 +92,12 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     // --- grid -------------------------------------------------------------
     let g = &file.grid;
     positive("grid.h", g.h)?;
+    coord("grid.h", &[g.h])?;
     if let Some(o) = g.origin {
-        finite_point("grid.origin", &o)?;
+        coord("grid.origin", &o)?;
     }
     if let Some(m) = g.margin {
-        finite("grid.margin", m)?;
+        coord("grid.margin", &[m])?;
         if m < 0.0 {
             return Err(SceneError::invalid(
                 "grid.margin",
@@ -90,8 +108,8 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     match (g.min, g.max) {
         (None, None) => {}
         (Some(lo), Some(hi)) => {
-            finite_point("grid.min", &lo)?;
-            finite_point("grid.max", &hi)?;
+            coord("grid.min", &lo)?;
+            coord("grid.max", &hi)?;
             if !(lo[0] < hi[0] && lo[1] < hi[1]) {
                 return Err(SceneError::invalid(
                     "grid.max",
@@ -205,7 +223,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             ));
         }
         for (i, r) in b.rects.iter().enumerate() {
-            finite_point(&key("rects"), r)?;
+            coord(&format!("bodies.{bname}.rects[{i}]"), r)?;
             if !(r[0] < r[2] && r[1] < r[3]) {
                 return Err(SceneError::invalid(
                     format!("bodies.{bname}.rects[{i}]"),
@@ -216,7 +234,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             }
         }
         for (i, d) in b.disks.iter().enumerate() {
-            finite_point(&key("disks"), d)?;
+            coord(&format!("bodies.{bname}.disks[{i}]"), d)?;
             if d[2] <= 0.0 {
                 return Err(SceneError::invalid(
                     format!("bodies.{bname}.disks[{i}]"),
@@ -226,7 +244,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         }
         for (i, poly) in b.polygons.iter().enumerate() {
             for p in poly {
-                finite_point(&key("polygons"), p)?;
+                coord(&format!("bodies.{bname}.polygons[{i}]"), p)?;
             }
             if poly.len() < 3 || super::seed::polygon_area(poly).abs() <= 0.0 {
                 return Err(SceneError::invalid(
@@ -252,15 +270,46 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             }
         }
     }
+    let shapes: usize = file
+        .bodies
+        .values()
+        .map(|b| b.rects.len() + b.disks.len() + b.polygons.len())
+        .sum();
+    if shapes > limits::MAX_SHAPES {
+        return Err(SceneError::invalid(
+            "bodies",
+            format!(
+                "hold {shapes} shapes, more than {}: merge rectangles",
+                limits::MAX_SHAPES
+            ),
+        ));
+    }
+    let vertices: usize = file
+        .bodies
+        .values()
+        .flat_map(|b| b.polygons.iter().map(Vec::len))
+        .sum();
+    if vertices > limits::MAX_POLYGON_VERTICES {
+        return Err(SceneError::invalid(
+            "bodies",
+            format!(
+                "hold {vertices} polygon vertices, more than {}",
+                limits::MAX_POLYGON_VERTICES
+            ),
+        ));
+    }
     check_rect_overlaps(&file)?;
 
     // --- constraints ------------------------------------------------------
     for (cname, c) in &file.constraints {
         for v in c.min.iter().chain(&c.max) {
-            if v.is_nan() {
+            if v.is_nan() || (v.is_finite() && v.abs() > limits::COORD_MAX) {
                 return Err(SceneError::invalid(
                     format!("constraints.{cname}"),
-                    "min/max must not be NaN",
+                    format!(
+                        "min/max must be ±inf or within ±{:e} m, not NaN",
+                        limits::COORD_MAX
+                    ),
                 ));
             }
         }
@@ -303,7 +352,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         positive("output.vtk_interval", v)?;
     }
     for (pname, p) in &o.probes {
-        finite_point(&format!("output.probes.{pname}"), p)?;
+        coord(&format!("output.probes.{pname}"), p)?;
     }
 
     // --- manufactured solution ---------------------------------------------
