@@ -28,6 +28,7 @@ enum Command {
         #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
         backend: BackendChoice,
         /// GPU adapter to use: a case-insensitive part of its name (see `lme-mpm info`).
+        /// An error with --backend cpu.
         #[arg(long)]
         adapter: Option<String>,
         /// Output folder. Default: out/<scene name>.
@@ -84,7 +85,7 @@ enum Command {
         /// Backends to measure.
         #[arg(long, value_enum, default_value_t = BenchBackends::Both)]
         backend: BenchBackends,
-        /// GPU adapter (part of its name).
+        /// GPU adapter (part of its name); an error with --backend cpu.
         #[arg(long)]
         adapter: Option<String>,
         /// Particle counts, comma-separated.
