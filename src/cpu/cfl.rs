@@ -6,9 +6,14 @@ use crate::material::Material;
 use crate::model::Model;
 use rayon::prelude::*;
 
+/// A step that would reach within this fraction of the time left of t_end
+/// is the last and lands on t_end exactly (shaders/step_begin.wgsl has the
+/// same constant; tests/gpu_shaders.rs compares them).
+pub const LAST_STEP_REL: f64 = 1e-6;
+
 /// Δt of a step starting at `t` (the CFL condition, or the scene's fixed
 /// `solver.dt`), and whether it is the last: a step that
-/// would reach within 1e-6 of t_end is shortened to land on it exactly
+/// would reach within `LAST_STEP_REL` of t_end is shortened to land on it exactly
 /// (the same rule as shaders/step_begin.wgsl).
 pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
     let p = &model.particles;
@@ -23,7 +28,7 @@ pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
         .fixed_dt
         .unwrap_or(model.cfl * model.grid.min_spacing() / c);
     let rem = model.t_end - t;
-    if dt >= rem * (1.0 - 1e-6) {
+    if dt >= rem * (1.0 - LAST_STEP_REL) {
         (rem, true)
     } else {
         (dt, false)

@@ -1,6 +1,6 @@
 //! Every struct shared with WGSL, defined once here with explicit padding
 //! and a compile-time size check. Keep in sync with shaders/shared/types.wgsl;
-//! tests/gpu_layout.rs compares offsets and sizes with naga's reflection.
+//! tests/gpu_shaders.rs compares offsets and sizes with naga's reflection.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -104,6 +104,8 @@ pub const NODE_STRIDE: usize = 5;
 pub const PROBE_STRIDE: usize = 8;
 /// Workgroup size of the per-particle and per-node passes.
 pub const WG: u32 = 256;
+/// Workgroup size of the probe gather (shaders/probes.wgsl).
+pub const PROBES_WG: u32 = 64;
 
 /// Fault codes (types.wgsl): `Sim::fault` = (particle << 4) | code.
 pub const FAULT_NONE: u32 = 0xffff_ffff;
