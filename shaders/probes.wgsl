@@ -10,6 +10,10 @@
 @group(0) @binding({{B_PROBE_IDX}}) var<storage, read> probe_idx: array<u32>;
 @group(0) @binding({{B_PROBE_OUT}}) var<storage, read_write> probe_out: array<f32>;
 
+// Floats per probe (src/gpu/layout.rs PROBE_STRIDE).
+const PROBE_STRIDE: u32 = 8u;
+
+// Workgroup size (src/gpu/layout.rs PROBES_WG, which the dispatch divides by).
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
@@ -18,7 +22,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p = probe_idx[k];
     let x = x0[p] + u[p];
-    let o = 8u * k;
+    let o = PROBE_STRIDE * k;
     probe_out[o] = x.x;
     probe_out[o + 1u] = x.y;
     probe_out[o + 2u] = v[p].x;

@@ -3,6 +3,10 @@
 // CpuBackend (src/cpu/mod.rs, Stage::Cfl and `advance`).
 #include "shared/common.wgsl"
 
+// A step that would reach within this fraction of the time left of t_end
+// lands on it exactly (src/cpu/cfl.rs LAST_STEP_REL).
+const LAST_STEP_REL: f32 = 1e-6;
+
 @compute @workgroup_size(1)
 fn main() {
     let fault = atomicLoad(&sim.fault);
@@ -21,7 +25,7 @@ fn main() {
     if params.fixed_dt > 0.0 {
         dt = params.fixed_dt;
     }
-    if dt >= rem_end * (1.0 - 1e-6) {
+    if dt >= rem_end * (1.0 - LAST_STEP_REL) {
         dt = rem_end;
         sim.final_step = 1u;
     }

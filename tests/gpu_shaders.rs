@@ -221,3 +221,175 @@ fn shared_structs_match_rust_layouts() {
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
 }
+
+/// A WGSL constant's value as naga's front end evaluated it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Value {
+    U32(u32),
+    F32(f32),
+}
+
+/// Every named `const` of a module with a scalar literal value.
+fn wgsl_constants(module: &naga::Module) -> Vec<(String, Value)> {
+    module
+        .constants
+        .iter()
+        .filter_map(|(_, c)| {
+            let v = match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => Value::U32(v),
+                naga::Expression::Literal(naga::Literal::F32(v)) => Value::F32(v),
+                _ => return None,
+            };
+            Some((c.name.clone()?, v))
+        })
+        .collect()
+}
+
+/// The constants of every pass in two variants that together include every
+/// shared file (MLS B-splines with two materials; stored-weight LME with the
+/// manufactured load), with the passes' entry-point workgroup sizes.
+fn every_pass_module() -> Vec<(Pass, naga::Module)> {
+    let all = variants();
+    let mls = all
+        .iter()
+        .find(|v| v.mls && v.multi_material && v.shape == ShapeKind::Bspline2)
+        .unwrap();
+    let lme = all
+        .iter()
+        .find(|v| v.lme_stored && v.mms && v.perturbed)
+        .unwrap();
+    let mut out = Vec::new();
+    for v in [mls, lme] {
+        let d = v.defines();
+        for pass in Pass::ALL {
+            if v.uses(pass) {
+                let src = pipelines::expand(pass, &d).unwrap();
+                out.push((
+                    pass,
+                    pipelines::validate(&src, pass.file(), v.atomics).unwrap(),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Every constant written in both Rust and WGSL holds the same value in
+/// both, as naga parses the expanded shaders. A constant that appears in
+/// several passes must agree in every one, and must appear at least once.
+#[test]
+fn constants_mirrored_in_wgsl_match_rust() {
+    use lme_mpm::gpu::layout as l;
+    let f = |v: f64| Value::F32(v as f32);
+    let u = Value::U32;
+    let expected: Vec<(&str, Value)> = vec![
+        ("FAULT_NONE", u(l::FAULT_NONE)),
+        ("FAULT_LEFT_GRID", u(l::FAULT_LEFT_GRID)),
+        ("FAULT_NON_FINITE_STRAIN", u(l::FAULT_NON_FINITE_STRAIN)),
+        ("FAULT_NON_FINITE_STRESS", u(l::FAULT_NON_FINITE_STRESS)),
+        ("FAULT_NON_FINITE_MOTION", u(l::FAULT_NON_FINITE_MOTION)),
+        ("FAULT_DENSITY", u(l::FAULT_DENSITY)),
+        ("FAULT_LME_FEW_NODES", u(l::FAULT_LME_FEW_NODES)),
+        ("FAULT_LME_NOT_CONVERGED", u(l::FAULT_LME_NOT_CONVERGED)),
+        ("FAULT_LME_SINGULAR", u(l::FAULT_LME_SINGULAR)),
+        ("FAULT_MLS_SINGULAR", u(l::FAULT_MLS_SINGULAR)),
+        ("MODEL_LINEAR_ELASTIC", u(l::MODEL_LINEAR_ELASTIC)),
+        ("MODEL_NEO_HOOKEAN", u(l::MODEL_NEO_HOOKEAN)),
+        ("NODE_STRIDE", u(l::NODE_STRIDE as u32)),
+        ("PROBE_STRIDE", u(l::PROBE_STRIDE as u32)),
+        ("WG", u(l::WG)),
+        ("LAST_STEP_REL", f(lme_mpm::model::time_step::LAST_STEP_REL)),
+        ("MLS_SUPPORT", f(lme_mpm::cpu::mls::SUPPORT_CELLS)),
+    ];
+    let modules = every_pass_module();
+    for (name, want) in &expected {
+        let mut seen = 0;
+        for (pass, m) in &modules {
+            for (n, v) in wgsl_constants(m) {
+                if n == *name {
+                    assert_eq!(v, *want, "{name} in {pass:?}: WGSL {v:?}, Rust {want:?}");
+                    seen += 1;
+                }
+            }
+        }
+        assert!(seen > 0, "{name} is declared in no pass");
+    }
+    // No FAULT_* or MODEL_* code in WGSL that Rust does not know.
+    for (pass, m) in &modules {
+        for (n, _) in wgsl_constants(m) {
+            if n.starts_with("FAULT_") || n.starts_with("MODEL_") {
+                assert!(
+                    expected.iter().any(|(e, _)| *e == n),
+                    "{n} in {pass:?} has no Rust twin in this test"
+                );
+            }
+        }
+    }
+}
+
+/// Each pass's workgroup size is what its dispatch divides by: `WG` for the
+/// per-particle, per-node, per-cell and per-Gauss-point passes (and the
+/// one-workgroup scan), `PROBES_WG` for the probe gather, 1 for the
+/// one-invocation step passes.
+#[test]
+fn workgroup_sizes_match_the_dispatch() {
+    use lme_mpm::gpu::layout::{PROBES_WG, WG};
+    for (pass, m) in every_pass_module() {
+        let want = match pass {
+            Pass::StepBegin | Pass::StepEnd => 1,
+            Pass::Probes => PROBES_WG,
+            _ => WG,
+        };
+        assert_eq!(m.entry_points.len(), 1, "{pass:?}");
+        assert_eq!(
+            m.entry_points[0].workgroup_size,
+            [want, 1, 1],
+            "{pass:?} workgroup size"
+        );
+    }
+}
+
+/// The GPU fixes whole boxes of nodes: a constraint group that is not a box
+/// of the lattice is refused with the scene key, in release builds too.
+#[test]
+fn constraint_groups_must_be_boxes_of_nodes() {
+    use lme_mpm::gpu::buffers::constraint_boxes;
+    let scene = lme_mpm::scene::Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/elastic_block.toml"),
+        &[],
+    )
+    .unwrap();
+    let mut model = lme_mpm::model::Model::new(&scene).unwrap();
+    let boxes = constraint_boxes(&model).unwrap();
+    assert_eq!(boxes.len(), model.constraints.groups.len());
+    for (b, grp) in boxes.iter().zip(&model.constraints.groups) {
+        let area = (b.i1 - b.i0 + 1) * (b.j1 - b.j0 + 1);
+        assert_eq!(area as usize, grp.nodes.len(), "{}", grp.name);
+    }
+    // Drop one node from the middle of the longest group: its box has a hole.
+    let grp = model
+        .constraints
+        .groups
+        .iter_mut()
+        .max_by_key(|g| g.nodes.len())
+        .unwrap();
+    assert!(grp.nodes.len() >= 3);
+    let name = grp.name.clone();
+    let mid = grp.nodes.len() / 2;
+    grp.nodes.remove(mid);
+    let err = constraint_boxes(&model).unwrap_err().to_string();
+    assert!(
+        err.contains(&format!("constraints.{name}")) && err.contains("box"),
+        "{err}"
+    );
+    // A duplicated node does not pass for the missing one.
+    let grp = &mut model
+        .constraints
+        .groups
+        .iter_mut()
+        .find(|g| g.name == name)
+        .unwrap();
+    let first = grp.nodes[0];
+    grp.nodes.insert(mid, first);
+    assert!(constraint_boxes(&model).is_err());
+}

@@ -10,7 +10,7 @@ use super::layout::{
     GpuConstraint, GpuMaterial, MODEL_LINEAR_ELASTIC, MODEL_NEO_HOOKEAN, NODE_STRIDE, PROBE_STRIDE,
     Params, Sim,
 };
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
 use crate::model::shape::Shape;
 use crate::model::{FIX_X, FIX_Y, Integrator, Model};
@@ -176,7 +176,7 @@ impl Buffers {
         data.push((Buf::Materials, bytemuck::cast_slice(&mats).to_vec()));
         data.push((
             Buf::Constraints,
-            bytemuck::cast_slice(&constraints(model)).to_vec(),
+            bytemuck::cast_slice(&constraint_boxes(model)?).to_vec(),
         ));
         data.push((Buf::X0, bytes(&flat2(&mut p.x0.iter().map(|x| rel(*x))))));
         let u: Vec<f32> =
@@ -317,8 +317,11 @@ pub fn initial_sim() -> Sim {
 }
 
 /// Constraint groups as lattice index boxes (membership is decided on the
-/// unperturbed lattice, exactly as `model::build_constraints` does).
-fn constraints(model: &Model) -> Vec<GpuConstraint> {
+/// unperturbed lattice, exactly as `model::build_constraints` does). The
+/// GPU fixes every node of the box, so a group whose nodes do not fill their
+/// bounding box exactly (not one a scene's `[constraints.*]` rectangle can
+/// select) is refused here rather than fixing nodes the CPU leaves free.
+pub fn constraint_boxes(model: &Model) -> Result<Vec<GpuConstraint>> {
     let g = &model.grid;
     let mut out = Vec::new();
     for grp in &model.constraints.groups {
@@ -330,11 +333,24 @@ fn constraints(model: &Model) -> Vec<GpuConstraint> {
             j0 = j0.min(j);
             j1 = j1.max(j);
         }
-        debug_assert_eq!(
-            ((i1 - i0 + 1) * (j1 - j0 + 1)) as usize,
-            grp.nodes.len(),
-            "a box region selects a box of nodes"
-        );
+        let mut distinct = grp.nodes.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let area = if grp.nodes.is_empty() {
+            0
+        } else {
+            (i1 - i0 + 1) as usize * (j1 - j0 + 1) as usize
+        };
+        if area == 0 || distinct.len() != area || grp.nodes.len() != area {
+            return Err(Error::Scene(SceneError::invalid(
+                format!("constraints.{}", grp.name),
+                format!(
+                    "its {} nodes do not form a box of the lattice (the bounding box holds {area}); \
+                     the GPU path needs a rectangle of nodes",
+                    grp.nodes.len()
+                ),
+            )));
+        }
         out.push(GpuConstraint {
             i0,
             i1,
@@ -355,5 +371,5 @@ fn constraints(model: &Model) -> Vec<GpuConstraint> {
             _pad: [0; 3],
         });
     }
-    out
+    Ok(out)
 }

@@ -104,6 +104,8 @@ pub const NODE_STRIDE: usize = 5;
 pub const PROBE_STRIDE: usize = 8;
 /// Workgroup size of the per-particle and per-node passes.
 pub const WG: u32 = 256;
+/// Workgroup size of the probe gather (shaders/probes.wgsl).
+pub const PROBES_WG: u32 = 64;
 
 /// Fault codes (types.wgsl): `Sim::fault` = (particle << 4) | code.
 pub const FAULT_NONE: u32 = 0xffff_ffff;

@@ -5,7 +5,7 @@
 
 use super::buffers::{Buf, Buffers};
 use super::context::{AtomicMode, GpuContext};
-use super::layout::WG;
+use super::layout::{PROBES_WG, WG};
 use super::preprocess::{self, Defines};
 use crate::error::{Error, Result};
 use crate::model::shape::Shape;
@@ -460,7 +460,7 @@ impl Pipelines {
         };
         let (x, y) = match b.domain {
             Domain::One => (1, 1),
-            Domain::Probes => (self.n_probes.div_ceil(64).max(1), 1),
+            Domain::Probes => (self.n_probes.div_ceil(PROBES_WG).max(1), 1),
             Domain::Particles => grid_2d(self.n_particles, self.max_groups),
             Domain::Nodes => grid_2d(self.n_nodes_or_groups, self.max_groups),
             Domain::Cells => grid_2d(self.n_cells, self.max_groups),
