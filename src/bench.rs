@@ -387,7 +387,6 @@ pub fn profile_gpu(
 ) -> Result<Vec<StageTime>> {
     use crate::gpu::GpuBackend;
     use crate::gpu::pipelines::Pass;
-    use crate::solver::STEP;
     let model = Model::new(&scene(particles, case)?)?;
     let n = model.particles.len() as f64;
     let lme = !model.particles.lambda.is_empty();
@@ -399,11 +398,7 @@ pub fn profile_gpu(
     })?;
     let mut gpu = GpuBackend::with_options(ctx, model, case.gpu)?;
     gpu.advance_steps(1).map_err(halted)?;
-    let mut passes: Vec<Pass> = STEP
-        .iter()
-        .flat_map(|s| Pass::for_stage(*s, lme, mls).iter().copied())
-        .collect();
-    passes.push(Pass::StepEnd);
+    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(lme, mls).collect();
     // Cost of a submission and wait alone.
     let start = Instant::now();
     for _ in 0..20 {
