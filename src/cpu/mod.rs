@@ -151,7 +151,12 @@ impl CpuBackend {
     /// only when every stage succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
         for stage in STEP {
-            self.run_stage(*stage)?;
+            // Without MLS, stress and forces run as one pass (as on the GPU).
+            match stage {
+                Stage::Stress if self.mls.is_none() => self.stress_forces()?,
+                Stage::Forces if self.mls.is_none() => {}
+                _ => self.run_stage(*stage)?,
+            }
         }
         self.t = if self.final_step {
             self.model.t_end
@@ -160,6 +165,38 @@ impl CpuBackend {
         };
         self.steps += 1;
         Ok(())
+    }
+
+    /// Stages `stress` and `forces` fused (`stress::stress_forces`).
+    fn stress_forces(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        // The stress is at the step's end (t + Δt), so are the loads.
+        let t = self.t + self.dt;
+        let g = m.gravity.map_or([0.0; 2], |g| g.at(t));
+        let (mms, x0) = (&m.manufactured, &p.x0);
+        let body = move |i: usize| match mms {
+            None => g,
+            Some(s) => {
+                let b = s.body_force(x0[i], t);
+                [g[0] + b[0], g[1] + b[1]]
+            }
+        };
+        stress::stress_forces(
+            &self.cache,
+            &self.mv,
+            self.dt,
+            &p.body,
+            &m.materials,
+            &m.body_material,
+            &p.mass,
+            &body,
+            &mut p.stress,
+            &mut p.rho,
+            &mut p.f,
+            &mut self.force,
+            &mut self.force_scatter,
+        )
     }
 
     /// Runs one stage of the step (public so tests can compare stages one by one).
