@@ -151,8 +151,11 @@ impl CpuBackend {
     /// only when every stage succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
         for stage in STEP {
-            // Without MLS, stress and forces run as one pass (as on the GPU).
+            // Without MLS, shape_eval and p2g run as one pass, and stress
+            // and forces as another (as on the GPU).
             match stage {
+                Stage::ShapeEval if self.mls.is_none() => self.shape_eval_p2g()?,
+                Stage::P2g if self.mls.is_none() => {}
                 Stage::Stress if self.mls.is_none() => self.stress_forces()?,
                 Stage::Forces if self.mls.is_none() => {}
                 _ => self.run_stage(*stage)?,
@@ -165,6 +168,29 @@ impl CpuBackend {
         };
         self.steps += 1;
         Ok(())
+    }
+
+    /// Stages `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
+    fn shape_eval_p2g(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        let a_factor = match m.integrator {
+            Integrator::Fe => 0.0,
+            Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
+        };
+        shape_eval::shape_eval_p2g(
+            &m.shape,
+            &m.grid,
+            &p.x,
+            &mut p.lambda,
+            &mut self.cache,
+            &p.mass,
+            &p.v,
+            &p.a,
+            a_factor,
+            &mut self.mv,
+            &mut self.p2g_scatter,
+        )
     }
 
     /// Stages `stress` and `forces` fused (`stress::stress_forces`).

@@ -170,10 +170,10 @@ mod tests {
     use crate::model::Model;
     use crate::solver::STEP;
 
-    /// A whole step runs `stress_forces`; the stages one by one must give
-    /// the very same numbers (same sums in the same order).
+    /// A whole step runs `shape_eval_p2g` and `stress_forces`; the stages
+    /// one by one must give the very same numbers (same sums, same order).
     #[test]
-    fn fused_stress_forces_equals_the_two_stages() {
+    fn fused_step_equals_the_stages_one_by_one() {
         for shape in ["linear", "bspline2", "lme"] {
             let sets = [format!("solver.shape={shape}")];
             let case = Case::new("t", &[sets[0].as_str()]);
@@ -192,6 +192,8 @@ mod tests {
             assert_eq!(a.rho, b.rho, "{shape}");
             assert_eq!(a.x, b.x, "{shape}");
             assert_eq!(fused.force, staged.force, "{shape}");
+            assert_eq!(fused.mv, staged.mv, "{shape}");
+            assert_eq!(a.lambda, b.lambda, "{shape}");
         }
     }
 }
