@@ -33,7 +33,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if !w.ok {
             continue;
         }
-        let f = -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * b;
+        let f = particle_force(vol, s, b, w);
         let base = w.node * NODE_STRIDE;
         node_add(base + 3u, f.x);
         node_add(base + 4u, f.y);

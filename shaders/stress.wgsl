@@ -1,6 +1,10 @@
 // Stage `stress`: L = Σ v_I ⊗ ∇N_I, then the material's update over Δt
 // (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F)),
 // and ρ ← ρ / (V_new / V_old). CPU twin: src/cpu/stress.rs.
+// Built with FORCES (pass `StressForces`, what a whole step runs) it goes on
+// to stage `forces` for the same particle with the same weights (the stress
+// is all `forces` needs from it), saving a pass over the particles and a
+// shape evaluation; the stages stay separate passes for parity tests.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -13,7 +17,28 @@
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
 @group(0) @binding({{B_RHO}}) var<storage, read_write> rho: array<f32>;
 @group(0) @binding({{B_STRESS}}) var<storage, read_write> stress: array<f32>;
+#if FORCES
+@group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
+
+#include "shared/atomics.wgsl" ARR=node_acc FN=node_add
+
+#include "shared/body_force.wgsl"
+
+fn node_value(i: u32) -> f32 {
+#if FLOAT_ATOMICS
+    return atomicLoad(&node_acc[i]);
+#else
+    return bitcast<f32>(atomicLoad(&node_acc[i]));
+#endif
+}
+#else
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read> node_acc: array<f32>;
+
+fn node_value(i: u32) -> f32 {
+    return node_acc[i];
+}
+#endif
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -30,7 +55,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             continue;
         }
         let b = w.node * NODE_STRIDE;
-        let vn = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]);
+        let vn = vec2<f32>(node_value(b + 1u), node_value(b + 2u));
         l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
     }
     let dt = sim.dt;
@@ -50,11 +75,27 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         report_fault(FAULT_NON_FINITE_STRESS, p);
         return;
     }
-    rho[p] = rho[p] / up.j;
+    let rho_p = rho[p] / up.j;
+    rho[p] = rho_p;
 #if DEF_GRAD
     def_grad[p] = up.f;
 #endif
     stress[3u * p] = s.x;
     stress[3u * p + 1u] = s.y;
     stress[3u * p + 2u] = s.z;
+#if FORCES
+    let m = mass[p];
+    let vol = m / rho_p;
+    let mb = m * body_force(p, sim.t + sim.t_lo + sim.dt);
+    for (var k = 0u; k < STENCIL; k++) {
+        let w = shape_node(c, k);
+        if !w.ok {
+            continue;
+        }
+        let f = particle_force(vol, s, mb, w);
+        let base = w.node * NODE_STRIDE;
+        node_add(base + 3u, f.x);
+        node_add(base + 4u, f.y);
+    }
+#endif
 }

@@ -5,6 +5,7 @@
 
 use crate::backend::Backend;
 use crate::error::Result;
+use crate::model::Model;
 use crate::scene::{Override, Scene};
 use crate::simulation::{BackendChoice, BackendSpec, Simulation};
 use std::fmt::Write;
@@ -344,4 +345,90 @@ pub fn chart(points: &[Point], stem: &std::path::Path) -> Result<()> {
 /// "cpu" or "gpu" from a backend's full name.
 fn short_backend(name: &str) -> String {
     name.split([' ', ':']).next().unwrap_or(name).to_string()
+}
+
+/// Time spent in one stage (CPU) or pass (GPU), per particle-step.
+#[derive(Debug, Clone)]
+pub struct StageTime {
+    pub name: String,
+    /// Nanoseconds per particle-step.
+    pub ns_per_particle_step: f64,
+}
+
+/// Per-stage breakdown of the CPU path: `steps` whole steps, each stage
+/// timed on its own (`CpuBackend::run_stage`), after one warm-up step.
+pub fn profile_cpu(particles: usize, case: &Case, steps: u64) -> Result<Vec<StageTime>> {
+    use crate::cpu::CpuBackend;
+    use crate::solver::STEP;
+    let model = Model::new(&scene(particles, case)?)?;
+    let n = model.particles.len() as f64;
+    let mut cpu = CpuBackend::new(model);
+    cpu.step().map_err(|f| halted(f.into()))?;
+    let mut t = vec![0.0f64; STEP.len()];
+    for _ in 0..steps {
+        for (k, stage) in STEP.iter().enumerate() {
+            let start = Instant::now();
+            cpu.run_stage(*stage).map_err(|f| halted(f.into()))?;
+            t[k] += start.elapsed().as_secs_f64();
+        }
+    }
+    Ok(STEP
+        .iter()
+        .zip(t)
+        .map(|(s, t)| StageTime {
+            name: format!("{s:?}"),
+            ns_per_particle_step: t * 1e9 / (n * steps as f64),
+        })
+        .collect())
+}
+
+/// Per-pass breakdown of the GPU path: `steps` whole steps, each pass
+/// submitted on its own and waited for (the wait's own cost, measured on
+/// an empty submission, is subtracted).
+pub fn profile_gpu(
+    adapter: Option<&str>,
+    particles: usize,
+    case: &Case,
+    steps: u64,
+) -> Result<Vec<StageTime>> {
+    use crate::gpu::GpuBackend;
+    use crate::gpu::pipelines::Pass;
+    let model = Model::new(&scene(particles, case)?)?;
+    let n = model.particles.len() as f64;
+    let lme = !model.particles.lambda.is_empty();
+    let mls = model.mls;
+    let ctx = crate::gpu::context::open(&crate::gpu::context::AdapterRequest {
+        name: adapter.map(str::to_string),
+        allow_software: true,
+        force_cas: false,
+    })?;
+    let mut gpu = GpuBackend::with_options(ctx, model, case.gpu)?;
+    gpu.advance_steps(1).map_err(halted)?;
+    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(lme, mls).collect();
+    // Cost of a submission and wait alone.
+    let start = Instant::now();
+    for _ in 0..20 {
+        gpu.read_sim()?;
+    }
+    let wait = start.elapsed().as_secs_f64() / 20.0;
+    let mut t = vec![0.0f64; passes.len()];
+    for _ in 0..steps {
+        for (k, pass) in passes.iter().enumerate() {
+            let start = Instant::now();
+            gpu.run_pass(*pass);
+            gpu.read_sim()?;
+            t[k] += (start.elapsed().as_secs_f64() - wait).max(0.0);
+        }
+    }
+    if let Some(f) = gpu.fault() {
+        return Err(halted(f.into()));
+    }
+    Ok(passes
+        .iter()
+        .zip(t)
+        .map(|(p, t)| StageTime {
+            name: format!("{p:?}"),
+            ns_per_particle_step: t * 1e9 / (n * steps as f64),
+        })
+        .collect())
 }

@@ -1,7 +1,7 @@
 // Body force per unit mass (m/s²) on particle p at time t (s): gravity
 // (paper eq. 45 when ramped) plus, with MMS, the aligned-vibration source
 // term derived in src/exact/mms.rs (`AlignedVibration::body_force`).
-// Needs the x0 binding.
+// Needs the x0 binding. Also the force one particle adds to one node.
 
 // Gravity at time t (paper eq. 45 when ramped).
 fn gravity_at(t: f32) -> vec2<f32> {
@@ -37,4 +37,11 @@ fn body_force(p: u32, t: f32) -> vec2<f32> {
 #else
     return gravity_at(t);
 #endif
+}
+
+// Stage `forces`: what particle p (volume vol, stress s = (xx, yy, xy), body
+// force m_p b) adds to node w: −V_p σ_p ∇N + N m_p b. Shared by forces.wgsl
+// and the fused stress.wgsl (FORCES).
+fn particle_force(vol: f32, s: vec3<f32>, mb: vec2<f32>, w: NodeW) -> vec2<f32> {
+    return -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * mb;
 }

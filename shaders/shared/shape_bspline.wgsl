@@ -23,9 +23,41 @@ struct Basis1 {
     dn: vec4<f32>,
 }
 
+// Away from the edge (every knot t_{s−p}..t_{s+p+1} uniform) the closed
+// form of the cardinal B-splines; near it the open-knot recursion.
 fn bs_basis(u: f32, n: u32) -> Basis1 {
+    let s = clamp(i32(floor(u + 0.5 * f32(BSPLINE_P + 1))), BSPLINE_P, i32(n) - 1);
+    if s > 2 * BSPLINE_P && s + BSPLINE_P + 2 <= i32(n) {
+        return bs_uniform_basis(u, s);
+    }
+    return bs_open_basis(u, s, n);
+}
+
+// Uniform knots: quadratic with f = u − first in [0.5, 1.5), cubic with
+// t = u − (first + 1) in [0, 1).
+fn bs_uniform_basis(u: f32, s: i32) -> Basis1 {
+    let first = s - BSPLINE_P;
+    if BSPLINE_P == 2 {
+        let f = u - f32(first);
+        let a = 1.5 - f;
+        let b = f - 1.0;
+        let c = f - 0.5;
+        return Basis1(u32(first), vec4<f32>(0.5 * a * a, 0.75 - b * b, 0.5 * c * c, 0.0), vec4<f32>(-a, -2.0 * b, c, 0.0));
+    }
+    let t = u - f32(first + 1);
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let r = 1.0 - t;
+    return Basis1(
+        u32(first),
+        vec4<f32>(r * r * r / 6.0, 0.5 * t3 - t2 + 2.0 / 3.0, -0.5 * t3 + 0.5 * t2 + 0.5 * t + 1.0 / 6.0, t3 / 6.0),
+        vec4<f32>(-0.5 * r * r, 1.5 * t2 - 2.0 * t, -1.5 * t2 + t + 0.5, 0.5 * t2),
+    );
+}
+
+// The general open-knot evaluation on span s (Cox-de Boor).
+fn bs_open_basis(u: f32, s: i32, n: u32) -> Basis1 {
     let p = BSPLINE_P;
-    let s = clamp(i32(floor(u + 0.5 * f32(p + 1))), p, i32(n) - 1);
     var nb = array<f32, 4>(1.0, 0.0, 0.0, 0.0);
     var lower = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
     var left = array<f32, 4>(0.0, 0.0, 0.0, 0.0);

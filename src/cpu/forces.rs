@@ -20,11 +20,25 @@ pub fn forces(
         let s = stress[p];
         let g = body(p);
         let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
-        let (nodes, w) = cache.particle(p);
-        for (&node, wk) in nodes.iter().zip(w) {
-            let acc = &mut acc[node as usize];
-            acc[0] += -vol * (s[0] * wk[1] + s[2] * wk[2]) + wk[0] * bx;
-            acc[1] += -vol * (s[2] * wk[1] + s[1] * wk[2]) + wk[0] * by;
-        }
+        add_particle_forces(cache, p, vol, s, [bx, by], acc);
     });
+}
+
+/// Adds particle p's −V_p σ_p ∇N + N m_p b to its nodes in `acc` (`mb` is
+/// m_p b). Shared with the fused `stress::stress_forces`.
+#[inline]
+pub fn add_particle_forces(
+    cache: &ShapeCache,
+    p: usize,
+    vol: f64,
+    s: [f64; 3],
+    mb: [f64; 2],
+    acc: &mut [[f64; 2]],
+) {
+    let (nodes, w) = cache.particle(p);
+    for (&node, wk) in nodes.iter().zip(w) {
+        let acc = &mut acc[node as usize];
+        acc[0] += -vol * (s[0] * wk[1] + s[2] * wk[2]) + wk[0] * mb[0];
+        acc[1] += -vol * (s[2] * wk[1] + s[1] * wk[2]) + wk[0] * mb[1];
+    }
 }

@@ -163,7 +163,15 @@ impl CpuBackend {
     /// only when every stage succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
         for stage in STEP {
-            self.run_stage(*stage)?;
+            // Without MLS, shape_eval and p2g run as one pass, and stress
+            // and forces as another (as on the GPU).
+            match stage {
+                Stage::ShapeEval if self.mls.is_none() => self.shape_eval_p2g()?,
+                Stage::P2g if self.mls.is_none() => {}
+                Stage::Stress if self.mls.is_none() => self.stress_forces()?,
+                Stage::Forces if self.mls.is_none() => {}
+                _ => self.run_stage(*stage)?,
+            }
         }
         self.t = if self.final_step {
             self.model.t_end
@@ -172,6 +180,61 @@ impl CpuBackend {
         };
         self.steps += 1;
         Ok(())
+    }
+
+    /// Stages `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
+    fn shape_eval_p2g(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        let a_factor = match m.integrator {
+            Integrator::Fe => 0.0,
+            Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
+        };
+        shape_eval::shape_eval_p2g(
+            &m.shape,
+            &m.grid,
+            &p.x,
+            &mut p.lambda,
+            &mut self.cache,
+            &p.mass,
+            &p.v,
+            &p.a,
+            a_factor,
+            &mut self.mv,
+            &mut self.p2g_scatter,
+        )
+    }
+
+    /// Stages `stress` and `forces` fused (`stress::stress_forces`).
+    fn stress_forces(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        // The stress is at the step's end (t + Δt), so are the loads.
+        let t = self.t + self.dt;
+        let g = m.gravity.map_or([0.0; 2], |g| g.at(t));
+        let (mms, x0) = (&m.manufactured, &p.x0);
+        let body = move |i: usize| match mms {
+            None => g,
+            Some(s) => {
+                let b = s.body_force(x0[i], t);
+                [g[0] + b[0], g[1] + b[1]]
+            }
+        };
+        stress::stress_forces(
+            &self.cache,
+            &self.mv,
+            self.dt,
+            &p.body,
+            &m.materials,
+            &m.body_material,
+            &p.mass,
+            &body,
+            &mut p.stress,
+            &mut p.rho,
+            &mut p.f,
+            &mut self.force,
+            &mut self.force_scatter,
+        )
     }
 
     /// Runs one stage of the step (public so tests can compare stages one by one).

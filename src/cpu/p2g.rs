@@ -17,18 +17,32 @@ pub fn p2g(
 ) {
     scatter.run(mv, mass.len(), |p, acc| {
         let m = mass[p];
-        let mut vel = v[p];
-        if !a.is_empty() {
-            vel[0] += a_factor * a[p][0];
-            vel[1] += a_factor * a[p][1];
-        }
+        let vel = particle_velocity(v, a, a_factor, p);
         let (nodes, w) = cache.particle(p);
-        for (&node, wk) in nodes.iter().zip(w) {
-            let nm = wk[0] * m;
-            let acc = &mut acc[node as usize];
-            acc[0] += nm;
-            acc[1] += nm * vel[0];
-            acc[2] += nm * vel[1];
-        }
+        add_particle(nodes, w, m, vel, acc);
     });
+}
+
+/// Adds one particle's N m and N m v to its nodes in `acc`. Shared with the
+/// fused `shape_eval::shape_eval_p2g`.
+#[inline]
+pub fn add_particle(nodes: &[u32], w: &[[f64; 3]], m: f64, vel: [f64; 2], acc: &mut [[f64; 3]]) {
+    for (&node, wk) in nodes.iter().zip(w) {
+        let nm = wk[0] * m;
+        let acc = &mut acc[node as usize];
+        acc[0] += nm;
+        acc[1] += nm * vel[0];
+        acc[2] += nm * vel[1];
+    }
+}
+
+/// The velocity particle p scatters (NPC: the predictor's).
+#[inline]
+pub fn particle_velocity(v: &[[f64; 2]], a: &[[f64; 2]], a_factor: f64, p: usize) -> [f64; 2] {
+    let mut vel = v[p];
+    if !a.is_empty() {
+        vel[0] += a_factor * a[p][0];
+        vel[1] += a_factor * a[p][1];
+    }
+    vel
 }

@@ -62,6 +62,68 @@ impl<const K: usize> Scatter<K> {
     }
 }
 
+impl<const K: usize> Scatter<K> {
+    /// Particles per worker range for `n_particles` (the split `run` uses).
+    pub fn range_len(n_particles: usize) -> usize {
+        let threads = rayon::current_num_threads().clamp(1, n_particles.max(1));
+        n_particles.div_ceil(threads).max(1)
+    }
+
+    /// Like `run`, for a kernel that also updates per-particle state: `ranges`
+    /// yields, for each worker range of `range_len(n_particles)` particles in
+    /// order, the caller's mutable chunks of its particle arrays (e.g.
+    /// `stress.par_chunks_mut(len)`), and `kernel(first particle, chunks,
+    /// acc)` runs the range. Returns the kernels' results folded by `fold`.
+    pub fn run_ranges<C: Send, R: Send>(
+        &mut self,
+        out: &mut [[f64; K]],
+        n_particles: usize,
+        ranges: impl IndexedParallelIterator<Item = C>,
+        kernel: impl Fn(usize, C, &mut [[f64; K]]) -> R + Sync,
+        fold: impl Fn(R, R) -> R + Sync + Send,
+        none: impl Fn() -> R + Sync + Send,
+    ) -> R {
+        if n_particles == 0 {
+            return none();
+        }
+        let n_nodes = out.len();
+        let threads = rayon::current_num_threads().clamp(1, n_particles.max(1));
+        let per = Self::range_len(n_particles);
+        let used = n_particles.div_ceil(per).max(1);
+        if self.scratch.len() != threads * n_nodes {
+            self.scratch = vec![[0.0; K]; threads * n_nodes];
+        }
+        let r = self
+            .scratch
+            .par_chunks_mut(n_nodes)
+            .take(used)
+            .zip(ranges)
+            .enumerate()
+            .map(|(t, (acc, c))| {
+                acc.fill([0.0; K]);
+                kernel(t * per, c, acc)
+            })
+            .reduce(&none, &fold);
+        let scratch = &self.scratch;
+        out.par_chunks_mut(REDUCE_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let base = c * REDUCE_CHUNK;
+                for (k, o) in chunk.iter_mut().enumerate() {
+                    let mut sum = *o;
+                    for t in 0..used {
+                        let v = &scratch[t * n_nodes + base + k];
+                        for d in 0..K {
+                            sum[d] += v[d];
+                        }
+                    }
+                    *o = sum;
+                }
+            });
+        r
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,8 @@
 //! GPU twin: `shaders/lme_newton.wgsl` (LME); other shapes are evaluated
 //! inline in each GPU pass.
 
-use super::ShapeCache;
+use super::p2g::{add_particle, particle_velocity};
+use super::{ShapeCache, scatter::Scatter};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::Shape;
@@ -60,6 +61,99 @@ pub fn shape_eval(
             .with_min_len(64)
             .map(|(p, (x, l, c, n, w))| eval(p, *x, l, c, n, w))
             .reduce(|| None, Fault::first)
+    };
+    fault.map_or(Ok(()), Err)
+}
+
+/// Stages `shape_eval` then `p2g` in one pass over the particles (what a
+/// whole step runs without MLS): each worker range evaluates its particles'
+/// weights into the cache and scatters them while they are still in the
+/// core's cache. The same values and sums in the same order as the two
+/// stages. Arguments as `shape_eval` and `p2g::p2g`.
+#[allow(clippy::too_many_arguments)]
+pub fn shape_eval_p2g(
+    shape: &Shape,
+    grid: &Grid,
+    x: &[[f64; 2]],
+    lambda: &mut [[f64; 2]],
+    cache: &mut ShapeCache,
+    mass: &[f64],
+    v: &[[f64; 2]],
+    a: &[[f64; 2]],
+    a_factor: f64,
+    mv: &mut [[f64; 3]],
+    scatter: &mut Scatter<3>,
+) -> Result<(), Fault> {
+    let s = cache.stride;
+    let n = x.len();
+    let len = Scatter::<3>::range_len(n);
+    let particle = |p: usize,
+                    lam: &mut [f64; 2],
+                    cnt: &mut u16,
+                    nodes: &mut [u32],
+                    w: &mut [[f64; 3]],
+                    acc: &mut [[f64; 3]]| {
+        match shape.eval(grid, x[p], lam, nodes, w) {
+            Ok(k) => {
+                *cnt = k as u16;
+                let vel = particle_velocity(v, a, a_factor, p);
+                add_particle(&nodes[..k], &w[..k], mass[p], vel, acc);
+                None
+            }
+            Err(e) => {
+                *cnt = 0;
+                Some(Fault::at(p, FaultKind::Shape(e)))
+            }
+        }
+    };
+    let ranges = cache
+        .count
+        .par_chunks_mut(len)
+        .zip(cache.nodes.par_chunks_mut(len * s))
+        .zip(cache.w.par_chunks_mut(len * s));
+    let fault = if lambda.is_empty() {
+        scatter.run_ranges(
+            mv,
+            n,
+            ranges,
+            |first, ((c, nodes), w), acc| {
+                let mut fault = None;
+                for (k, ((c, nodes), w)) in c
+                    .iter_mut()
+                    .zip(nodes.chunks_mut(s))
+                    .zip(w.chunks_mut(s))
+                    .enumerate()
+                {
+                    let f = particle(first + k, &mut [0.0; 2], c, nodes, w, acc);
+                    fault = Fault::first(fault, f);
+                }
+                fault
+            },
+            Fault::first,
+            || None,
+        )
+    } else {
+        scatter.run_ranges(
+            mv,
+            n,
+            ranges.zip(lambda.par_chunks_mut(len)),
+            |first, (((c, nodes), w), lam), acc| {
+                let mut fault = None;
+                for (k, (((c, nodes), w), lam)) in c
+                    .iter_mut()
+                    .zip(nodes.chunks_mut(s))
+                    .zip(w.chunks_mut(s))
+                    .zip(lam)
+                    .enumerate()
+                {
+                    let f = particle(first + k, lam, c, nodes, w, acc);
+                    fault = Fault::first(fault, f);
+                }
+                fault
+            },
+            Fault::first,
+            || None,
+        )
     };
     fault.map_or(Ok(()), Err)
 }

@@ -5,7 +5,8 @@
 //! The density follows the volume ratio the material returns.
 //! GPU twin: `shaders/stress.wgsl`.
 
-use super::ShapeCache;
+use super::forces::add_particle_forces;
+use super::{ShapeCache, scatter::Scatter};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::Material;
 use rayon::prelude::*;
@@ -23,26 +24,16 @@ pub fn stress(
     f: &mut [[f64; 4]],
 ) -> Result<(), Fault> {
     let kernel = |p: usize, s: &mut [f64; 3], r: &mut f64, f: &mut [f64; 4]| {
-        let (nodes, w) = cache.particle(p);
-        // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
-        let mut l = [0.0; 4];
-        for (&node, wk) in nodes.iter().zip(w) {
-            let v = &mv[node as usize];
-            l[0] += v[1] * wk[1];
-            l[1] += v[1] * wk[2];
-            l[2] += v[2] * wk[1];
-            l[3] += v[2] * wk[2];
-        }
-        match materials[body_material[body[p] as usize] as usize].update(l, dt, s, f) {
-            Err(kind) => Some(Fault::at(p, kind)),
-            Ok(j) => {
-                *r /= j;
-                if !(s[0].is_finite() && s[1].is_finite() && s[2].is_finite()) {
-                    return Some(Fault::at(p, FaultKind::NonFinite { field: "stress" }));
-                }
-                None
-            }
-        }
+        update_particle(
+            cache,
+            mv,
+            dt,
+            &materials[body_material[body[p] as usize] as usize],
+            p,
+            s,
+            r,
+            f,
+        )
     };
     let fault = if f.is_empty() {
         (stress.par_iter_mut(), rho.par_iter_mut())
@@ -60,4 +51,149 @@ pub fn stress(
             .reduce(|| None, Fault::first)
     };
     fault.map_or(Ok(()), Err)
+}
+
+/// Particle p's velocity gradient and material update (the whole stage for
+/// one particle).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn update_particle(
+    cache: &ShapeCache,
+    mv: &[[f64; 3]],
+    dt: f64,
+    material: &Material,
+    p: usize,
+    s: &mut [f64; 3],
+    r: &mut f64,
+    f: &mut [f64; 4],
+) -> Option<Fault> {
+    let (nodes, w) = cache.particle(p);
+    // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
+    let mut l = [0.0; 4];
+    for (&node, wk) in nodes.iter().zip(w) {
+        let v = &mv[node as usize];
+        l[0] += v[1] * wk[1];
+        l[1] += v[1] * wk[2];
+        l[2] += v[2] * wk[1];
+        l[3] += v[2] * wk[2];
+    }
+    match material.update(l, dt, s, f) {
+        Err(kind) => Some(Fault::at(p, kind)),
+        Ok(j) => {
+            *r /= j;
+            if !(s[0].is_finite() && s[1].is_finite() && s[2].is_finite()) {
+                return Some(Fault::at(p, FaultKind::NonFinite { field: "stress" }));
+            }
+            None
+        }
+    }
+}
+
+/// Stages `stress` then `forces` in one pass over the particles (what a
+/// whole step runs without MLS; twin of stress.wgsl built with FORCES): each
+/// particle's update, then its forces from the stress just computed, with
+/// the shape cache read once. The same sums as the two stages, in the same
+/// order per node and thread, so the same result.
+#[allow(clippy::too_many_arguments)]
+pub fn stress_forces(
+    cache: &ShapeCache,
+    mv: &[[f64; 3]],
+    dt: f64,
+    body: &[u32],
+    materials: &[Material],
+    body_material: &[u32],
+    mass: &[f64],
+    body_force: &(dyn Fn(usize) -> [f64; 2] + Sync),
+    stress: &mut [[f64; 3]],
+    rho: &mut [f64],
+    f: &mut [[f64; 4]],
+    force: &mut [[f64; 2]],
+    scatter: &mut Scatter<2>,
+) -> Result<(), Fault> {
+    let n = mass.len();
+    let len = Scatter::<2>::range_len(n);
+    let particle =
+        |p: usize, s: &mut [f64; 3], r: &mut f64, f: &mut [f64; 4], acc: &mut [[f64; 2]]| {
+            let material = &materials[body_material[body[p] as usize] as usize];
+            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, f) {
+                return Some(fault);
+            }
+            let g = body_force(p);
+            let m = mass[p];
+            add_particle_forces(cache, p, m / *r, *s, [m * g[0], m * g[1]], acc);
+            None
+        };
+    let fault = if f.is_empty() {
+        let ranges = stress.par_chunks_mut(len).zip(rho.par_chunks_mut(len));
+        scatter.run_ranges(
+            force,
+            n,
+            ranges,
+            |first, (s, r), acc| {
+                let mut fault = None;
+                for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
+                    let mut id = [1.0, 0.0, 0.0, 1.0];
+                    fault = Fault::first(fault, particle(first + k, s, r, &mut id, acc));
+                }
+                fault
+            },
+            Fault::first,
+            || None,
+        )
+    } else {
+        let ranges = stress
+            .par_chunks_mut(len)
+            .zip(rho.par_chunks_mut(len))
+            .zip(f.par_chunks_mut(len));
+        scatter.run_ranges(
+            force,
+            n,
+            ranges,
+            |first, ((s, r), f), acc| {
+                let mut fault = None;
+                for (k, ((s, r), f)) in s.iter_mut().zip(r).zip(f).enumerate() {
+                    fault = Fault::first(fault, particle(first + k, s, r, f, acc));
+                }
+                fault
+            },
+            Fault::first,
+            || None,
+        )
+    };
+    fault.map_or(Ok(()), Err)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::bench::{Case, scene};
+    use crate::cpu::CpuBackend;
+    use crate::model::Model;
+    use crate::solver::STEP;
+
+    /// A whole step runs `shape_eval_p2g` and `stress_forces`; the stages
+    /// one by one must give the very same numbers (same sums, same order).
+    #[test]
+    fn fused_step_equals_the_stages_one_by_one() {
+        for shape in ["linear", "bspline2", "lme"] {
+            let sets = [format!("solver.shape={shape}")];
+            let case = Case::new("t", &[sets[0].as_str()]);
+            let model = Model::new(&scene(900, &case).unwrap()).unwrap();
+            let mut fused = CpuBackend::new(model.clone());
+            let mut staged = CpuBackend::new(model);
+            for _ in 0..3 {
+                fused.step().unwrap();
+                for stage in STEP {
+                    staged.run_stage(*stage).unwrap();
+                }
+                staged.set_time(staged.t + staged.dt);
+            }
+            let (a, b) = (&fused.model.particles, &staged.model.particles);
+            assert_eq!(a.stress, b.stress, "{shape}");
+            assert_eq!(a.rho, b.rho, "{shape}");
+            assert_eq!(a.x, b.x, "{shape}");
+            assert_eq!(fused.force, staged.force, "{shape}");
+            assert_eq!(fused.mv, staged.mv, "{shape}");
+            assert_eq!(a.lambda, b.lambda, "{shape}");
+        }
+    }
 }

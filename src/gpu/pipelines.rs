@@ -28,6 +28,10 @@ pub enum Pass {
     MlsP2g,
     GridPredict,
     Stress,
+    /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
+    /// what a whole step runs without MLS. Not in `ALL`, which lists the
+    /// passes of the stages one by one.
+    StressForces,
     Forces,
     MlsForces,
     GridCorrect,
@@ -83,7 +87,7 @@ impl Pass {
             Pass::LmeNewton => "lme_newton.wgsl",
             Pass::P2g => "p2g.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
-            Pass::Stress => "stress.wgsl",
+            Pass::Stress | Pass::StressForces => "stress.wgsl",
             Pass::Forces => "forces.wgsl",
             Pass::G2p => "g2p.wgsl",
             Pass::StepEnd => "step_end.wgsl",
@@ -245,7 +249,7 @@ impl Variant {
             | Pass::MlsFill
             | Pass::MlsP2g
             | Pass::MlsForces => self.mls,
-            Pass::P2g | Pass::Forces => !self.mls,
+            Pass::P2g | Pass::Forces | Pass::StressForces => !self.mls,
             _ => true,
         }
     }
@@ -263,7 +267,8 @@ pub fn lme_side(model: &Model) -> u32 {
 /// Expands a pass's WGSL for `d`, adding the pass's own flag.
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
-    d.flag("CORRECT", pass == Pass::GridCorrect);
+    d.flag("CORRECT", pass == Pass::GridCorrect)
+        .flag("FORCES", pass == Pass::StressForces);
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
@@ -355,7 +360,7 @@ impl Pipelines {
         let d = variant.defines();
         let lme = matches!(model.shape, Shape::Lme(_));
         let mut built = Vec::new();
-        for pass in Pass::ALL {
+        for pass in Pass::ALL.into_iter().chain([Pass::StressForces]) {
             if !variant.uses(pass) {
                 continue;
             }
@@ -471,14 +476,25 @@ impl Pipelines {
         cpass.dispatch_workgroups(x, y, 1);
     }
 
-    /// Records the passes of one whole step, in `solver::STEP` order.
+    /// The passes of one whole step, in `solver::STEP` order; without MLS
+    /// `stress` and `forces` run fused as `StressForces`.
+    pub fn step_passes(lme: bool, mls: bool) -> impl Iterator<Item = Pass> {
+        crate::solver::STEP
+            .iter()
+            .flat_map(move |stage| Pass::for_stage(*stage, lme, mls).iter().copied())
+            .filter_map(move |pass| match pass {
+                Pass::Stress if !mls => Some(Pass::StressForces),
+                Pass::Forces => None,
+                p => Some(p),
+            })
+            .chain([Pass::StepEnd])
+    }
+
+    /// Records the passes of one whole step.
     pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
-        for stage in crate::solver::STEP {
-            for pass in Pass::for_stage(*stage, self.lme, self.mls) {
-                self.dispatch(cpass, *pass);
-            }
+        for pass in Pipelines::step_passes(self.lme, self.mls) {
+            self.dispatch(cpass, pass);
         }
-        self.dispatch(cpass, Pass::StepEnd);
     }
 }
 
@@ -490,5 +506,64 @@ fn grid_2d(n: u32, max: u32) -> (u32, u32) {
         (groups, 1)
     } else {
         (max, groups.div_ceil(max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::ShapeKind;
+
+    /// `StressForces` is outside `Pass::ALL` (which tests/gpu_shaders.rs
+    /// validates in every variant), so it is validated here.
+    #[test]
+    fn fused_stress_forces_validates() {
+        let npc = Integrator::Npc {
+            gamma: 0.5,
+            position: NpcPosition::Corrected,
+        };
+        let mut checked = 0;
+        for shape in [
+            ShapeKind::Linear,
+            ShapeKind::Ugimp,
+            ShapeKind::Lme,
+            ShapeKind::Bspline2,
+            ShapeKind::Bspline3,
+        ] {
+            for integrator in [Integrator::Fe, npc] {
+                for perturbed in [false, true] {
+                    for atomics in [AtomicMode::Float, AtomicMode::CompareExchange] {
+                        for (multi_material, neo_hookean, mms) in [
+                            (false, false, false),
+                            (true, true, false),
+                            (false, true, true),
+                        ] {
+                            let v = Variant {
+                                shape,
+                                integrator,
+                                perturbed,
+                                multi_material,
+                                atomics,
+                                lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
+                                lme_stored: false,
+                                linear_elastic: !neo_hookean || multi_material,
+                                neo_hookean,
+                                def_grad: neo_hookean,
+                                mms,
+                                mls: false,
+                            };
+                            let src = expand(Pass::StressForces, &v.defines()).unwrap();
+                            let m = validate(&src, "stress.wgsl", atomics)
+                                .unwrap_or_else(|e| panic!("{v:?}: {e}"));
+                            let b = bindings(&m);
+                            assert!(b.iter().any(|b| b.buf == Buf::NodeAcc && b.writable));
+                            assert!(b.iter().any(|b| b.buf == Buf::Mass));
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 120);
     }
 }

@@ -43,9 +43,74 @@ pub fn greville(i: usize, n: usize, p: usize) -> f64 {
 
 /// The p + 1 nonzero basis functions at `u` (lattice units, in [0, n − 1])
 /// and their derivatives d/du: returns (first basis index, values, derivatives).
+///
+/// Away from the grid's edge every knot the span touches (t_{s−p} to
+/// t_{s+p+1}) is uniform and the bases are the cardinal B-splines centred
+/// on their nodes, evaluated in closed form (`uniform_basis`); within 2p
+/// cells of the edge the open-knot recursion (`open_basis`) runs. Both give
+/// the same functions (equal to round-off, tested below).
+#[inline]
 pub fn basis(u: f64, n: usize, p: usize) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
-    // Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
-    let s = ((u + 0.5 * (p as f64 + 1.0)).floor() as i64).clamp(p as i64, n as i64 - 1) as usize;
+    let s = span(u, n, p);
+    if s > 2 * p && s + p + 2 <= n {
+        uniform_basis(u, s, p)
+    } else {
+        open_basis(u, s, n, p)
+    }
+}
+
+/// Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
+#[inline]
+fn span(u: f64, n: usize, p: usize) -> usize {
+    ((u + 0.5 * (p as f64 + 1.0)).floor() as i64).clamp(p as i64, n as i64 - 1) as usize
+}
+
+/// Uniform knots: quadratic with f = u − first in [0.5, 1.5), cubic with
+/// t = u − (first + 1) in [0, 1) (the mpm88 weights and their cubic kin).
+#[inline]
+fn uniform_basis(
+    u: f64,
+    s: usize,
+    p: usize,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    let first = s - p;
+    if p == 2 {
+        let f = u - first as f64;
+        let (a, b, c) = (1.5 - f, f - 1.0, f - 0.5);
+        (
+            first,
+            [0.5 * a * a, 0.75 - b * b, 0.5 * c * c, 0.0],
+            [-a, -2.0 * b, c, 0.0],
+        )
+    } else {
+        let t = u - (first + 1) as f64;
+        let (t2, r) = (t * t, 1.0 - t);
+        let t3 = t2 * t;
+        (
+            first,
+            [
+                r * r * r / 6.0,
+                0.5 * t3 - t2 + 2.0 / 3.0,
+                -0.5 * t3 + 0.5 * t2 + 0.5 * t + 1.0 / 6.0,
+                t3 / 6.0,
+            ],
+            [
+                -0.5 * r * r,
+                1.5 * t2 - 2.0 * t,
+                -1.5 * t2 + t + 0.5,
+                0.5 * t2,
+            ],
+        )
+    }
+}
+
+/// The general open-knot evaluation on span `s` (Cox-de Boor).
+fn open_basis(
+    u: f64,
+    s: usize,
+    n: usize,
+    p: usize,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
     let t = |k: usize| knot(k as i64, n, p);
     // Cox-de Boor triangle (The NURBS Book, A2.2), keeping degree p − 1 for the derivatives.
     let mut nb = [0.0; MAX_DEGREE + 1];
@@ -148,6 +213,33 @@ mod tests {
                     u += 0.0371;
                 }
             }
+        }
+    }
+
+    #[test]
+    fn closed_form_interior_matches_the_open_knot_recursion() {
+        for p in [2, 3] {
+            let n = 16;
+            let mut u = 0.0;
+            let mut interior = 0;
+            while u <= (n - 1) as f64 {
+                let s = span(u, n, p);
+                let (f0, n0, d0) = open_basis(u, s, n, p);
+                let (f1, n1, d1) = basis(u, n, p);
+                assert_eq!(f0, f1);
+                for r in 0..=p {
+                    assert!((n0[r] - n1[r]).abs() < 1e-14, "p {p} u {u} r {r}");
+                    assert!((d0[r] - d1[r]).abs() < 1e-13, "p {p} u {u} r {r}");
+                }
+                if s > 2 * p && s + p + 2 <= n {
+                    interior += 1;
+                }
+                u += 0.0173;
+            }
+            assert!(
+                interior > 200,
+                "p {p}: the closed form ran {interior} times"
+            );
         }
     }
 
