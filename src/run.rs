@@ -353,15 +353,15 @@ impl Writer {
             started: None,
             resumed_from: None,
         };
-        w.status_summary("running", None)?;
-        let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
-        w.write("scene.resolved.toml", resolved.as_bytes())?;
         let o = &scene.file.output;
         if o.vtk_final || o.vtk_interval.is_some() {
             let vdir = w.folder.path("vtk");
             std::fs::create_dir_all(&vdir)
                 .map_err(|e| Error::io("cannot create snapshot folder", &vdir, e))?;
         }
+        w.status_summary("running", None)?;
+        let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
+        w.write("scene.resolved.toml", resolved.as_bytes())?;
         Ok(w)
     }
 

@@ -156,6 +156,9 @@ impl Folder {
                 continue;
             }
             for p in [self.dir.join(rel), self.dir.join(format!("{rel}.tmp"))] {
+                if std::fs::symlink_metadata(&p).is_err() {
+                    continue; // gone already (or its folder is not one)
+                }
                 match std::fs::remove_file(&p) {
                     Ok(()) => {}
                     Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}

@@ -28,3 +28,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     }
     written
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_write_leaves_no_tmp_file_and_the_old_file_whole() {
+        let dir = std::env::temp_dir().join(format!("lme-mpm-atomic-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("taken")).unwrap();
+        // A folder where the file should go: the rename fails after the write.
+        let e = write_atomic(&dir.join("taken"), b"data").unwrap_err();
+        assert!(e.to_string().contains("rename"), "{e}");
+        assert!(!dir.join("taken.tmp").exists());
+        // A missing folder: the write itself fails.
+        assert!(write_atomic(&dir.join("none").join("f.csv"), b"x").is_err());
+        write_atomic(&dir.join("f.csv"), b"old").unwrap();
+        assert_eq!(std::fs::read(dir.join("f.csv")).unwrap(), b"old");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
