@@ -141,6 +141,20 @@ fn a_foreign_folder_a_folder_in_use_and_an_unwritable_one_are_refused_before_ste
     assert!(stderr(&o).contains(&foreign.display().to_string()));
     assert_eq!(std::fs::read_dir(&foreign).unwrap().count(), 1);
 
+    // A folder of a version without a manifest: recognised by its
+    // summary.json; lme-mpm's files go, the user's stay.
+    let legacy = tmp("legacy");
+    std::fs::create_dir_all(legacy.join("vtk")).unwrap();
+    std::fs::write(legacy.join("summary.json"), "{}").unwrap();
+    std::fs::write(legacy.join("vtk/particles_00007.vtu"), "old").unwrap();
+    std::fs::write(legacy.join("probes.csv.tmp"), "half").unwrap();
+    std::fs::write(legacy.join("mine.txt"), "keep").unwrap();
+    let o = run("dyka_bar.toml", &legacy, &["solver.t_end=2e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!legacy.join("vtk/particles_00007.vtu").exists());
+    assert_eq!(read(&legacy.join("mine.txt")), "keep");
+    no_tmp_files(&legacy);
+
     // A folder held by a live process (this test): exit 2, pid named.
     let busy = tmp("busy");
     std::fs::create_dir_all(&busy).unwrap();
