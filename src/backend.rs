@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::model::energy::Energy;
 use crate::model::fault::Fault;
 use crate::model::{Model, Particles};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Why `advance` stopped short: the run went unstable (a result), or the
 /// backend itself failed (a GPU device error: an error).
@@ -70,10 +71,12 @@ pub trait Backend {
     fn time(&self) -> f64;
     /// Steps taken.
     fn steps(&self) -> u64;
-    /// Takes steps until the time reaches `t_stop` or the model's `t_end`.
+    /// Takes steps until the time reaches `t_stop` or the model's `t_end`,
+    /// or `stop` is raised (checked between steps on the CPU, between
+    /// submissions on the GPU; the caller sees it raised and the time short).
     /// The last step before `t_end` is shortened to land on it exactly;
     /// other stops may be passed by less than one step.
-    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt>;
+    fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt>;
     /// Takes exactly `n` steps (or fewer if t_end comes first); for benchmarks.
     fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt>;
     /// Probes, energy and reactions now.
@@ -84,4 +87,34 @@ pub trait Backend {
     fn model(&self) -> &Model;
     /// Memory the backend holds per particle, grid included (bytes).
     fn bytes_per_particle(&self) -> f64;
+    /// Replaces the run state with `state` after `steps` steps (resuming
+    /// from a checkpoint): particles, time, Δt of the last step.
+    fn restore(&mut self, state: &State, steps: u64) -> Result<()>;
+}
+
+/// `stop` raised? (Relaxed: the flag is a request, nothing else hangs on it.)
+pub fn stop_requested(stop: &AtomicBool) -> bool {
+    stop.load(Ordering::Relaxed)
+}
+
+/// `state` fits `model`: same particle count and fields, same node count.
+pub fn check_state(model: &Model, state: &State) -> Result<()> {
+    let (p, q) = (&model.particles, &state.particles);
+    let same = p.len() == q.len()
+        && p.a.len() == q.a.len()
+        && p.lambda.len() == q.lambda.len()
+        && p.f.len() == q.f.len()
+        && state.mv.len() == model.grid.n_nodes()
+        && state.force.len() == model.grid.n_nodes();
+    if same {
+        Ok(())
+    } else {
+        Err(Error::Checkpoint(format!(
+            "the state holds {} particles and {} nodes, the scene {} and {}",
+            q.len(),
+            state.mv.len(),
+            p.len(),
+            model.grid.n_nodes()
+        )))
+    }
 }

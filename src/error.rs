@@ -25,6 +25,16 @@ pub enum Error {
     #[error("no GPU adapter: {0}")]
     NoAdapter(String),
 
+    /// A checkpoint cannot be resumed: missing, corrupted, from another
+    /// version, or not matching its scene.
+    #[error("checkpoint {0}")]
+    Checkpoint(String),
+
+    /// The output folder cannot be used: not an lme-mpm folder, or another
+    /// run holds it.
+    #[error("output folder {0}")]
+    Folder(String),
+
     /// The GPU device reported an error (validation, out of memory, lost device).
     #[error("GPU error: {0}")]
     Gpu(String),
@@ -35,7 +45,7 @@ impl Error {
     /// 1 for anything else (0 = completed and 3 = unstable are run results).
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Scene(_) => 2,
+            Error::Scene(_) | Error::Checkpoint(_) | Error::Folder(_) => 2,
             _ => 1,
         }
     }

@@ -1,5 +1,7 @@
-//! The `lme-mpm` command line: run, check, info, study, bench. Exit codes:
-//! 0 completed, 2 invalid input, 3 unstable run, 1 anything else.
+//! The `lme-mpm` command line: run, resume, check, info, study, bench.
+//! Exit codes: 0 completed, 2 invalid input (or a folder or checkpoint
+//! that cannot be used), 3 unstable run, 130/143 interrupted by
+//! SIGINT/SIGTERM, 1 anything else.
 
 use clap::{Parser, Subcommand};
 use lme_mpm::run::{self, BackendChoice, RunOptions};
@@ -10,6 +12,8 @@ use lme_mpm::{Error, SceneError};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 #[derive(Parser)]
 #[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC time integration, linear elastic and Neo-Hookean materials, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
@@ -21,6 +25,13 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene and write its outputs (summary.json, probes.csv, particles.csv, VTK).
+    ///
+    /// The output folder belongs to the run: the files an earlier run wrote
+    /// there are removed first (only those: lme-mpm.manifest lists them), a
+    /// second run into a folder in use is refused (lme-mpm.lock), and a
+    /// non-empty folder that is not an lme-mpm output folder is refused.
+    /// SIGINT/SIGTERM stop the run at the next step boundary with every
+    /// output written and a checkpoint (exit 130/143); `resume` continues it.
     Run {
         /// Scene file (TOML), e.g. cases/dyka_bar.toml.
         scene: PathBuf,
@@ -37,7 +48,30 @@ enum Command {
         /// Override a scene key, e.g. --set solver.shape=ugimp --set grid.h=0.0005 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// No progress bar and no result line (warnings and errors still print).
+        /// No progress (bar on a terminal, else a line every 10 %) and no result line
+        /// (warnings and errors still print).
+        #[arg(long, short)]
+        quiet: bool,
+        #[command(flatten)]
+        limits: LimitArgs,
+    },
+    /// Continue the run in DIR from its checkpoint (checkpoint.lmeck: written
+    /// when a run is interrupted, and every output.checkpoint_interval), into
+    /// the same folder: the CSV files keep their rows up to the checkpoint.
+    Resume {
+        /// The run's output folder.
+        dir: PathBuf,
+        /// Where to run: auto = GPU when an adapter exists, else CPU.
+        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+        backend: BackendChoice,
+        /// GPU adapter to use: a case-insensitive part of its name.
+        #[arg(long)]
+        adapter: Option<String>,
+        /// Change a key: solver.t_end (to run further), output.checkpoint_interval,
+        /// output.vtk_interval, output.vtk_final, output.particles_csv (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress and no result line.
         #[arg(long, short)]
         quiet: bool,
         #[command(flatten)]
@@ -191,42 +225,35 @@ fn main() -> ExitCode {
                 Err(e) => return fail(&Error::Scene(e)),
             };
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-            let opts = RunOptions {
-                backend,
-                adapter,
-                out: out.clone(),
-                progress: !quiet && std::io::stderr().is_terminal(),
-                verbose: !quiet,
-                limits: limits.limits(),
+            let Some(signals) = Signals::install_or_say() else {
+                return ExitCode::from(1);
             };
-            match run::run(&scene, &opts) {
-                Ok(outcome) => {
-                    let s = &outcome.summary;
-                    if !quiet {
-                        eprintln!(
-                            "{}: t = {:.6e} s, {} steps, {} particles, {:.3e} particle-steps/s on {}",
-                            s.status,
-                            s.t,
-                            s.steps,
-                            s.particles,
-                            s.particle_steps_per_second,
-                            s.backend
-                        );
-                        if let Some(r) = &s.reason {
-                            eprintln!("reason: {r}");
-                        }
-                        if let Some(e) = &s.errors {
-                            eprintln!("errors: {}", serde_json::to_string(e).unwrap_or_default());
-                        }
-                        eprintln!("outputs: {}", out.display());
-                    }
-                    match outcome.status {
-                        RunStatus::Completed => ExitCode::SUCCESS,
-                        RunStatus::Unstable { .. } => ExitCode::from(3),
-                    }
-                }
-                Err(e) => fail(&e),
-            }
+            let mut opts = run_options(backend, adapter, out, quiet, &signals);
+            opts.limits = limits.limits();
+            report(run::run(&scene, &opts), &opts, quiet, &signals)
+        }
+        Command::Resume {
+            dir,
+            backend,
+            adapter,
+            set,
+            quiet,
+            limits,
+        } => {
+            let overrides = match set
+                .iter()
+                .map(|s| Override::parse(s))
+                .collect::<Result<Vec<_>, _>>()
+            {
+                Ok(o) => o,
+                Err(e) => return fail(&Error::Scene(e)),
+            };
+            let Some(signals) = Signals::install_or_say() else {
+                return ExitCode::from(1);
+            };
+            let mut opts = run_options(backend, adapter, dir.clone(), quiet, &signals);
+            opts.limits = limits.limits();
+            report(run::resume(&dir, &overrides, &opts), &opts, quiet, &signals)
         }
         Command::Info => info(),
         Command::Study {
@@ -320,6 +347,92 @@ fn main() -> ExitCode {
                 Err(e) => fail(&Error::Scene(e)),
             }
         }
+    }
+}
+
+/// SIGINT and SIGTERM raise `stop` (the run ends at the next step
+/// boundary) and record which came; a second one ends the process at once.
+struct Signals {
+    stop: Arc<AtomicBool>,
+    which: Arc<AtomicUsize>,
+}
+
+impl Signals {
+    fn install() -> std::io::Result<Signals> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let stop = Arc::new(AtomicBool::new(false));
+        let which = Arc::new(AtomicUsize::new(0));
+        for sig in [SIGINT, SIGTERM] {
+            // Order matters: the shutdown checks the flag before it is raised.
+            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&stop))?;
+            signal_hook::flag::register_usize(sig, Arc::clone(&which), sig as usize)?;
+            signal_hook::flag::register(sig, Arc::clone(&stop))?;
+        }
+        Ok(Signals { stop, which })
+    }
+
+    fn install_or_say() -> Option<Signals> {
+        Signals::install()
+            .map_err(|e| eprintln!("error: cannot install the SIGINT/SIGTERM handlers: {e}"))
+            .ok()
+    }
+
+    /// 130 for SIGINT, 143 for SIGTERM.
+    fn exit_code(&self) -> ExitCode {
+        let sig = self.which.load(Ordering::Relaxed);
+        ExitCode::from((128 + sig.clamp(1, 127)) as u8)
+    }
+}
+
+fn run_options(
+    backend: BackendChoice,
+    adapter: Option<String>,
+    out: PathBuf,
+    quiet: bool,
+    signals: &Signals,
+) -> RunOptions {
+    let terminal = std::io::stderr().is_terminal();
+    RunOptions {
+        backend,
+        adapter,
+        out,
+        progress: !quiet && terminal,
+        progress_lines: !quiet && !terminal,
+        verbose: !quiet,
+        stop: Some(Arc::clone(&signals.stop)),
+        limits: Default::default(),
+    }
+}
+
+/// The result line of `run` and `resume`, and the exit code.
+fn report(
+    result: lme_mpm::Result<run::Outcome>,
+    opts: &RunOptions,
+    quiet: bool,
+    signals: &Signals,
+) -> ExitCode {
+    let outcome = match result {
+        Ok(o) => o,
+        Err(e) => return fail(&e),
+    };
+    let s = &outcome.summary;
+    if !quiet {
+        eprintln!(
+            "{}: t = {:.6e} s, {} steps, {} particles, {:.3e} particle-steps/s on {}",
+            s.status, s.t, s.steps, s.particles, s.particle_steps_per_second, s.backend
+        );
+        if let Some(r) = &s.reason {
+            eprintln!("reason: {r}");
+        }
+        if let Some(e) = &s.errors {
+            eprintln!("errors: {}", serde_json::to_string(e).unwrap_or_default());
+        }
+        eprintln!("outputs: {}", opts.out.display());
+    }
+    match outcome.status {
+        RunStatus::Completed => ExitCode::SUCCESS,
+        RunStatus::Unstable { .. } => ExitCode::from(3),
+        RunStatus::Interrupted { .. } => signals.exit_code(),
     }
 }
 

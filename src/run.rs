@@ -2,19 +2,23 @@
 //! writing samples and snapshots, then score and summarise. Nothing is
 //! written before the scene and model are known to be valid.
 
-use crate::backend::{Backend, Sample};
+use crate::backend::{Backend, Sample, State};
 use crate::cpu::CpuBackend;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::model::shape::Shape;
+use crate::output::checkpoint::{self, Checkpoint};
+use crate::output::folder::Folder;
 use crate::output::{self, csv, summary::Summary, vtk};
-use crate::scene::Scene;
+use crate::scene::{Override, Scene};
 pub use crate::simulation::BackendChoice;
 use crate::simulation::{BackendSpec, Simulation};
-use crate::solver::{Observer, RunStatus};
+use crate::solver::{Cursor, Observer, RunStatus};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 #[derive(Debug, Clone)]
@@ -25,10 +29,16 @@ pub struct RunOptions {
     pub out: PathBuf,
     /// Show a progress bar on a terminal (runs over a second).
     pub progress: bool,
+    /// Print a progress line to stderr every 10 % of t_end (and at least
+    /// once a minute): for logs, when stderr is not a terminal.
+    pub progress_lines: bool,
     /// Print the backend choice and the result line to stderr.
     pub verbose: bool,
     /// What the preflight allows (memory, steps, hours, snapshots).
     pub limits: crate::preflight::Limits,
+    /// Raised (by a signal handler) to stop at the next step boundary:
+    /// the run then writes its outputs and a checkpoint and ends `interrupted`.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// How a run ended, with its summary (also written to summary.json).
@@ -38,33 +48,148 @@ pub struct Outcome {
     pub summary: Summary,
 }
 
-/// Runs `scene` and writes its outputs to `opts.out`. The preflight comes
-/// first: a scene that cannot fit or run in the limits is refused before
-/// anything is allocated, and output intervals below a step are clamped
-/// (with a warning on stderr).
+/// `--set` keys `lme-mpm resume` accepts: the rest would change the run
+/// being continued.
+pub const RESUME_KEYS: &[&str] = &[
+    "solver.t_end",
+    "output.checkpoint_interval",
+    "output.vtk_interval",
+    "output.vtk_final",
+    "output.particles_csv",
+];
+
+/// Runs `scene` and writes its outputs to `opts.out`, which it takes for
+/// itself (see `output::folder`): the files of an earlier run there go.
+/// The preflight comes first: a scene that cannot fit or run in the limits
+/// is refused before anything is allocated or written, and output
+/// intervals below a step are clamped (with a warning on stderr).
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let start = Instant::now();
+    let plan = preflight(scene, opts)?;
+    let scene = &plan.scene;
+    let mut sim = Simulation::new(scene, &spec(opts))?;
+    let folder = Folder::create(&opts.out)?;
+    let writer = Writer::start(folder, scene, sim.backend_ref().model(), opts)?;
+    execute(&mut sim, writer, None, start, opts, &plan)
+}
+
+/// The preflight of `scene` under `opts.limits`, its warnings printed.
+fn preflight(scene: &Scene, opts: &RunOptions) -> Result<crate::preflight::Plan> {
     let plan = crate::preflight::plan(scene, &opts.limits, rayon::current_num_threads())?;
     for w in &plan.warnings {
         eprintln!("warning: {w}");
     }
-    let scene = &plan.scene;
-    let spec = BackendSpec {
+    Ok(plan)
+}
+
+/// Continues the run in `dir` from its checkpoint, into the same folder:
+/// the CSV files keep their rows up to the checkpoint and go on from there.
+/// `overrides` may only touch `RESUME_KEYS` (a later `solver.t_end`, say).
+pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<Outcome> {
+    let start = Instant::now();
+    for o in overrides {
+        let key = o.path.join(".");
+        if !RESUME_KEYS.contains(&key.as_str()) {
+            return Err(Error::Scene(crate::SceneError::Override {
+                arg: o.arg.clone(),
+                message: format!(
+                    "resume continues the run as it was; only {} can change",
+                    RESUME_KEYS.join(", ")
+                ),
+            }));
+        }
+    }
+    let mut folder = Folder::resume(dir)?;
+    let ck_path = folder.path(checkpoint::FILE);
+    if !ck_path.is_file() {
+        return Err(Error::Checkpoint(format!(
+            "{}: none in this folder (a run writes one when interrupted, or every \
+             output.checkpoint_interval)",
+            ck_path.display()
+        )));
+    }
+    let ck = Checkpoint::read(&ck_path)?;
+    let origin = ck_path.display().to_string();
+    let scene = Scene::from_str(&ck.scene_toml, &origin, &ck.scene_name, overrides)?;
+    if ck.t >= scene.solver().t_end {
+        return Err(Error::Checkpoint(format!(
+            "{origin} is at t = {} s, not before t_end = {} s: resume with --set solver.t_end=LATER",
+            ck.t,
+            scene.solver().t_end
+        )));
+    }
+    // A later t_end goes through the preflight like a new run.
+    let plan = preflight(&scene, opts)?;
+    let mut sim = Simulation::new(&plan.scene, &spec(opts))?;
+    let nodes = sim.backend_ref().model().grid.n_nodes();
+    let state = State {
+        particles: ck.particles.clone(),
+        mv: vec![[0.0; 3]; nodes],
+        force: vec![[0.0; 2]; nodes],
+        t: ck.t,
+        dt: ck.dt,
+    };
+    sim.backend().restore(&state, ck.steps)?;
+    // What the run wrote after its checkpoint goes; the snapshots up to it stay.
+    let keep: std::collections::BTreeSet<&str> = ck
+        .snapshots
+        .iter()
+        .map(|(_, f)| f.as_str())
+        .chain([checkpoint::FILE])
+        .chain((!ck.snapshots.is_empty()).then_some("particles.pvd"))
+        .collect();
+    folder.retain(|f| keep.contains(f))?;
+    let mut writer = Writer::start(folder, &plan.scene, sim.backend_ref().model(), opts)?;
+    writer.samples = ck.samples.clone();
+    writer.snapshots = ck.snapshots.clone();
+    writer.resumed_from = Some(ck.t);
+    writer.flush()?;
+    writer.write_pvd()?;
+    execute(&mut sim, writer, Some(ck.cursor), start, opts, &plan)
+}
+
+fn spec(opts: &RunOptions) -> BackendSpec {
+    BackendSpec {
         choice: Some(opts.backend),
         adapter: opts.adapter.clone(),
         gpu: Default::default(),
         verbose: opts.verbose,
-    };
-    let mut sim = Simulation::new(scene, &spec)?;
+    }
+}
 
-    std::fs::create_dir_all(&opts.out)
-        .map_err(|e| Error::io("cannot create output folder", &opts.out, e))?;
-    let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
-    output::write_atomic(&opts.out.join("scene.resolved.toml"), resolved.as_bytes())?;
+/// Drives `sim` to its end with `writer`, then writes the final outputs
+/// and summary.json. A failure on the way is written to summary.json too.
+fn execute(
+    sim: &mut Simulation,
+    mut writer: Writer,
+    cursor: Option<Cursor>,
+    start: Instant,
+    opts: &RunOptions,
+    plan: &crate::preflight::Plan,
+) -> Result<Outcome> {
+    let result = finish(sim, &mut writer, cursor, start, opts, plan);
+    if let Err(e) = &result {
+        // Best effort: the folder must not claim a run that has ended.
+        let _ = writer.status_summary("failed", Some(&e.to_string()));
+    }
+    result
+}
 
-    let mut writer = Writer::new(&opts.out, sim.backend_ref().model(), opts.progress);
+fn finish(
+    sim: &mut Simulation,
+    writer: &mut Writer,
+    cursor: Option<Cursor>,
+    start: Instant,
+    opts: &RunOptions,
+    plan: &crate::preflight::Plan,
+) -> Result<Outcome> {
+    let scene = sim.scene.clone();
+    let steps0 = sim.backend_ref().steps();
+    let mut schedule = sim.schedule();
+    schedule.stop = opts.stop.clone();
     let t_drive = Instant::now();
-    let driven = sim.drive(&mut writer);
+    writer.started = Some((t_drive, sim.backend_ref().time(), steps0));
+    let driven = sim.drive_from(schedule, writer, cursor);
     writer.finish_progress();
     let status = driven?;
     let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
@@ -73,6 +198,13 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let backend = sim.backend();
     let t = backend.time();
     let steps = backend.steps();
+    if matches!(status, RunStatus::Interrupted { .. })
+        && writer.samples.last().is_none_or(|s| s.t < t)
+    {
+        // Every CSV ends at the time reached.
+        let s = backend.sample()?;
+        writer.samples.push(s);
+    }
     let bytes_per_particle = backend.bytes_per_particle();
     let backend_name = backend.name();
     let final_sample = writer.samples.last().cloned();
@@ -80,13 +212,20 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
     let model = backend.model().clone();
     let particles = &particles;
     if scene.file.output.particles_csv {
-        output::write_atomic(
-            &opts.out.join("particles.csv"),
+        writer.write(
+            "particles.csv",
             csv::particles(&model.body_names, particles).as_bytes(),
         )?;
     }
+    let out = &scene.file.output;
+    let vtk_on = out.vtk_final || out.vtk_interval.is_some();
+    let final_snapshot = match status {
+        RunStatus::Completed => out.vtk_final,
+        RunStatus::Unstable { .. } => true,
+        RunStatus::Interrupted { .. } => vtk_on,
+    };
     let snap_done = writer.snapshots.last().is_some_and(|(ts, _)| *ts == t);
-    if (scene.file.output.vtk_final || !matches!(status, RunStatus::Completed)) && !snap_done {
+    if final_snapshot && !snap_done {
         writer.write_snapshot(particles, t)?;
     }
     writer.flush()?;
@@ -98,12 +237,21 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         RunStatus::Unstable { fault, .. } => {
             (Some(fault.to_string()), Some(fault.code()), fault.particle)
         }
+        RunStatus::Interrupted { .. } => (
+            Some(format!(
+                "stopped by a signal at a step boundary; `lme-mpm resume {}` continues it",
+                writer.folder.dir().display()
+            )),
+            None,
+            None,
+        ),
     };
     let npc = matches!(model.integrator, crate::model::Integrator::Npc { .. });
     let summary = Summary {
         status: match status {
             RunStatus::Completed => "completed",
             RunStatus::Unstable { .. } => "unstable",
+            RunStatus::Interrupted { .. } => "interrupted",
         },
         reason,
         reason_code,
@@ -111,12 +259,13 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         scene: scene.name.clone(),
         t,
         t_end: model.t_end,
+        resumed_from: writer.resumed_from,
         steps,
         particles: n,
         nodes: model.grid.n_nodes(),
         wall_seconds: wall,
         wall_seconds_total: start.elapsed().as_secs_f64(),
-        particle_steps_per_second: n as f64 * steps as f64 / wall,
+        particle_steps_per_second: n as f64 * (steps - steps0) as f64 / wall,
         backend: backend_name,
         bytes_per_particle,
         shape: solver.shape,
@@ -153,31 +302,46 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
         peak_rss_bytes: crate::preflight::peak_rss(),
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
-    output::write_atomic(&opts.out.join("summary.json"), json.as_bytes())?;
+    writer.write("summary.json", json.as_bytes())?;
     Ok(Outcome { status, summary })
 }
 
 /// Observer that keeps the samples, rewrites the CSV files now and then (so
-/// a killed run leaves complete files) and writes VTK snapshots.
+/// a killed run leaves complete files), writes VTK snapshots and
+/// checkpoints, and lists every file in the folder's manifest first.
 struct Writer {
-    dir: PathBuf,
+    folder: Folder,
+    scene_name: String,
+    /// The resolved scene with `output.sample_interval` explicit (checkpoints).
+    scene_toml: String,
     probe_names: Vec<String>,
     group_names: Vec<String>,
+    n_particles: usize,
     samples: Vec<Sample>,
     snapshots: Vec<(f64, String)>,
     last_flush: Instant,
     io_seconds: f64,
     progress: Option<(ProgressBar, Instant)>,
+    /// Progress lines: the last tenth of t_end reported, and when.
+    lines: Option<(u64, Instant)>,
+    /// When driving started, with the time and steps then.
+    started: Option<(Instant, f64, u64)>,
+    resumed_from: Option<f64>,
 }
 
 /// Rewrite the CSV files at most this often while running.
 const FLUSH_EVERY: Duration = Duration::from_secs(5);
 /// Runs shorter than this show no progress bar.
 const PROGRESS_AFTER: Duration = Duration::from_secs(1);
+/// A progress line at least this often, even between tenths.
+const LINE_EVERY: Duration = Duration::from_secs(60);
 
 impl Writer {
-    fn new(dir: &Path, model: &Model, progress: bool) -> Self {
-        let bar = progress.then(|| {
+    /// Takes the folder for `scene`: writes a `running` summary.json and
+    /// scene.resolved.toml, and makes `vtk/` when snapshots are on, so an
+    /// unwritable folder fails before the first step.
+    fn start(folder: Folder, scene: &Scene, model: &Model, opts: &RunOptions) -> Result<Writer> {
+        let bar = opts.progress.then(|| {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::hidden());
             bar.set_style(
                 ProgressStyle::with_template(
@@ -188,8 +352,12 @@ impl Writer {
             );
             (bar, Instant::now())
         });
-        Writer {
-            dir: dir.to_path_buf(),
+        let mut file = scene.file.clone();
+        file.output.sample_interval = Some(scene.sample_interval);
+        let mut w = Writer {
+            folder,
+            scene_name: scene.name.clone(),
+            scene_toml: toml::to_string(&file).expect("a scene file serialises to TOML"),
             probe_names: model.probes.iter().map(|p| p.name.clone()).collect(),
             group_names: model
                 .constraints
@@ -197,28 +365,57 @@ impl Writer {
                 .iter()
                 .map(|g| g.name.clone())
                 .collect(),
+            n_particles: model.particles.len(),
             samples: Vec::new(),
             snapshots: Vec::new(),
             last_flush: Instant::now(),
             io_seconds: 0.0,
             progress: bar,
+            lines: opts.progress_lines.then(|| (0, Instant::now())),
+            started: None,
+            resumed_from: None,
+        };
+        let o = &scene.file.output;
+        if o.vtk_final || o.vtk_interval.is_some() {
+            let vdir = w.folder.path("vtk");
+            std::fs::create_dir_all(&vdir)
+                .map_err(|e| Error::io("cannot create snapshot folder", &vdir, e))?;
         }
+        w.status_summary("running", None)?;
+        let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
+        w.write("scene.resolved.toml", resolved.as_bytes())?;
+        Ok(w)
+    }
+
+    /// Writes `rel` in the folder (atomically), listed in the manifest first.
+    fn write(&mut self, rel: &str, bytes: &[u8]) -> Result<()> {
+        self.folder.record(rel)?;
+        output::write_atomic(&self.folder.path(rel), bytes)
+    }
+
+    /// A short summary.json while the run is not done (`running`) or after
+    /// it failed (`failed`, with the error).
+    fn status_summary(&mut self, status: &str, error: Option<&str>) -> Result<()> {
+        let json = serde_json::json!({
+            "status": status,
+            "error": error,
+            "scene": self.scene_name,
+            "pid": std::process::id(),
+            "resumed_from": self.resumed_from,
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        let text = serde_json::to_string_pretty(&json).expect("json serialises");
+        self.write("summary.json", text.as_bytes())
     }
 
     fn flush(&mut self) -> Result<()> {
         let t0 = Instant::now();
-        output::write_atomic(
-            &self.dir.join("probes.csv"),
-            csv::probes(&self.probe_names, &self.samples).as_bytes(),
-        )?;
-        output::write_atomic(
-            &self.dir.join("energy.csv"),
-            csv::energy(&self.samples).as_bytes(),
-        )?;
-        output::write_atomic(
-            &self.dir.join("reactions.csv"),
-            csv::reactions(&self.group_names, &self.samples).as_bytes(),
-        )?;
+        let probes = csv::probes(&self.probe_names, &self.samples);
+        self.write("probes.csv", probes.as_bytes())?;
+        let energy = csv::energy(&self.samples);
+        self.write("energy.csv", energy.as_bytes())?;
+        let reactions = csv::reactions(&self.group_names, &self.samples);
+        self.write("reactions.csv", reactions.as_bytes())?;
         self.last_flush = Instant::now();
         self.io_seconds += t0.elapsed().as_secs_f64();
         Ok(())
@@ -226,23 +423,48 @@ impl Writer {
 
     fn write_snapshot(&mut self, particles: &crate::model::Particles, t: f64) -> Result<()> {
         let t0 = Instant::now();
-        let vdir = self.dir.join("vtk");
+        let vdir = self.folder.path("vtk");
         std::fs::create_dir_all(&vdir).map_err(|e| Error::io("cannot create", &vdir, e))?;
-        let name = format!("particles_{:05}.vtu", self.snapshots.len());
-        output::write_atomic(&vdir.join(&name), &vtk::particles_vtu(particles, t))?;
-        self.snapshots.push((t, format!("vtk/{name}")));
-        output::write_atomic(
-            &self.dir.join("particles.pvd"),
-            vtk::pvd(&self.snapshots).as_bytes(),
-        )?;
+        let name = format!("vtk/particles_{:05}.vtu", self.snapshots.len());
+        self.write(&name, &vtk::particles_vtu(particles, t))?;
+        self.snapshots.push((t, name));
+        self.write_pvd()?;
         self.io_seconds += t0.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    fn write_pvd(&mut self) -> Result<()> {
+        if self.snapshots.is_empty() {
+            return Ok(());
+        }
+        let pvd = vtk::pvd(&self.snapshots);
+        self.write("particles.pvd", pvd.as_bytes())
     }
 
     fn finish_progress(&mut self) {
         if let Some((bar, _)) = &self.progress {
             bar.finish_and_clear();
         }
+    }
+
+    /// One progress line on stderr: time reached, steps, speed, ETA.
+    fn progress_line(&self, t: f64, t_end: f64, steps: u64) {
+        let Some((t0, time0, steps0)) = self.started else {
+            return;
+        };
+        let secs = t0.elapsed().as_secs_f64().max(1e-9);
+        let rate = self.n_particles as f64 * steps.saturating_sub(steps0) as f64 / secs;
+        let done = (t - time0) / (t_end - time0).max(f64::MIN_POSITIVE);
+        let eta = if done > 0.0 {
+            format!("{:.0} s", secs * (1.0 - done) / done)
+        } else {
+            "unknown".to_string()
+        };
+        eprintln!(
+            "progress: {:>3.0} %  t = {t:.4e} s of {t_end:.4e} s, {steps} steps, \
+             {rate:.3e} particle-steps/s, eta {eta}",
+            100.0 * t / t_end
+        );
     }
 }
 
@@ -261,14 +483,42 @@ impl Observer for Writer {
         self.write_snapshot(p, t)
     }
 
-    fn progress(&mut self, fraction: f64) {
+    fn checkpoint(&mut self, backend: &mut dyn Backend, cursor: &Cursor) -> Result<()> {
+        let t0 = Instant::now();
+        let ck = Checkpoint {
+            scene_name: self.scene_name.clone(),
+            scene_toml: self.scene_toml.clone(),
+            t: backend.time(),
+            // The next step computes its own Δt; 0 says "not known".
+            dt: 0.0,
+            steps: backend.steps(),
+            particles: backend.particles()?.clone(),
+            cursor: *cursor,
+            samples: self.samples.clone(),
+            snapshots: self.snapshots.clone(),
+        };
+        self.write(checkpoint::FILE, &ck.encode())?;
+        // The CSV files as of the checkpoint, so a kill leaves them consistent with it.
+        self.flush()?;
+        self.io_seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn progress(&mut self, t: f64, t_end: f64, steps: u64) {
         if let Some((bar, started)) = &self.progress {
             if bar.is_hidden() && started.elapsed() > PROGRESS_AFTER {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
             }
-            bar.set_position((fraction * 1000.0) as u64);
+            bar.set_position((t / t_end * 1000.0) as u64);
             if let Some(s) = self.samples.last() {
                 bar.set_message(format!("t = {:.4e} s", s.t));
+            }
+        }
+        if let Some((tenth, at)) = self.lines {
+            let now = ((t / t_end * 10.0).floor() as u64).min(10);
+            if now > tenth || at.elapsed() > LINE_EVERY {
+                self.progress_line(t, t_end, steps);
+                self.lines = Some((now.max(tenth), Instant::now()));
             }
         }
     }

@@ -18,7 +18,7 @@ use crate::exact::{self, Errors};
 use crate::gpu::{self, GpuBackend};
 use crate::model::Model;
 use crate::scene::Scene;
-use crate::solver::{self, Observer, RunStatus, Schedule};
+use crate::solver::{self, Cursor, Observer, RunStatus, Schedule};
 
 /// `--backend`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -135,6 +135,8 @@ impl Simulation {
             sample_interval: self.scene.sample_interval,
             vtk_interval: self.scene.file.output.vtk_interval,
             snapshot_times: Vec::new(),
+            checkpoint_interval: self.scene.file.output.checkpoint_interval,
+            stop: None,
         }
     }
 
@@ -147,6 +149,17 @@ impl Simulation {
     /// Runs to t_end on `schedule`.
     pub fn drive_with(&mut self, schedule: Schedule, obs: &mut dyn Observer) -> Result<RunStatus> {
         solver::drive(self.backend.as_mut(), schedule, obs)
+    }
+
+    /// Runs to t_end on `schedule`, continuing from `cursor` (a resumed
+    /// run, its backend restored) or from the start when None.
+    pub fn drive_from(
+        &mut self,
+        schedule: Schedule,
+        obs: &mut dyn Observer,
+        cursor: Option<Cursor>,
+    ) -> Result<RunStatus> {
+        solver::drive_from(self.backend.as_mut(), schedule, obs, cursor)
     }
 
     /// Errors against the scene's exact solution at the time reached (None

@@ -11,6 +11,8 @@ use crate::backend::{Backend, Halt, Sample};
 use crate::error::Result;
 use crate::model::energy::Energy;
 use crate::model::fault::{Fault, FaultKind};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 /// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
 /// WGSL twin `shaders/<name>.wgsl` of the same name.
@@ -60,7 +62,16 @@ pub const ENERGY_RUNAWAY: f64 = 10.0;
 #[derive(Debug, Clone, PartialEq)]
 pub enum RunStatus {
     Completed,
-    Unstable { fault: Fault, t: f64, step: u64 },
+    Unstable {
+        fault: Fault,
+        t: f64,
+        step: u64,
+    },
+    /// `Schedule::stop` was raised (a signal): stopped at a step boundary.
+    Interrupted {
+        t: f64,
+        step: u64,
+    },
 }
 
 /// Receives a run's samples as they happen (the output writer, or a test).
@@ -69,8 +80,13 @@ pub trait Observer {
     fn sample(&mut self, sample: &Sample) -> Result<()>;
     /// A snapshot of all particles is due (VTK).
     fn snapshot(&mut self, backend: &mut dyn Backend) -> Result<()>;
-    /// Progress, as the fraction of t_end reached.
-    fn progress(&mut self, _fraction: f64) {}
+    /// Progress: time reached, t_end (s), steps taken.
+    fn progress(&mut self, _t: f64, _t_end: f64, _steps: u64) {}
+    /// A checkpoint is due (every `Schedule::checkpoint_interval`, and when
+    /// interrupted): `cursor` is what `drive_from` needs to continue.
+    fn checkpoint(&mut self, _backend: &mut dyn Backend, _cursor: &Cursor) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Observer that keeps every sample in memory.
@@ -97,6 +113,29 @@ pub struct Schedule {
     pub vtk_interval: Option<f64>,
     /// Snapshots at these times too, each taken at the first step end at or after it.
     pub snapshot_times: Vec<f64>,
+    /// Checkpoints every this often (s). Default: none.
+    pub checkpoint_interval: Option<f64>,
+    /// Raised to stop at the next step boundary (`RunStatus::Interrupted`).
+    pub stop: Option<Arc<AtomicBool>>,
+}
+
+/// Where `drive` stands between steps: its sample, snapshot and checkpoint
+/// counters and the energy reference of the runaway check. A checkpoint
+/// keeps it so a resumed run samples exactly as an uninterrupted one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cursor {
+    /// Index of the next sample time (k · sample_interval).
+    pub k_sample: u64,
+    /// Index of the next periodic snapshot.
+    pub k_vtk: u64,
+    /// Index of the next checkpoint.
+    pub k_checkpoint: u64,
+    /// Energy at t = 0 (J/m).
+    pub e0: Energy,
+    /// Peak energy a manufactured field supplies (J/m).
+    pub supplied: f64,
+    /// Energies below this are round-off (J/m).
+    pub floor: f64,
 }
 
 impl Schedule {
@@ -124,32 +163,66 @@ pub fn drive(
     schedule: Schedule,
     obs: &mut dyn Observer,
 ) -> Result<RunStatus> {
+    drive_from(backend, schedule, obs, None)
+}
+
+/// `drive`, continuing from `cursor` (a resumed run: the backend holds the
+/// checkpoint's state; no sample or snapshot is taken at the start) or from
+/// t = 0 when `cursor` is None.
+pub fn drive_from(
+    backend: &mut dyn Backend,
+    schedule: Schedule,
+    obs: &mut dyn Observer,
+    cursor: Option<Cursor>,
+) -> Result<RunStatus> {
     let t_end = backend.model().t_end;
-    let first = backend.sample()?;
-    let e0 = first.energy;
-    let scale = energy_floor(backend);
-    // A manufactured body force supplies (and takes back) the exact field's energy.
-    let supplied = {
-        let m = backend.model();
-        m.manufactured
-            .as_ref()
-            .map_or(0.0, |mms| mms.peak_energy(&m.particles))
+    let never = AtomicBool::new(false);
+    let stop = schedule.stop.as_deref().unwrap_or(&never);
+    let mut c = match cursor {
+        Some(c) => c,
+        None => {
+            let first = backend.sample()?;
+            let floor = energy_floor(backend);
+            // A manufactured body force supplies (and takes back) the exact field's energy.
+            let supplied = {
+                let m = backend.model();
+                m.manufactured
+                    .as_ref()
+                    .map_or(0.0, |mms| mms.peak_energy(&m.particles))
+            };
+            obs.sample(&first)?;
+            if schedule.vtk_interval.is_some() {
+                obs.snapshot(backend)?;
+            }
+            Cursor {
+                k_sample: 1,
+                k_vtk: 1,
+                k_checkpoint: 1,
+                e0: first.energy,
+                supplied,
+                floor,
+            }
+        }
     };
-    obs.sample(&first)?;
-    if schedule.vtk_interval.is_some() {
-        obs.snapshot(backend)?;
-    }
-    let mut k_sample = 1u64;
-    let mut k_vtk = 1u64;
     loop {
         let t = backend.time();
         if t >= t_end {
             return Ok(RunStatus::Completed);
         }
-        let next_sample = k_sample as f64 * schedule.sample_interval;
-        let next_vtk = schedule.next_snapshot(k_vtk, t);
-        let stop = next_sample.min(next_vtk).min(t_end);
-        match backend.advance(stop) {
+        if crate::backend::stop_requested(stop) {
+            obs.checkpoint(backend, &c)?;
+            return Ok(RunStatus::Interrupted {
+                t,
+                step: backend.steps(),
+            });
+        }
+        let next_sample = c.k_sample as f64 * schedule.sample_interval;
+        let next_vtk = schedule.next_snapshot(c.k_vtk, t);
+        let next_checkpoint = schedule
+            .checkpoint_interval
+            .map_or(f64::INFINITY, |i| c.k_checkpoint as f64 * i);
+        let target = next_sample.min(next_vtk).min(next_checkpoint).min(t_end);
+        match backend.advance(target, stop) {
             Ok(()) => {}
             Err(Halt::Failed(e)) => return Err(e),
             Err(Halt::Unstable(fault)) => {
@@ -163,12 +236,12 @@ pub fn drive(
             }
         }
         let t = backend.time();
-        obs.progress(t / t_end);
+        obs.progress(t, t_end, backend.steps());
         if t >= next_sample || t >= t_end {
             let s = backend.sample()?;
             obs.sample(&s)?;
-            k_sample = next_multiple(k_sample, schedule.sample_interval, t);
-            if let Some(fault) = runaway(&e0, &s.energy, supplied, scale) {
+            c.k_sample = next_multiple(c.k_sample, schedule.sample_interval, t);
+            if let Some(fault) = runaway(&c.e0, &s.energy, c.supplied, c.floor) {
                 return Ok(RunStatus::Unstable {
                     fault,
                     t,
@@ -179,8 +252,14 @@ pub fn drive(
         if t >= next_vtk {
             obs.snapshot(backend)?;
             if let Some(iv) = schedule.vtk_interval {
-                k_vtk = next_multiple(k_vtk, iv, t);
+                c.k_vtk = next_multiple(c.k_vtk, iv, t);
             }
+        }
+        if t >= next_checkpoint && t < t_end {
+            if let Some(iv) = schedule.checkpoint_interval {
+                c.k_checkpoint = next_multiple(c.k_checkpoint, iv, t);
+            }
+            obs.checkpoint(backend, &c)?;
         }
     }
 }

@@ -89,6 +89,7 @@ fn elastic_block_q4_fails_or_is_far_worse_than_lme() {
     let q4 = run("elastic_block.toml", &["solver.shape=linear"]);
     match q4.status {
         RunStatus::Unstable { fault, t, .. } => println!("Q4 went unstable at t = {t}: {fault}"),
+        RunStatus::Interrupted { .. } => panic!("nothing interrupts this run"),
         RunStatus::Completed => {
             // Our Q4 completes (the paper's blew up early; see
             // docs/verification.md), but no better than this:

@@ -14,12 +14,13 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample, State};
+use crate::backend::{Backend, Halt, ProbeState, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
 use crate::solver::{STEP, Stage};
 use scatter::Scatter;
+use std::sync::atomic::AtomicBool;
 
 /// N and ∇N of every particle for the current step: `stride` slots per
 /// particle, `count[p]` of them used.
@@ -351,8 +352,8 @@ impl Backend for CpuBackend {
         self.steps
     }
 
-    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt> {
-        while self.t < t_stop && self.t < self.model.t_end {
+    fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt> {
+        while self.t < t_stop && self.t < self.model.t_end && !stop_requested(stop) {
             self.step()?;
         }
         Ok(())
@@ -397,5 +398,17 @@ impl Backend for CpuBackend {
 
     fn bytes_per_particle(&self) -> f64 {
         CpuBackend::bytes_per_particle_of(&self.model)
+    }
+
+    fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
+        crate::backend::check_state(&self.model, state)?;
+        self.model.particles = state.particles.clone();
+        self.mv.clone_from(&state.mv);
+        self.force.clone_from(&state.force);
+        self.t = state.t;
+        self.dt = state.dt;
+        self.steps = steps;
+        self.final_step = false;
+        Ok(())
     }
 }

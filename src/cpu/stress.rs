@@ -162,38 +162,3 @@ pub fn stress_forces(
     };
     fault.map_or(Ok(()), Err)
 }
-
-#[cfg(test)]
-mod tests {
-    use crate::bench::{Case, scene};
-    use crate::cpu::CpuBackend;
-    use crate::model::Model;
-    use crate::solver::STEP;
-
-    /// A whole step runs `shape_eval_p2g` and `stress_forces`; the stages
-    /// one by one must give the very same numbers (same sums, same order).
-    #[test]
-    fn fused_step_equals_the_stages_one_by_one() {
-        for shape in ["linear", "bspline2", "lme"] {
-            let sets = [format!("solver.shape={shape}")];
-            let case = Case::new("t", &[sets[0].as_str()]);
-            let model = Model::new(&scene(900, &case).unwrap()).unwrap();
-            let mut fused = CpuBackend::new(model.clone());
-            let mut staged = CpuBackend::new(model);
-            for _ in 0..3 {
-                fused.step().unwrap();
-                for stage in STEP {
-                    staged.run_stage(*stage).unwrap();
-                }
-                staged.set_time(staged.t + staged.dt);
-            }
-            let (a, b) = (&fused.model.particles, &staged.model.particles);
-            assert_eq!(a.stress, b.stress, "{shape}");
-            assert_eq!(a.rho, b.rho, "{shape}");
-            assert_eq!(a.x, b.x, "{shape}");
-            assert_eq!(fused.force, staged.force, "{shape}");
-            assert_eq!(fused.mv, staged.mv, "{shape}");
-            assert_eq!(a.lambda, b.lambda, "{shape}");
-        }
-    }
-}

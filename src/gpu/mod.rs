@@ -12,7 +12,7 @@ pub mod layout;
 pub mod pipelines;
 pub mod preprocess;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample, State};
+use crate::backend::{Backend, Halt, ProbeState, Sample, State, stop_requested};
 use crate::error::{Error, Result};
 use crate::model::energy::Energy;
 use crate::model::fault::{Fault, FaultKind};
@@ -22,6 +22,7 @@ use buffers::{Buf, Buffers};
 use context::{AtomicMode, GpuContext};
 use layout::*;
 use pipelines::{Pass, Pipelines};
+use std::sync::atomic::AtomicBool;
 
 /// Most steps recorded into one submission.
 const MAX_BATCH: u64 = 512;
@@ -206,6 +207,11 @@ impl GpuBackend {
     /// Replaces the device state with `state` (parity tests load the CPU
     /// path's): the particles, the nodal arrays, the time and the step's Δt.
     pub fn upload_state(&mut self, state: &State) {
+        self.upload_state_at(state, 0);
+    }
+
+    /// `upload_state`, with the step counter set to `steps`.
+    fn upload_state_at(&mut self, state: &State, steps: u32) {
         let p = &state.particles;
         let q = &self.ctx.queue;
         let f2 = |v: &[[f64; 2]]| {
@@ -265,9 +271,11 @@ impl GpuBackend {
             t_stop_hi: sh,
             t_stop_lo: sl,
             running: 1,
+            steps,
             ..buffers::initial_sim()
         };
         self.write_sim(&sim);
+        self.sim = sim;
         self.t_floor = 0.0;
         self.model.particles = p.clone();
         self.fresh = false;
@@ -425,7 +433,7 @@ impl Backend for GpuBackend {
         self.sim.steps as u64
     }
 
-    fn advance(&mut self, t_stop: f64) -> std::result::Result<(), Halt> {
+    fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt> {
         let t_end = self.model.t_end;
         let (hi, lo) = split_f64(t_stop.min(t_end));
         // The device compares with the two-float target, which can sit an
@@ -437,6 +445,9 @@ impl Backend for GpuBackend {
             if t >= target {
                 // Reached as the device counts: report the stop time itself.
                 self.t_floor = self.t_floor.max(t_stop.min(t_end));
+                return Ok(());
+            }
+            if stop_requested(stop) {
                 return Ok(());
             }
             let dt = if self.sim.dt > 0.0 {
@@ -569,6 +580,18 @@ impl Backend for GpuBackend {
 
     fn bytes_per_particle(&self) -> f64 {
         self.buffers.bytes() as f64 / self.model.particles.len().max(1) as f64
+    }
+
+    fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
+        crate::backend::check_state(&self.model, state)?;
+        let steps = u32::try_from(steps).map_err(|_| {
+            Error::Checkpoint(format!("{steps} steps exceed the GPU's step counter"))
+        })?;
+        self.upload_state_at(state, steps);
+        self.t_floor = state.t;
+        // The host copy of the particles is the state itself.
+        self.fresh = true;
+        Ok(())
     }
 }
 

@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
-    /// `completed` or `unstable`.
+    /// `completed`, `unstable` or `interrupted` (while running: a short
+    /// summary with `running`; after an error: `failed`).
     pub status: &'static str,
     /// Why the run stopped early (unstable only).
     pub reason: Option<String>,
@@ -21,6 +22,8 @@ pub struct Summary {
     /// Time reached (s).
     pub t: f64,
     pub t_end: f64,
+    /// The checkpoint time this run was resumed from (s); null for a fresh run.
+    pub resumed_from: Option<f64>,
     pub steps: u64,
     pub particles: usize,
     pub nodes: usize,

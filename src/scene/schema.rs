@@ -273,6 +273,9 @@ pub struct OutputSpec {
     pub sample_interval: Option<f64>,
     /// Interval between VTK snapshots (s). Default: none (only the final state, if `vtk_final`).
     pub vtk_interval: Option<f64>,
+    /// Interval between checkpoints (`checkpoint.lmeck`, for `lme-mpm resume`) (s).
+    /// Default: none (a checkpoint is still written when a run is interrupted).
+    pub checkpoint_interval: Option<f64>,
     /// Write a VTK snapshot of the final state. Default true.
     #[serde(default = "default_true")]
     pub vtk_final: bool,
@@ -289,6 +292,7 @@ impl Default for OutputSpec {
         OutputSpec {
             sample_interval: None,
             vtk_interval: None,
+            checkpoint_interval: None,
             vtk_final: true,
             particles_csv: true,
             probes: BTreeMap::new(),

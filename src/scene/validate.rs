@@ -351,6 +351,9 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     if let Some(v) = o.vtk_interval {
         positive("output.vtk_interval", v)?;
     }
+    if let Some(v) = o.checkpoint_interval {
+        positive("output.checkpoint_interval", v)?;
+    }
     for (pname, p) in &o.probes {
         coord(&format!("output.probes.{pname}"), p)?;
     }

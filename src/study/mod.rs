@@ -231,6 +231,9 @@ pub fn failure_text(r: &runner::JobResult) -> String {
             crate::solver::RunStatus::Unstable { fault, t, .. } => {
                 format!("unstable at {} s ({})", sig(*t), fault.code())
             }
+            crate::solver::RunStatus::Interrupted { t, .. } => {
+                format!("interrupted at {} s", sig(*t))
+            }
         },
     }
 }

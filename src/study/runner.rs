@@ -95,6 +95,7 @@ impl RunData {
         match &self.status {
             RunStatus::Completed => "completed".into(),
             RunStatus::Unstable { fault, t, .. } => format!("unstable at t = {t:.4e} s: {fault}"),
+            RunStatus::Interrupted { t, .. } => format!("interrupted at t = {t:.4e} s"),
         }
     }
 
@@ -171,6 +172,7 @@ fn run_one(job: &Job, threads: usize, gpu_lock: &Mutex<()>) -> Result<RunData, S
     let schedule = Schedule {
         snapshot_times: job.snapshot_times.clone(),
         vtk_interval: None,
+        checkpoint_interval: None,
         ..sim.schedule()
     };
     let mut keeper = Keeper {
@@ -313,6 +315,7 @@ pub fn results_csv(results: &[JobResult]) -> String {
                 let (status, reason) = match &d.status {
                     RunStatus::Completed => ("completed", String::new()),
                     RunStatus::Unstable { fault, .. } => ("unstable", fault.to_string()),
+                    RunStatus::Interrupted { .. } => ("interrupted", String::new()),
                 };
                 let _ = write!(
                     s,

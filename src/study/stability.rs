@@ -182,6 +182,11 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                             format!("t = {} s\n{}", sig(*t), fault.code()),
                             format!("**unstable** at {} s: {}", sig(*t), fault),
                         ),
+                        RunStatus::Interrupted { t, .. } => (
+                            Status::Error,
+                            format!("t = {} s\ninterrupted", sig(*t)),
+                            format!("interrupted at {} s", sig(*t)),
+                        ),
                     },
                 },
             };

@@ -1,0 +1,35 @@
+//! The CPU's whole step fuses stages (`shape_eval` with `p2g`, `stress`
+//! with `forces`) so each particle's weights are read while they are still
+//! in cache; the stages run one by one, as the parity tests run them, must
+//! give the very same numbers (same sums, same order).
+
+use lme_mpm::backend::Backend;
+use lme_mpm::bench::{Case, scene};
+use lme_mpm::cpu::CpuBackend;
+use lme_mpm::model::Model;
+use lme_mpm::solver::STEP;
+
+#[test]
+fn fused_step_equals_the_stages_one_by_one() {
+    for shape in ["linear", "bspline2", "lme"] {
+        let set = format!("solver.shape={shape}");
+        let case = Case::new("t", &[set.as_str()]);
+        let model = Model::new(&scene(900, &case).unwrap()).unwrap();
+        let mut fused = CpuBackend::new(model.clone());
+        let mut staged = CpuBackend::new(model);
+        for _ in 0..3 {
+            fused.step().unwrap();
+            for stage in STEP {
+                staged.run_stage(*stage).unwrap();
+            }
+            staged.set_time(staged.time() + staged.dt());
+        }
+        let (a, b) = (&fused.model.particles, &staged.model.particles);
+        assert_eq!(a.stress, b.stress, "{shape}");
+        assert_eq!(a.rho, b.rho, "{shape}");
+        assert_eq!(a.x, b.x, "{shape}");
+        assert_eq!(fused.force, staged.force, "{shape}");
+        assert_eq!(fused.mv, staged.mv, "{shape}");
+        assert_eq!(a.lambda, b.lambda, "{shape}");
+    }
+}

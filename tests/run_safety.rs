@@ -1,0 +1,395 @@
+//! Run safety (issue 10): an output folder holds one run, whole; a second
+//! run into a folder in use is refused; SIGTERM stops a run with every
+//! output at the same time and a checkpoint (exit 143); `resume` continues
+//! it so that the CPU path's particles.csv is byte-identical to an
+//! uninterrupted run; a damaged checkpoint is refused; progress lines
+//! appear on a non-terminal stderr unless --quiet.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_lme-mpm"));
+    c.env("NODEVICE_SELECT", "1");
+    c
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lme-mpm-safety-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn run(case: &str, out: &Path, sets: &[&str]) -> Output {
+    let mut c = bin();
+    c.args(["run", "--backend", "cpu", "--quiet", "--out"])
+        .arg(out)
+        .arg(common::case(case));
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    c.output().expect("binary runs")
+}
+
+fn resume(dir: &Path, sets: &[&str]) -> Output {
+    let mut c = bin();
+    c.args(["resume", "--backend", "cpu", "--quiet"]).arg(dir);
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    c.output().expect("binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&read(&dir.join("summary.json"))).unwrap()
+}
+
+/// The time of a CSV file's last row (its first column).
+fn last_t(p: &Path) -> f64 {
+    let text = read(p);
+    let line = text.lines().last().unwrap();
+    line.split(',').next().unwrap().parse().unwrap()
+}
+
+fn no_tmp_files(dir: &Path) {
+    for e in walk(dir) {
+        assert!(
+            !e.to_string_lossy().ends_with(".tmp"),
+            "left behind: {}",
+            e.display()
+        );
+    }
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        }
+        out.push(p);
+    }
+    out
+}
+
+/// Dyka's bar, short: enough steps to interrupt, quick in a debug build.
+const DYKA_SHORT: &[&str] = &["solver.t_end=3e-5"];
+
+#[test]
+fn a_rerun_replaces_every_file_of_the_earlier_run_and_nothing_else() {
+    let out = tmp("rerun");
+    // First run: a snapshot every 1e-5 s (4 files with t = 0 and the end).
+    let first = run(
+        "dyka_bar.toml",
+        &out,
+        &["solver.t_end=3e-5", "output.vtk_interval=1e-5"],
+    );
+    assert!(first.status.success(), "{}", stderr(&first));
+    assert_eq!(std::fs::read_dir(out.join("vtk")).unwrap().count(), 4);
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    // Second run: fewer snapshots, no particles.csv.
+    let second = run(
+        "dyka_bar.toml",
+        &out,
+        &["solver.t_end=1e-5", "output.particles_csv=false"],
+    );
+    assert!(second.status.success(), "{}", stderr(&second));
+    let vtk: Vec<_> = std::fs::read_dir(out.join("vtk")).unwrap().collect();
+    assert_eq!(vtk.len(), 1, "stale snapshots of the first run remain");
+    assert!(
+        !out.join("particles.csv").exists(),
+        "the first run's particles.csv remains"
+    );
+    assert_eq!(
+        read(&out.join("notes.txt")),
+        "mine",
+        "a user's file was touched"
+    );
+    assert_eq!(summary(&out)["t_end"], 1e-5);
+    assert!(
+        !out.join("lme-mpm.lock").exists(),
+        "the lock outlives the run"
+    );
+    no_tmp_files(&out);
+}
+
+#[test]
+fn a_foreign_folder_a_folder_in_use_and_an_unwritable_one_are_refused_before_stepping() {
+    // A non-empty folder that is not an output folder: exit 2, named.
+    let foreign = tmp("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("thesis.tex"), "x").unwrap();
+    let o = run("dyka_bar.toml", &foreign, DYKA_SHORT);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not an lme-mpm output folder"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains(&foreign.display().to_string()));
+    assert_eq!(std::fs::read_dir(&foreign).unwrap().count(), 1);
+
+    // A folder of a version without a manifest: recognised by its
+    // summary.json; lme-mpm's files go, the user's stay.
+    let legacy = tmp("legacy");
+    std::fs::create_dir_all(legacy.join("vtk")).unwrap();
+    std::fs::write(legacy.join("summary.json"), "{}").unwrap();
+    std::fs::write(legacy.join("vtk/particles_00007.vtu"), "old").unwrap();
+    std::fs::write(legacy.join("probes.csv.tmp"), "half").unwrap();
+    std::fs::write(legacy.join("mine.txt"), "keep").unwrap();
+    let o = run("dyka_bar.toml", &legacy, &["solver.t_end=2e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!legacy.join("vtk/particles_00007.vtu").exists());
+    assert_eq!(read(&legacy.join("mine.txt")), "keep");
+    no_tmp_files(&legacy);
+
+    // A folder held by a live process (this test): exit 2, pid named.
+    let busy = tmp("busy");
+    std::fs::create_dir_all(&busy).unwrap();
+    let me = std::process::id();
+    std::fs::write(busy.join("lme-mpm.lock"), format!("{me}\n")).unwrap();
+    let o = run("dyka_bar.toml", &busy, DYKA_SHORT);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("process {me}")),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!busy.join("summary.json").exists());
+
+    // The lock of a process that has ended is taken over.
+    let mut gone = Command::new("true").spawn().unwrap();
+    let dead = gone.id();
+    gone.wait().unwrap();
+    std::fs::write(busy.join("lme-mpm.lock"), format!("{dead}\n")).unwrap();
+    let o = run("dyka_bar.toml", &busy, &["solver.t_end=2e-6"]);
+    assert!(
+        o.status.success(),
+        "stale lock not taken over: {}",
+        stderr(&o)
+    );
+    assert!(!busy.join("lme-mpm.lock").exists());
+
+    // A file named `vtk` where snapshots go: an error before the first step.
+    let blocked = tmp("vtkfile");
+    let o = run("dyka_bar.toml", &blocked, &["solver.t_end=2e-6"]);
+    assert!(o.status.success());
+    std::fs::remove_dir_all(blocked.join("vtk")).unwrap();
+    std::fs::write(blocked.join("vtk"), "not a folder").unwrap();
+    let started = std::time::Instant::now();
+    let o = run("dyka_bar.toml", &blocked, &["solver.t_end=1"]);
+    assert!(matches!(o.status.code(), Some(1 | 2)), "{}", stderr(&o));
+    assert!(stderr(&o).contains("vtk"), "{}", stderr(&o));
+    assert!(started.elapsed().as_secs() < 30, "it computed first");
+    assert!(
+        !blocked.join("summary.json").exists(),
+        "the earlier run's summary is still there"
+    );
+    no_tmp_files(&blocked);
+
+    // An output path under a file.
+    let o = run(
+        "dyka_bar.toml",
+        &blocked.join("vtk").join("sub"),
+        &["solver.t_end=2e-6"],
+    );
+    assert!(matches!(o.status.code(), Some(1 | 2)), "{}", stderr(&o));
+    assert!(stderr(&o).contains("error:"), "{}", stderr(&o));
+}
+
+/// Starts a CPU run with progress lines on a pipe, sends SIGTERM once
+/// `after` lines have come, and returns its output.
+fn interrupted(case: &str, out: &Path, sets: &[&str], after: usize) -> (Output, f64) {
+    let mut c = bin();
+    c.args(["run", "--backend", "cpu", "--out"])
+        .arg(out)
+        .arg(common::case(case));
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    let mut child = c
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        let progress = line.starts_with("progress:");
+        seen.push(line);
+        if progress && seen.iter().filter(|l| l.starts_with("progress:")).count() == after {
+            break;
+        }
+    }
+    let sent = std::time::Instant::now();
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    seen.extend(lines.map_while(|l| l.ok()));
+    let status = child.wait().unwrap();
+    let waited = sent.elapsed().as_secs_f64();
+    (
+        Output {
+            status,
+            stdout: Vec::new(),
+            stderr: seen.join("\n").into_bytes(),
+        },
+        waited,
+    )
+}
+
+#[test]
+fn sigterm_stops_at_a_step_boundary_and_resume_matches_an_uninterrupted_run_bit_for_bit() {
+    let sets = &["solver.t_end=3e-5", "output.vtk_interval=1e-5"];
+    let whole = tmp("whole");
+    let o = run("dyka_bar.toml", &whole, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The CPU path repeats itself bit for bit.
+    let again = tmp("again");
+    assert!(run("dyka_bar.toml", &again, sets).status.success());
+    for f in ["particles.csv", "probes.csv", "energy.csv", "reactions.csv"] {
+        assert_eq!(
+            read(&whole.join(f)),
+            read(&again.join(f)),
+            "{f} differs run to run"
+        );
+    }
+
+    let cut = tmp("cut");
+    let (o, waited) = interrupted("dyka_bar.toml", &cut, sets, 2);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(143), "{err}");
+    println!("SIGTERM to exit: {waited:.3} s");
+    let s = summary(&cut);
+    assert_eq!(s["status"], "interrupted", "{s}");
+    let t1 = s["t"].as_f64().unwrap();
+    assert!(t1 > 0.0 && t1 < 3e-5, "t = {t1}");
+    for f in ["probes.csv", "energy.csv", "reactions.csv"] {
+        assert_eq!(
+            last_t(&cut.join(f)),
+            t1,
+            "{f} does not end at the time reached"
+        );
+    }
+    let pvd = read(&cut.join("particles.pvd"));
+    assert!(
+        pvd.contains(&format!("timestep=\"{t1}\"")),
+        "no snapshot at {t1}: {pvd}"
+    );
+    assert!(cut.join("particles.csv").exists() && cut.join("checkpoint.lmeck").exists());
+    assert!(!cut.join("lme-mpm.lock").exists());
+    no_tmp_files(&cut);
+
+    let o = resume(&cut, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(summary(&cut)["resumed_from"], t1);
+    for f in [
+        "particles.csv",
+        "probes.csv",
+        "energy.csv",
+        "reactions.csv",
+        "particles.pvd",
+    ] {
+        assert_eq!(
+            read(&whole.join(f)),
+            read(&cut.join(f)),
+            "{f}: interrupted at {t1} and resumed differs from the uninterrupted run"
+        );
+    }
+    let snaps = |d: &Path| std::fs::read_dir(d.join("vtk")).unwrap().count();
+    assert_eq!(snaps(&whole), snaps(&cut));
+}
+
+#[test]
+fn resume_from_a_periodic_checkpoint_gives_the_same_particles_on_the_block() {
+    let out = tmp("block");
+    let sets = &["solver.t_end=3", "output.checkpoint_interval=1.1"];
+    let o = run("elastic_block.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = read(&out.join("particles.csv"));
+    let probes = read(&out.join("probes.csv"));
+    // The last checkpoint is at 2.2 s: resuming redoes 2.2 s → 3 s.
+    let o = resume(&out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    let from = s["resumed_from"].as_f64().unwrap();
+    assert!((2.2..2.5).contains(&from), "resumed from {from}");
+    assert_eq!(read(&out.join("particles.csv")), whole);
+    assert_eq!(read(&out.join("probes.csv")), probes);
+
+    // Further: a later t_end continues the same run.
+    let o = resume(&out, &["solver.t_end=3.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(summary(&out)["t"], 3.5);
+    // Keys that would change the run are refused.
+    let o = resume(&out, &["materials.soil.youngs_modulus=1e9"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn a_damaged_or_missing_checkpoint_is_refused_with_exit_2() {
+    let out = tmp("damaged");
+    let o = run(
+        "dyka_bar.toml",
+        &out,
+        &["solver.t_end=2e-6", "output.checkpoint_interval=1e-6"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ck = out.join("checkpoint.lmeck");
+    let mut bytes = std::fs::read(&ck).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    std::fs::write(&ck, &bytes).unwrap();
+    let o = resume(&out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("checksum"), "{}", stderr(&o));
+
+    std::fs::write(&ck, b"LMEMPMCK\x63\0\0\0rest of a future format....").unwrap();
+    let o = resume(&out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("format 99"), "{}", stderr(&o));
+
+    std::fs::remove_file(&ck).unwrap();
+    let o = resume(&out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("checkpoint"), "{}", stderr(&o));
+}
+
+#[test]
+fn progress_lines_on_a_pipe_unless_quiet() {
+    let out = tmp("progress");
+    let o = bin()
+        .args(["run", "--backend", "cpu", "--out"])
+        .arg(&out)
+        .arg(common::case("dyka_bar.toml"))
+        .args(["--set", "solver.t_end=1e-5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("progress:")).collect();
+    assert!((9..=11).contains(&lines.len()), "{err}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.contains("particle-steps/s") && l.contains("eta"))
+    );
+    assert!(lines.last().unwrap().contains("100 %"), "{err}");
+    let quiet = run("dyka_bar.toml", &out, &["solver.t_end=1e-5"]);
+    assert!(!stderr(&quiet).contains("progress:"));
+}
