@@ -8,11 +8,12 @@ mod common;
 
 use lme_mpm::backend::{Backend, Sample};
 use lme_mpm::cpu::CpuBackend;
-use lme_mpm::exact::{self, Errors};
+use lme_mpm::exact::Errors;
 use lme_mpm::gpu::GpuBackend;
 use lme_mpm::model::{Model, Particles};
 use lme_mpm::scene::{Override, Scene};
-use lme_mpm::solver::{self, Recorder, RunStatus, Schedule};
+use lme_mpm::simulation::Simulation;
+use lme_mpm::solver::{Recorder, RunStatus, Schedule};
 
 // Sampled energies, as history RMS difference over the largest CPU value of
 // each of kinetic, strain and gravity-work bound: 10 times the worst
@@ -38,24 +39,22 @@ struct Outcome {
     steps: u64,
 }
 
-fn run_on(backend: &mut dyn Backend, scene: &lme_mpm::scene::Scene) -> Outcome {
+/// `backend` driven through the one `Simulation` every caller uses.
+fn run_on(backend: Box<dyn Backend>, scene: &Scene) -> Outcome {
+    let mut sim = Simulation::with_backend(scene, backend);
     let mut rec = Recorder::default();
     let schedule = Schedule {
-        sample_interval: scene.sample_interval,
         vtk_interval: None,
-        ..Default::default()
+        ..sim.schedule()
     };
-    let status = solver::drive(backend, schedule, &mut rec).unwrap();
-    assert_eq!(status, RunStatus::Completed, "{}", backend.name());
-    let t = backend.time();
-    let particles = backend.particles().unwrap().clone();
-    let errors = scene
-        .file
-        .exact
-        .map(|k| exact::score(k, scene, backend.model(), &particles, t));
+    let status = sim.drive_with(schedule, &mut rec).unwrap();
+    let name = sim.backend_ref().name();
+    assert_eq!(status, RunStatus::Completed, "{name}");
+    let errors = sim.score().unwrap();
+    let backend = sim.backend();
     Outcome {
         samples: rec.samples,
-        particles,
+        particles: backend.particles().unwrap().clone(),
         errors,
         steps: backend.steps(),
     }
@@ -73,8 +72,8 @@ fn both_of(
 ) -> Option<(Outcome, Outcome)> {
     let ctx = common::gpu::open(label, force_cas)?;
     let model = Model::new(scene).unwrap();
-    let cpu = run_on(&mut CpuBackend::new(model.clone()), scene);
-    let gpu = run_on(&mut GpuBackend::new(ctx, model).unwrap(), scene);
+    let cpu = run_on(Box::new(CpuBackend::new(model.clone())), scene);
+    let gpu = run_on(Box::new(GpuBackend::new(ctx, model).unwrap()), scene);
     assert!(
         cpu.samples.len() >= 3,
         "{label}: {} samples",

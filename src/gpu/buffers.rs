@@ -142,142 +142,24 @@ impl Buffers {
         params: &Params,
         opts: &GpuOptions,
     ) -> Result<Buffers> {
-        let p = &model.particles;
-        let n = p.len();
+        let mut data: Vec<(Buf, Vec<u8>)> = vec![
+            (Buf::Params, bytemuck::bytes_of(params).to_vec()),
+            (Buf::Sim, bytemuck::bytes_of(&initial_sim()).to_vec()),
+            (
+                Buf::Materials,
+                bytemuck::cast_slice(&gpu_materials(model)).to_vec(),
+            ),
+            (
+                Buf::Constraints,
+                bytemuck::cast_slice(&constraint_boxes(model)?).to_vec(),
+            ),
+        ];
+        particle_data(model, params, opts, &mut data);
+        grid_and_output_data(model, params, &mut data);
+        let map = upload(ctx, data, model)?;
         let g = &model.grid;
-        let origin = g.min;
-        let rel = |x: [f64; 2]| [(x[0] - origin[0]) as f32, (x[1] - origin[1]) as f32];
-        let mut data: Vec<(Buf, Vec<u8>)> = Vec::new();
-        let bytes = |v: &[f32]| bytemuck::cast_slice::<f32, u8>(v).to_vec();
-        let flat2 = |it: &mut dyn Iterator<Item = [f32; 2]>| it.flatten().collect::<Vec<f32>>();
-
-        data.push((Buf::Params, bytemuck::bytes_of(params).to_vec()));
-        data.push((Buf::Sim, bytemuck::bytes_of(&initial_sim()).to_vec()));
-        let mats: Vec<GpuMaterial> = model
-            .materials
-            .iter()
-            .map(|m| {
-                let (lame, shear) = m.lame_shear();
-                let (youngs, nu, model) = match m {
-                    Material::LinearElastic(e) => (e.youngs, e.nu, MODEL_LINEAR_ELASTIC),
-                    Material::NeoHookean(e) => (e.youngs, e.nu, MODEL_NEO_HOOKEAN),
-                };
-                GpuMaterial {
-                    lame: lame as f32,
-                    shear: shear as f32,
-                    p_modulus: (lame + 2.0 * shear) as f32,
-                    youngs: youngs as f32,
-                    nu: nu as f32,
-                    model,
-                    _pad: [0.0; 2],
-                }
-            })
-            .collect();
-        data.push((Buf::Materials, bytemuck::cast_slice(&mats).to_vec()));
-        data.push((
-            Buf::Constraints,
-            bytemuck::cast_slice(&constraint_boxes(model)?).to_vec(),
-        ));
-        data.push((Buf::X0, bytes(&flat2(&mut p.x0.iter().map(|x| rel(*x))))));
-        let u: Vec<f32> =
-            flat2(&mut (0..n).map(|i| f32x2([p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]])));
-        data.push((Buf::U, bytes(&u)));
-        data.push((Buf::ULo, vec![0u8; 8 * n]));
-        data.push((Buf::V, bytes(&flat2(&mut p.v.iter().map(|v| f32x2(*v))))));
-        if matches!(model.integrator, Integrator::Npc { .. }) {
-            data.push((Buf::A, bytes(&flat2(&mut p.a.iter().map(|v| f32x2(*v))))));
-        }
-        let to32 = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
-        data.push((Buf::Mass, bytes(&to32(&p.mass))));
-        data.push((Buf::Rho, bytes(&to32(&p.rho))));
-        let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
-        data.push((Buf::Stress, bytes(&s)));
-        if model.materials.len() > 1 {
-            let mat: Vec<u32> = p
-                .body
-                .iter()
-                .map(|b| model.body_material[*b as usize])
-                .collect();
-            data.push((Buf::Mat, bytemuck::cast_slice(&mat).to_vec()));
-        }
-        if matches!(model.shape, Shape::Lme(_)) {
-            data.push((
-                Buf::Lambda,
-                bytes(&flat2(&mut p.lambda.iter().map(|v| f32x2(*v)))),
-            ));
-            if opts.lme_stored {
-                let slots = (params.lme_side * params.lme_side) as usize;
-                data.push((Buf::LmeNodes, vec![0xffu8; 4 * slots * n]));
-                data.push((Buf::LmeW, vec![0u8; 12 * slots * n]));
-            } else {
-                data.push((Buf::LmeCache, vec![0u8; 16 * n]));
-            }
-        }
-        if !p.f.is_empty() {
-            let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
-            data.push((Buf::DefGrad, bytes(&f)));
-        }
-        data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * g.n_nodes()]));
-        if g.is_perturbed() {
-            data.push((
-                Buf::NodePos,
-                bytes(&flat2(&mut g.pos.iter().map(|x| rel(*x)))),
-            ));
-        }
         let groups = model.constraints.groups.len();
-        data.push((Buf::Reactions, vec![0u8; 8 * groups.max(1)]));
-        let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
-        let probe_idx = if probe_idx.is_empty() {
-            vec![0]
-        } else {
-            probe_idx
-        };
-        data.push((Buf::ProbeIdx, bytemuck::cast_slice(&probe_idx).to_vec()));
-        data.push((
-            Buf::ProbeOut,
-            vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
-        ));
-        data.push((Buf::EnergyOut, vec![0u8; 16]));
-        if model.mls {
-            let cells = (g.nx - 1) * (g.ny - 1);
-            let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
-            data.push((Buf::MlsCount, vec![0u8; 4 * cells]));
-            data.push((Buf::MlsStart, vec![0u8; 4 * (cells + 1)]));
-            data.push((Buf::MlsOrder, vec![0u8; 4 * n]));
-            data.push((Buf::MlsCell, vec![0u8; 4 * n]));
-            data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
-            data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
-        }
-
-        let limit = ctx.limits.max_storage_buffer_binding_size;
-        let max_buf = ctx.limits.max_buffer_size;
-        let mut map = BTreeMap::new();
-        for (b, bytes) in data {
-            let size = (bytes.len() as u64).max(16).next_multiple_of(4);
-            if size > limit.min(max_buf) {
-                return Err(Error::Gpu(format!(
-                    "the {b:?} buffer needs {size} bytes, more than this adapter binds ({} bytes): \
-                     the scene has {n} particles and {} nodes; use fewer, or an adapter with larger bindings",
-                    limit.min(max_buf),
-                    g.n_nodes()
-                )));
-            }
-            let usage = if b == Buf::Params {
-                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
-            } else {
-                wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC
-            };
-            let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{b:?}")),
-                size,
-                usage,
-                mapped_at_creation: false,
-            });
-            ctx.queue.write_buffer(&buf, 0, &bytes);
-            map.insert(b, buf);
-        }
+        let n = model.particles.len();
         Ok(Buffers {
             map,
             n_particles: n,
@@ -296,6 +178,167 @@ impl Buffers {
             },
         })
     }
+}
+
+/// The materials as the shaders read them.
+fn gpu_materials(model: &Model) -> Vec<GpuMaterial> {
+    model
+        .materials
+        .iter()
+        .map(|m| {
+            let (lame, shear) = m.lame_shear();
+            let (youngs, nu, model) = match m {
+                Material::LinearElastic(e) => (e.youngs, e.nu, MODEL_LINEAR_ELASTIC),
+                Material::NeoHookean(e) => (e.youngs, e.nu, MODEL_NEO_HOOKEAN),
+            };
+            GpuMaterial {
+                lame: lame as f32,
+                shear: shear as f32,
+                p_modulus: (lame + 2.0 * shear) as f32,
+                youngs: youngs as f32,
+                nu: nu as f32,
+                model,
+                _pad: [0.0; 2],
+            }
+        })
+        .collect()
+}
+
+/// Initial contents of the per-particle buffers.
+fn particle_data(
+    model: &Model,
+    params: &Params,
+    opts: &GpuOptions,
+    data: &mut Vec<(Buf, Vec<u8>)>,
+) {
+    let p = &model.particles;
+    let n = p.len();
+    let g = &model.grid;
+    let origin = g.min;
+    let rel = |x: [f64; 2]| [(x[0] - origin[0]) as f32, (x[1] - origin[1]) as f32];
+    let bytes = |v: &[f32]| bytemuck::cast_slice::<f32, u8>(v).to_vec();
+    let flat2 = |it: &mut dyn Iterator<Item = [f32; 2]>| it.flatten().collect::<Vec<f32>>();
+    data.push((Buf::X0, bytes(&flat2(&mut p.x0.iter().map(|x| rel(*x))))));
+    let u: Vec<f32> =
+        flat2(&mut (0..n).map(|i| f32x2([p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1]])));
+    data.push((Buf::U, bytes(&u)));
+    data.push((Buf::ULo, vec![0u8; 8 * n]));
+    data.push((Buf::V, bytes(&flat2(&mut p.v.iter().map(|v| f32x2(*v))))));
+    if matches!(model.integrator, Integrator::Npc { .. }) {
+        data.push((Buf::A, bytes(&flat2(&mut p.a.iter().map(|v| f32x2(*v))))));
+    }
+    let to32 = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
+    data.push((Buf::Mass, bytes(&to32(&p.mass))));
+    data.push((Buf::Rho, bytes(&to32(&p.rho))));
+    let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
+    data.push((Buf::Stress, bytes(&s)));
+    if model.materials.len() > 1 {
+        let mat: Vec<u32> = p
+            .body
+            .iter()
+            .map(|b| model.body_material[*b as usize])
+            .collect();
+        data.push((Buf::Mat, bytemuck::cast_slice(&mat).to_vec()));
+    }
+    if matches!(model.shape, Shape::Lme(_)) {
+        data.push((
+            Buf::Lambda,
+            bytes(&flat2(&mut p.lambda.iter().map(|v| f32x2(*v)))),
+        ));
+        if opts.lme_stored {
+            let slots = (params.lme_side * params.lme_side) as usize;
+            data.push((Buf::LmeNodes, vec![0xffu8; 4 * slots * n]));
+            data.push((Buf::LmeW, vec![0u8; 12 * slots * n]));
+        } else {
+            data.push((Buf::LmeCache, vec![0u8; 16 * n]));
+        }
+    }
+    if !p.f.is_empty() {
+        let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
+        data.push((Buf::DefGrad, bytes(&f)));
+    }
+}
+
+/// Initial contents of the nodal, constraint, probe, energy and MLS buffers.
+fn grid_and_output_data(model: &Model, params: &Params, data: &mut Vec<(Buf, Vec<u8>)>) {
+    let n = model.particles.len();
+    let g = &model.grid;
+    let origin = g.min;
+    let rel = |x: [f64; 2]| [(x[0] - origin[0]) as f32, (x[1] - origin[1]) as f32];
+    let bytes = |v: &[f32]| bytemuck::cast_slice::<f32, u8>(v).to_vec();
+    let flat2 = |it: &mut dyn Iterator<Item = [f32; 2]>| it.flatten().collect::<Vec<f32>>();
+    data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * g.n_nodes()]));
+    if g.is_perturbed() {
+        data.push((
+            Buf::NodePos,
+            bytes(&flat2(&mut g.pos.iter().map(|x| rel(*x)))),
+        ));
+    }
+    let groups = model.constraints.groups.len();
+    data.push((Buf::Reactions, vec![0u8; 8 * groups.max(1)]));
+    let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
+    let probe_idx = if probe_idx.is_empty() {
+        vec![0]
+    } else {
+        probe_idx
+    };
+    data.push((Buf::ProbeIdx, bytemuck::cast_slice(&probe_idx).to_vec()));
+    data.push((
+        Buf::ProbeOut,
+        vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
+    ));
+    data.push((Buf::EnergyOut, vec![0u8; 16]));
+    if model.mls {
+        let cells = (g.nx - 1) * (g.ny - 1);
+        let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
+        data.push((Buf::MlsCount, vec![0u8; 4 * cells]));
+        data.push((Buf::MlsStart, vec![0u8; 4 * (cells + 1)]));
+        data.push((Buf::MlsOrder, vec![0u8; 4 * n]));
+        data.push((Buf::MlsCell, vec![0u8; 4 * n]));
+        data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
+        data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
+    }
+}
+
+/// Creates each buffer (the uniform `Params`, the rest storage) with its
+/// contents; refuses one larger than the adapter can bind, naming it.
+fn upload(
+    ctx: &GpuContext,
+    data: Vec<(Buf, Vec<u8>)>,
+    model: &Model,
+) -> Result<BTreeMap<Buf, wgpu::Buffer>> {
+    let n = model.particles.len();
+    let g = &model.grid;
+    let limit = ctx.limits.max_storage_buffer_binding_size;
+    let max_buf = ctx.limits.max_buffer_size;
+    let mut map = BTreeMap::new();
+    for (b, bytes) in data {
+        let size = (bytes.len() as u64).max(16).next_multiple_of(4);
+        if size > limit.min(max_buf) {
+            return Err(Error::Gpu(format!(
+                "the {b:?} buffer needs {size} bytes, more than this adapter binds ({} bytes): \
+                 the scene has {n} particles and {} nodes; use fewer, or an adapter with larger bindings",
+                limit.min(max_buf),
+                g.n_nodes()
+            )));
+        }
+        let usage = if b == Buf::Params {
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
+        } else {
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC
+        };
+        let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{b:?}")),
+            size,
+            usage,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&buf, 0, &bytes);
+        map.insert(b, buf);
+    }
+    Ok(map)
 }
 
 /// The Sim state at t = 0.

@@ -117,40 +117,11 @@ impl Model {
         let seeds = seed::seed_particles(scene, anchor, h);
 
         let body_names: Vec<String> = scene.bodies().map(|(n, _)| n.clone()).collect();
-        for (bi, name) in body_names.iter().enumerate() {
-            if !seeds.iter().any(|s| s.body == bi as u32) {
-                return Err(SceneError::invalid(
-                    format!("bodies.{name}"),
-                    format!(
-                        "is empty: its shapes hold no particle point at h = {h} (shapes smaller than a cell?)"
-                    ),
-                ));
-            }
-        }
+        check_not_empty(&seeds, &body_names, h)?;
 
         let grid = Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed);
 
-        let margin = shape.edge_margin();
-        if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
-            return Err(SceneError::invalid(
-                format!("bodies.{}", body_names[s.body as usize]),
-                format!(
-                    "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
-                     enlarge grid.min/grid.max or drop them to derive the extent",
-                    s.x[0],
-                    s.x[1],
-                    grid.min[0],
-                    grid.min[1],
-                    grid.max()[0],
-                    grid.max()[1],
-                    if margin > 0.0 {
-                        format!(" or within {margin:.6} m of its edge")
-                    } else {
-                        String::new()
-                    }
-                ),
-            ));
-        }
+        check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
 
         let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
         let body_material: Vec<u32> = scene
@@ -188,31 +159,7 @@ impl Model {
                 particles.v[i] = m.velocity(particles.x0[i], 0.0);
             }
         }
-        let probes = f
-            .output
-            .probes
-            .iter()
-            .map(|(name, &point)| {
-                let particle = particles.nearest(point);
-                let x = particles.x[particle];
-                let d = (x[0] - point[0]).hypot(x[1] - point[1]);
-                // A probe off the body would silently track some other point.
-                if d > h {
-                    return Err(SceneError::invalid(
-                        format!("output.probes.{name}"),
-                        format!(
-                            "is {d:.4e} m from the nearest particle, more than one cell (h = {h} m): \
-                             put it on a body"
-                        ),
-                    ));
-                }
-                Ok(Probe {
-                    name: name.clone(),
-                    point,
-                    particle,
-                })
-            })
-            .collect::<Result<_, _>>()?;
+        let probes = build_probes(scene, &particles)?;
 
         Ok(Model {
             grid,
@@ -345,6 +292,83 @@ pub fn grid_extent(scene: &Scene, shape: &Shape) -> Result<GridExtent, SceneErro
         ));
     }
     Ok(GridExtent { lo, nx, ny })
+}
+
+/// Every body holds at least one particle.
+fn check_not_empty(seeds: &[seed::Seed], body_names: &[String], h: f64) -> Result<(), SceneError> {
+    for (bi, name) in body_names.iter().enumerate() {
+        if !seeds.iter().any(|s| s.body == bi as u32) {
+            return Err(SceneError::invalid(
+                format!("bodies.{name}"),
+                format!(
+                    "is empty: its shapes hold no particle point at h = {h} (shapes smaller than a cell?)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every seeded particle lies inside the grid, `margin` (m) from its edge.
+fn check_inside(
+    grid: &Grid,
+    seeds: &[seed::Seed],
+    body_names: &[String],
+    margin: f64,
+) -> Result<(), SceneError> {
+    if let Some(s) = seeds.iter().find(|s| !grid.contains(s.x, margin)) {
+        return Err(SceneError::invalid(
+            format!("bodies.{}", body_names[s.body as usize]),
+            format!(
+                "has a particle at ({:.6}, {:.6}) outside the grid ({:.6}, {:.6}) to ({:.6}, {:.6}){}: \
+                 enlarge grid.min/grid.max or drop them to derive the extent",
+                s.x[0],
+                s.x[1],
+                grid.min[0],
+                grid.min[1],
+                grid.max()[0],
+                grid.max()[1],
+                if margin > 0.0 {
+                    format!(" or within {margin:.6} m of its edge")
+                } else {
+                    String::new()
+                }
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Probes on the particle nearest to each requested point; a point more
+/// than a cell from every particle is refused.
+fn build_probes(scene: &Scene, particles: &Particles) -> Result<Vec<Probe>, SceneError> {
+    let h = scene.file.grid.h;
+    scene
+        .file
+        .output
+        .probes
+        .iter()
+        .map(|(name, &point)| {
+            let particle = particles.nearest(point);
+            let x = particles.x[particle];
+            let d = (x[0] - point[0]).hypot(x[1] - point[1]);
+            // A probe off the body would silently track some other point.
+            if d > h {
+                return Err(SceneError::invalid(
+                    format!("output.probes.{name}"),
+                    format!(
+                        "is {d:.4e} m from the nearest particle, more than one cell (h = {h} m): \
+                         put it on a body"
+                    ),
+                ));
+            }
+            Ok(Probe {
+                name: name.clone(),
+                point,
+                particle,
+            })
+        })
+        .collect()
 }
 
 /// Constraints that are walls: a half-plane region beyond the bodies
