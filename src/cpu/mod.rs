@@ -211,16 +211,7 @@ impl CpuBackend {
         let m = &mut self.model;
         let p = &mut m.particles;
         // The stress is at the step's end (t + Δt), so are the loads.
-        let t = self.t + self.dt;
-        let g = m.gravity.map_or([0.0; 2], |g| g.at(t));
-        let (mms, x0) = (&m.manufactured, &p.x0);
-        let body = move |i: usize| match mms {
-            None => g,
-            Some(s) => {
-                let b = s.body_force(x0[i], t);
-                [g[0] + b[0], g[1] + b[1]]
-            }
-        };
+        let body = body_force(m.gravity, &m.manufactured, &p.x0, self.t + self.dt);
         stress::stress_forces(
             &self.cache,
             &self.mv,
@@ -283,16 +274,7 @@ impl CpuBackend {
             )?,
             Stage::Forces => {
                 // The stress is already at the step's end (t + Δt), so are the loads.
-                let t = self.t + self.dt;
-                let g = m.gravity.map_or([0.0; 2], |g| g.at(t));
-                let (mms, x0) = (&m.manufactured, &p.x0);
-                let body = move |i: usize| match mms {
-                    None => g,
-                    Some(s) => {
-                        let b = s.body_force(x0[i], t);
-                        [g[0] + b[0], g[1] + b[1]]
-                    }
-                };
+                let body = body_force(m.gravity, &m.manufactured, &p.x0, self.t + self.dt);
                 if let Some(mls) = &mut self.mls {
                     mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
                     return Ok(());
@@ -336,6 +318,25 @@ impl CpuBackend {
             }
         }
         Ok(())
+    }
+}
+
+/// Body force per unit mass on particle `i` at time `t` (m/s²): gravity
+/// with its ramp, plus a manufactured solution's load at the particle's
+/// reference position.
+fn body_force<'a>(
+    gravity: Option<crate::model::Gravity>,
+    mms: &'a Option<crate::model::AlignedVibration>,
+    x0: &'a [[f64; 2]],
+    t: f64,
+) -> impl Fn(usize) -> [f64; 2] + Sync + 'a {
+    let g = gravity.map_or([0.0; 2], |g| g.at(t));
+    move |i: usize| match mms {
+        None => g,
+        Some(s) => {
+            let b = s.body_force(x0[i], t);
+            [g[0] + b[0], g[1] + b[1]]
+        }
     }
 }
 

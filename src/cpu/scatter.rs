@@ -43,6 +43,15 @@ impl<const K: usize> Scatter<K> {
                 let end = ((t + 1) * per).min(n_particles);
                 (t * per..end).for_each(|p| kernel(p, acc));
             });
+        self.reduce_into(out, threads);
+    }
+}
+
+impl<const K: usize> Scatter<K> {
+    /// Adds the first `copies` private node arrays into `out`, node by node
+    /// in thread order (the same sums every run).
+    fn reduce_into(&self, out: &mut [[f64; K]], copies: usize) {
+        let n_nodes = out.len();
         let scratch = &self.scratch;
         out.par_chunks_mut(REDUCE_CHUNK)
             .enumerate()
@@ -50,7 +59,7 @@ impl<const K: usize> Scatter<K> {
                 let base = c * REDUCE_CHUNK;
                 for (k, o) in chunk.iter_mut().enumerate() {
                     let mut sum = *o;
-                    for t in 0..threads {
+                    for t in 0..copies {
                         let v = &scratch[t * n_nodes + base + k];
                         for d in 0..K {
                             sum[d] += v[d];
@@ -60,9 +69,7 @@ impl<const K: usize> Scatter<K> {
                 }
             });
     }
-}
 
-impl<const K: usize> Scatter<K> {
     /// Particles per worker range for `n_particles` (the split `run` uses).
     pub fn range_len(n_particles: usize) -> usize {
         let threads = rayon::current_num_threads().clamp(1, n_particles.max(1));
@@ -104,22 +111,7 @@ impl<const K: usize> Scatter<K> {
                 kernel(t * per, c, acc)
             })
             .reduce(&none, &fold);
-        let scratch = &self.scratch;
-        out.par_chunks_mut(REDUCE_CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                let base = c * REDUCE_CHUNK;
-                for (k, o) in chunk.iter_mut().enumerate() {
-                    let mut sum = *o;
-                    for t in 0..used {
-                        let v = &scratch[t * n_nodes + base + k];
-                        for d in 0..K {
-                            sum[d] += v[d];
-                        }
-                    }
-                    *o = sum;
-                }
-            });
+        self.reduce_into(out, used);
         r
     }
 }

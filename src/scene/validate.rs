@@ -64,7 +64,40 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         ));
     }
 
-    // --- solver -----------------------------------------------------------
+    check_solver(&file)?;
+    check_grid(&file)?;
+    check_materials(&file)?;
+    check_bodies(&file)?;
+    check_constraints(&file)?;
+    check_gravity(&file)?;
+    let sample_interval = check_output(&file)?;
+    check_manufactured_section(&mut file)?;
+    check_solver_options(&file)?;
+    if let Some(kind) = file.exact {
+        check_exact(&file, kind)?;
+    }
+
+    let (s, g) = (&file.solver, &file.grid);
+    let margin = match g.margin {
+        Some(m) => m,
+        None => {
+            file.bodies
+                .values()
+                .map(|b| b.velocity[0].hypot(b.velocity[1]))
+                .fold(0.0, f64::max)
+                * s.t_end
+        }
+    };
+    Ok(Scene {
+        name,
+        file,
+        margin,
+        sample_interval,
+    })
+}
+
+/// `[solver]`: times, Courant number, integrator and shape parameters.
+fn check_solver(file: &SceneFile) -> Result<(), SceneError> {
     let s = &file.solver;
     positive("solver.t_end", s.t_end)?;
     finite("solver.cfl", s.cfl)?;
@@ -88,8 +121,12 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             format!("must be in (0, 1e-2], got {}", s.lme_tol),
         ));
     }
+    Ok(())
+}
 
-    // --- grid -------------------------------------------------------------
+/// `[grid]`: spacing, extent, origin, perturbation; the shape’s grid needs.
+fn check_grid(file: &SceneFile) -> Result<(), SceneError> {
+    let s = &file.solver;
     let g = &file.grid;
     positive("grid.h", g.h)?;
     coord("grid.h", &[g.h])?;
@@ -167,8 +204,11 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             ));
         }
     }
+    Ok(())
+}
 
-    // --- materials --------------------------------------------------------
+/// `[materials]`: at least one, with density, E and ν in range.
+fn check_materials(file: &SceneFile) -> Result<(), SceneError> {
     if file.materials.is_empty() {
         return Err(SceneError::invalid(
             "materials",
@@ -187,8 +227,12 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             ));
         }
     }
+    Ok(())
+}
 
-    // --- bodies -----------------------------------------------------------
+/// `[bodies]`: at least one; shapes, particles per cell, materials, sizes and overlaps.
+fn check_bodies(file: &SceneFile) -> Result<(), SceneError> {
+    let s = &file.solver;
     if file.bodies.is_empty() {
         return Err(SceneError::invalid(
             "bodies",
@@ -298,9 +342,12 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             ),
         ));
     }
-    check_rect_overlaps(&file)?;
+    check_rect_overlaps(file)?;
+    Ok(())
+}
 
-    // --- constraints ------------------------------------------------------
+/// `[constraints]`: boxes with finite or infinite bounds in order.
+fn check_constraints(file: &SceneFile) -> Result<(), SceneError> {
     for (cname, c) in &file.constraints {
         for v in c.min.iter().chain(&c.max) {
             if v.is_nan() || (v.is_finite() && v.abs() > limits::COORD_MAX) {
@@ -323,8 +370,11 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             ));
         }
     }
+    Ok(())
+}
 
-    // --- gravity ----------------------------------------------------------
+/// `[gravity]`: a finite vector and a ramp with its period.
+fn check_gravity(file: &SceneFile) -> Result<(), SceneError> {
     if let Some(gr) = &file.gravity {
         finite_point("gravity.g", &gr.g)?;
         match (gr.ramp, gr.ramp_period) {
@@ -338,8 +388,12 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             _ => {}
         }
     }
+    Ok(())
+}
 
-    // --- output -----------------------------------------------------------
+/// `[output]`: intervals and probes; returns the sample interval (s), t_end / 500 by default.
+fn check_output(file: &SceneFile) -> Result<f64, SceneError> {
+    let s = &file.solver;
     let o = &file.output;
     let sample_interval = match o.sample_interval {
         Some(v) => {
@@ -357,10 +411,13 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     for (pname, p) in &o.probes {
         coord(&format!("output.probes.{pname}"), p)?;
     }
+    Ok(sample_interval)
+}
 
-    // --- manufactured solution ---------------------------------------------
+/// `[manufactured]`: its own checks, and `exact` set to score against it.
+fn check_manufactured_section(file: &mut SceneFile) -> Result<(), SceneError> {
     if let Some(m) = &file.manufactured {
-        check_manufactured(&file, m)?;
+        check_manufactured(file, m)?;
         match file.exact {
             None | Some(ExactKind::AlignedVibration) => {
                 file.exact = Some(ExactKind::AlignedVibration)
@@ -380,6 +437,13 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             "= \"aligned_vibration\" needs a [manufactured] section",
         ));
     }
+    Ok(())
+}
+
+/// `solver.dt` and `solver.mls` against the shape and the grid.
+fn check_solver_options(file: &SceneFile) -> Result<(), SceneError> {
+    let s = &file.solver;
+    let g = &file.grid;
     if let Some(dt) = s.dt {
         positive("solver.dt", dt)?;
     }
@@ -397,28 +461,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
             "needs a regular grid (grid.perturb = 0): its Gauss points sit in the grid's rectangular cells",
         ));
     }
-
-    // --- exact solution applicability -------------------------------------
-    if let Some(kind) = file.exact {
-        check_exact(&file, kind)?;
-    }
-
-    let margin = match g.margin {
-        Some(m) => m,
-        None => {
-            file.bodies
-                .values()
-                .map(|b| b.velocity[0].hypot(b.velocity[1]))
-                .fold(0.0, f64::max)
-                * s.t_end
-        }
-    };
-    Ok(Scene {
-        name,
-        file,
-        margin,
-        sample_interval,
-    })
+    Ok(())
 }
 
 fn bname_key(bname: &str) -> String {
