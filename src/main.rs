@@ -90,7 +90,7 @@ enum Command {
     /// List GPU adapters: backend, device type, float-atomic support, key limits.
     Info,
     /// Run one of the papers' comparisons (or all): CSV tables and charts in
-    /// --out, and (full runs) the study's section of docs/verification.md.
+    /// --out; with --doc FILE (e.g. docs/verification.md) also the study's section there.
     Study {
         /// dyka, block, plate-impact, stability, mms or all.
         #[arg(value_enum)]
