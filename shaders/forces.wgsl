@@ -28,14 +28,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
     let b = m * body_force(p, sim.t + sim.t_lo + sim.dt);
     let c = shape_ctx(p, x0[p] + u[p]);
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
-        }
-        let f = particle_force(vol, s, b, w);
-        let base = w.node * NODE_STRIDE;
-        node_add(base + 3u, f.x);
-        node_add(base + 4u, f.y);
-    }
+    add_particle_forces(c, vol, s, b);
 }

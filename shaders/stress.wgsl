@@ -87,15 +87,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let m = mass[p];
     let vol = m / rho_p;
     let mb = m * body_force(p, sim.t + sim.t_lo + sim.dt);
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
-        }
-        let f = particle_force(vol, s, mb, w);
-        let base = w.node * NODE_STRIDE;
-        node_add(base + 3u, f.x);
-        node_add(base + 4u, f.y);
-    }
+    add_particle_forces(c, vol, s, mb);
 #endif
 }

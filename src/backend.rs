@@ -83,7 +83,8 @@ pub trait Backend {
     fn sample(&mut self) -> Result<Sample>;
     /// Particle state now (the GPU backend downloads it).
     fn particles(&mut self) -> Result<&Particles>;
-    /// The model being run (its particles may be stale on the GPU backend).
+    /// The model being run. Its particles are those of the last
+    /// `particles()` call (on the GPU backend they may be stale after it).
     fn model(&self) -> &Model;
     /// Memory the backend holds per particle, grid included (bytes).
     fn bytes_per_particle(&self) -> f64;

@@ -297,9 +297,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
 /// Peak resident bytes of a CPU run of `n` particles on an `nx` × `ny`
 /// grid: the largest of (a) building the model (seeds beside the particle
 /// fields) and (b) its end, when `run::run` holds the backend (particles,
-/// shape cache, node arrays, per-thread scatter copies, MLS), two more
-/// copies of the particles (the state read back and the model kept for the
-/// outputs) and the particles.csv text.
+/// shape cache, node arrays, per-thread scatter copies, MLS) and the
+/// particles.csv text; the particles are scored and written in place.
 #[allow(clippy::too_many_arguments)]
 fn memory(
     scene: &Scene,
@@ -359,7 +358,7 @@ fn memory(
     } else {
         0.0
     };
-    let end = n * (3.0 * particle + cache + csv) + nodes * per_node + mls + sample_rows;
+    let end = n * (particle + cache + csv) + nodes * per_node + mls + sample_rows;
     BASELINE_BYTES + build.max(end)
 }
 

@@ -208,9 +208,10 @@ fn finish(
     let bytes_per_particle = backend.bytes_per_particle();
     let backend_name = backend.name();
     let final_sample = writer.samples.last().cloned();
-    let particles = backend.particles()?.clone();
-    let model = backend.model().clone();
-    let particles = &particles;
+    // The particles are read once (a GPU download) and used in place.
+    backend.particles()?;
+    let model = backend.model();
+    let particles = &model.particles;
     if scene.file.output.particles_csv {
         writer.write(
             "particles.csv",

@@ -169,12 +169,15 @@ impl Simulation {
             return Ok(None);
         };
         let t = self.backend.time();
-        let particles = self.backend.particles()?.clone();
+        // Brings the model's particles up to date (a GPU download), so they
+        // are scored in place rather than copied.
+        self.backend.particles()?;
+        let model = self.backend.model();
         Ok(Some(exact::score(
             kind,
             &self.scene,
-            self.backend.model(),
-            &particles,
+            model,
+            &model.particles,
             t,
         )))
     }

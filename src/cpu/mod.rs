@@ -183,14 +183,19 @@ impl CpuBackend {
         Ok(())
     }
 
-    /// Stages `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
-    fn shape_eval_p2g(&mut self) -> std::result::Result<(), Fault> {
-        let m = &mut self.model;
-        let p = &mut m.particles;
-        let a_factor = match m.integrator {
+    /// Factor of a_p in p2g's predicted momentum: (1 − γ)Δt for NPC, 0 for FE.
+    fn p2g_accel(&self) -> f64 {
+        match self.model.integrator {
             Integrator::Fe => 0.0,
             Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
-        };
+        }
+    }
+
+    /// Stages `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
+    fn shape_eval_p2g(&mut self) -> std::result::Result<(), Fault> {
+        let a_factor = self.p2g_accel();
+        let m = &mut self.model;
+        let p = &mut m.particles;
         shape_eval::shape_eval_p2g(
             &m.shape,
             &m.grid,
@@ -231,11 +236,12 @@ impl CpuBackend {
 
     /// Runs one stage of the step (public so tests can compare stages one by one).
     pub fn run_stage(&mut self, stage: Stage) -> std::result::Result<(), Fault> {
+        let a_factor = self.p2g_accel();
         let m = &mut self.model;
         let p = &mut m.particles;
-        let (gamma, npc) = match m.integrator {
-            Integrator::Fe => (1.0, false),
-            Integrator::Npc { gamma, .. } => (gamma, true),
+        let gamma = match m.integrator {
+            Integrator::Fe => 1.0,
+            Integrator::Npc { gamma, .. } => gamma,
         };
         match stage {
             Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
@@ -244,7 +250,6 @@ impl CpuBackend {
                 shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
             }
             Stage::P2g => {
-                let a_factor = if npc { (1.0 - gamma) * self.dt } else { 0.0 };
                 if let Some(mls) = &mut self.mls {
                     return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
                 }
