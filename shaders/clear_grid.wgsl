@@ -11,7 +11,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if sim.running == 0u {
         return;
     }
-    if n < 2u * params.n_groups {
+    // Constraint groups' reactions, then walls' (the whole buffer).
+    if n < arrayLength(&reactions) {
         reactions[n] = 0.0;
     }
     if n >= params.n_nodes {

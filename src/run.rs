@@ -287,10 +287,8 @@ fn finish(
             .as_ref()
             .map(|s| {
                 model
-                    .constraints
-                    .groups
-                    .iter()
-                    .map(|g| g.name.clone())
+                    .reaction_names()
+                    .into_iter()
                     .zip(s.reactions.iter().copied())
                     .collect()
             })
@@ -360,12 +358,7 @@ impl Writer {
             scene_name: scene.name.clone(),
             scene_toml: toml::to_string(&file).expect("a scene file serialises to TOML"),
             probe_names: model.probes.iter().map(|p| p.name.clone()).collect(),
-            group_names: model
-                .constraints
-                .groups
-                .iter()
-                .map(|g| g.name.clone())
-                .collect(),
+            group_names: model.reaction_names(),
             n_particles: model.particles.len(),
             samples: Vec::new(),
             snapshots: Vec::new(),
@@ -629,6 +622,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             .groups
             .iter()
             .map(|c| format!("{} ({} nodes)", c.name, c.nodes.len()))
+            .chain(model.walls.list.iter().map(|w| format!(
+                "wall {} ({} nodes)",
+                w.name,
+                w.nodes.len()
+            )),)
             .collect::<Vec<_>>()
             .join(", "),
         npr = model

@@ -3,7 +3,7 @@
 //! for, and every struct shared with Rust has the same layout on both sides.
 
 use lme_mpm::gpu::context::AtomicMode;
-use lme_mpm::gpu::layout::{GpuConstraint, GpuMaterial, Params, Sim};
+use lme_mpm::gpu::layout::{GpuConstraint, GpuMaterial, GpuWall, Params, Sim};
 use lme_mpm::gpu::pipelines::{self, Pass, Variant};
 use lme_mpm::gpu::preprocess::SOURCES;
 use lme_mpm::model::Integrator;
@@ -110,6 +110,10 @@ fn variants() -> Vec<Variant> {
                                         def_grad: neo_hookean,
                                         mms,
                                         mls,
+                                        // Walls and loads in every shape and
+                                        // integrator, with one atomic mode.
+                                        walls: atomics == AtomicMode::CompareExchange && !mls,
+                                        ext_force: atomics == AtomicMode::CompareExchange && !mls,
                                     });
                                 }
                             }
@@ -159,6 +163,20 @@ fn every_pass_validates_in_every_variant() {
                 !(has(Buf::MlsCount) || has(Buf::MlsOrder) || has(Buf::MlsCoef)) || v.mls,
                 "{pass:?} {v:?}: MLS buffers without MLS"
             );
+            assert!(
+                !(has(Buf::Walls) || has(Buf::WallMask)) || v.walls,
+                "{pass:?} {v:?}: wall buffers without walls"
+            );
+            assert!(
+                !has(Buf::ExtForce) || v.ext_force,
+                "{pass:?} {v:?}: external forces without loads"
+            );
+            if v.walls && matches!(pass, Pass::GridPredict | Pass::GridCorrect) {
+                assert!(has(Buf::WallMask), "{pass:?} {v:?}: walls unread");
+            }
+            if v.ext_force && matches!(pass, Pass::Forces) {
+                assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");
+            }
             checked += 1;
         }
     }
@@ -218,8 +236,10 @@ fn shared_structs_match_rust_layouts() {
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
     let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model);
     assert_eq!(wgsl_struct(&module, "Material"), mat);
-    let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix);
+    let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix, vx, vy, ramp_time);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
+    let wall = rust_fields!(GpuWall; point, normal, mu, contact);
+    assert_eq!(wgsl_struct(&module, "Wall"), wall);
 }
 
 /// A WGSL constant's value as naga's front end evaluated it.
@@ -295,6 +315,12 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("FAULT_MLS_SINGULAR", u(l::FAULT_MLS_SINGULAR)),
         ("MODEL_LINEAR_ELASTIC", u(l::MODEL_LINEAR_ELASTIC)),
         ("MODEL_NEO_HOOKEAN", u(l::MODEL_NEO_HOOKEAN)),
+        ("CONTACT_STICK", u(lme_mpm::model::walls::CONTACT_STICK)),
+        ("CONTACT_SLIP", u(lme_mpm::model::walls::CONTACT_SLIP)),
+        (
+            "CONTACT_FRICTION",
+            u(lme_mpm::model::walls::CONTACT_FRICTION),
+        ),
         ("NODE_STRIDE", u(l::NODE_STRIDE as u32)),
         ("PROBE_STRIDE", u(l::PROBE_STRIDE as u32)),
         ("WG", u(l::WG)),

@@ -1,7 +1,23 @@
 // Body force per unit mass (m/s²) on particle p at time t (s): gravity
 // (paper eq. 45 when ramped) plus, with MMS, the aligned-vibration source
-// term derived in src/exact/mms.rs (`AlignedVibration::body_force`).
-// Needs the x0 binding. Also the force one particle adds to one node.
+// term derived in src/exact/mms.rs (`AlignedVibration::body_force`), plus,
+// with EXT_FORCE, the particle's share of the tractions and point loads
+// (ramped) over its mass. Needs the x0 binding, and the mass binding with
+// EXT_FORCE. Also the force one particle adds to one node.
+
+#if EXT_FORCE
+// (fx, fy, ramp_time) per particle: full force (N/m) and its ramp (s).
+@group(0) @binding({{B_EXT_FORCE}}) var<storage, read> ext_force: array<f32>;
+
+fn external_force(p: u32, t: f32) -> vec2<f32> {
+    let ramp = ext_force[3u * p + 2u];
+    var r = 1.0;
+    if ramp > 0.0 {
+        r = clamp(t / ramp, 0.0, 1.0);
+    }
+    return r * vec2<f32>(ext_force[3u * p], ext_force[3u * p + 1u]);
+}
+#endif
 
 // Gravity at time t (paper eq. 45 when ramped).
 fn gravity_at(t: f32) -> vec2<f32> {
@@ -33,10 +49,14 @@ fn mms_body_force(x0p: vec2<f32>, t: f32) -> vec2<f32> {
 
 fn body_force(p: u32, t: f32) -> vec2<f32> {
 #if MMS
-    return gravity_at(t) + mms_body_force(x0[p], t);
+    var b = gravity_at(t) + mms_body_force(x0[p], t);
 #else
-    return gravity_at(t);
+    var b = gravity_at(t);
 #endif
+#if EXT_FORCE
+    b += external_force(p, t) / mass[p];
+#endif
+    return b;
 }
 
 // Stage `forces`: particle p (shape context c, volume vol, stress

@@ -114,16 +114,35 @@ struct Material {
 }
 
 // Nodes with i0 <= i <= i1 and j0 <= j <= j1 are fixed in the `fix` bits
-// (1 = x, 2 = y); their reactions add up in `reactions[group]`.
+// (1 = x, 2 = y) at velocity (vx, vy) (m/s), ramped linearly from 0 over
+// ramp_time (s; 0 = from the start); their reactions add up in
+// `reactions[group]`.
 struct Constraint {
     i0: u32,
     i1: u32,
     j0: u32,
     j1: u32,
     fix: u32,
+    vx: f32,
+    vy: f32,
+    ramp_time: f32,
+}
+
+// Contact laws of a wall. Keep in sync with src/model/walls.rs.
+const CONTACT_STICK: u32 = 0u;
+const CONTACT_SLIP: u32 = 1u;
+const CONTACT_FRICTION: u32 = 2u;
+
+// A rigid wall: the line through `point` (m, grid-relative) with unit
+// normal `normal` into the material; `contact` is CONTACT_*, `mu` Coulomb's
+// coefficient (friction only). Its nodes are marked in `wall_mask`.
+struct Wall {
+    point: vec2<f32>,
+    normal: vec2<f32>,
+    mu: f32,
+    contact: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // Linear invocation index over a 2D dispatch (large counts exceed 65535

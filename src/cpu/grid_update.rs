@@ -1,12 +1,19 @@
 //! Stage `grid_update`, in two passes around the force computation.
 //! `predict`: nodal velocity from the scattered momentum, v_I = q_I / m_I,
-//! then the Dirichlet conditions (fixed components set to zero).
+//! then the walls' contact rules (each wall the node is behind, in scene
+//! order), then the Dirichlet conditions (fixed components set to the
+//! constraint's prescribed velocity at the step's end, zero by default):
+//! a constraint wins over a wall.
 //! `correct`: reactions on fixed nodes, their force components zeroed, then
 //! v_I += γ Δt f_I / m_I (NPC corrector; FE is γ = 1: the nodal momentum
-//! update p_I += Δt f_I of Zhang et al.).
+//! update p_I += Δt f_I of Zhang et al.); then the walls' rules on the
+//! corrected velocity, whose change Δv becomes the wall's force
+//! m Δv / (γ Δt), added to f_I (so the particles feel it) and to the wall's
+//! reaction. Fixed components keep their prescribed value.
 //! GPU twin: `shaders/grid_update.wgsl` (entry points `predict`, `correct`).
 
-use crate::model::{ConstraintGroup, FIX_X, FIX_Y};
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
 use rayon::prelude::*;
 
 pub use crate::model::MASS_EPS_REL;
@@ -21,35 +28,113 @@ fn zero_fixed(v: &mut [f64], fix: u8) {
     }
 }
 
-/// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out.
-pub fn predict(mv: &mut [[f64; 3]], fix: &[u8], mass_eps: f64) {
+/// A wall's contact rule on a node velocity `v` (m/s): stick stops it;
+/// slip removes the normal component when it points into the wall
+/// (v·n < 0) and leaves separation free; friction does that and applies
+/// Coulomb's law with the normal velocity change Δv_n = −v·n as the
+/// impulse per unit mass: a tangential velocity |v_t| ≤ μ Δv_n stops,
+/// a larger one loses μ Δv_n along −v_t/|v_t|.
+#[inline]
+pub fn wall_velocity(v: [f64; 2], normal: [f64; 2], contact: u32, mu: f64) -> [f64; 2] {
+    if contact == CONTACT_STICK {
+        return [0.0, 0.0];
+    }
+    let vn = v[0] * normal[0] + v[1] * normal[1];
+    if vn >= 0.0 {
+        return v;
+    }
+    let vt = [v[0] - vn * normal[0], v[1] - vn * normal[1]];
+    if contact != CONTACT_FRICTION {
+        return vt;
+    }
+    let dvn = -vn;
+    let speed = vt[0].hypot(vt[1]);
+    if speed <= mu * dvn {
+        return [0.0, 0.0];
+    }
+    let k = 1.0 - mu * dvn / speed;
+    [k * vt[0], k * vt[1]]
+}
+
+/// The rules of every wall in `mask` (bit k = wall k), in order.
+#[inline]
+fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
+    for (k, w) in walls.iter().enumerate() {
+        if mask & (1 << k) != 0 {
+            v = wall_velocity(v, w.normal, w.contact, w.mu);
+        }
+    }
+    v
+}
+
+/// Prescribed velocities at time `t` (s) on the fixed components of the
+/// groups that move (later groups win on shared nodes); nodes without
+/// mass stay at rest.
+fn prescribe(mv: &mut [[f64; 3]], groups: &[ConstraintGroup], t: f64, mass_eps: f64) {
+    for g in groups.iter().filter(|g| g.moves()) {
+        let v = g.velocity_at(t);
+        for &n in &g.nodes {
+            let node = &mut mv[n as usize];
+            if node[0] > mass_eps {
+                if g.fix & FIX_X != 0 {
+                    node[1] = v[0];
+                }
+                if g.fix & FIX_Y != 0 {
+                    node[2] = v[1];
+                }
+            }
+        }
+    }
+}
+
+/// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end time (s).
+pub fn predict(
+    mv: &mut [[f64; 3]],
+    fix: &[u8],
+    groups: &[ConstraintGroup],
+    walls: &Walls,
+    t: f64,
+    mass_eps: f64,
+) {
+    let wl = &walls.list;
     mv.par_iter_mut()
         .zip(fix)
+        .enumerate()
         .with_min_len(4096)
-        .for_each(|(n, &f)| {
+        .for_each(|(i, (n, &f))| {
             if n[0] > mass_eps {
                 let mut v = [n[1] / n[0], n[2] / n[0]];
+                if let Some(&mask) = walls.mask.get(i) {
+                    if mask != 0 {
+                        v = walls_velocity(v, mask, wl);
+                    }
+                }
                 zero_fixed(&mut v, f);
                 *n = [n[0], v[0], v[1]];
             } else {
                 *n = [n[0], 0.0, 0.0];
             }
         });
+    prescribe(mv, groups, t, mass_eps);
 }
 
 /// Records reactions per constraint group (the force the support exerts,
-/// −f_I on each fixed component), zeroes those components, and corrects
-/// the velocities by `gamma_dt` · f/m.
+/// −f_I on each fixed component), zeroes those components, corrects the
+/// velocities by `gamma_dt` · f/m, then applies the walls. `reactions`
+/// holds the constraint groups' then the walls'.
+#[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
     force: &mut [[f64; 2]],
     fix: &[u8],
     groups: &[ConstraintGroup],
+    walls: &Walls,
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
     mass_eps: f64,
 ) {
-    for (g, r) in groups.iter().zip(reactions.iter_mut()) {
+    let (group_r, wall_r) = reactions.split_at_mut(groups.len());
+    for (g, r) in groups.iter().zip(group_r.iter_mut()) {
         *r = [0.0; 2];
         for &n in &g.nodes {
             let f = force[n as usize];
@@ -72,4 +157,81 @@ pub fn correct(
                 n[2] += gamma_dt * f[1] / n[0];
             }
         });
+    for r in wall_r.iter_mut() {
+        *r = [0.0; 2];
+    }
+    if walls.is_empty() {
+        return;
+    }
+    // Each wall's velocity change on its nodes, one wall after another in
+    // scene order (a node behind two walls gets both), as on the GPU.
+    for (node, &mask) in walls.mask.iter().enumerate() {
+        let n = &mut mv[node];
+        if mask == 0 || n[0] <= mass_eps {
+            continue;
+        }
+        let m = n[0];
+        let mut v = [n[1], n[2]];
+        for (k, w) in walls.list.iter().enumerate() {
+            if mask & (1 << k) == 0 {
+                continue;
+            }
+            let mut new = wall_velocity(v, w.normal, w.contact, w.mu);
+            // A constraint wins: its components keep their value.
+            if fix[node] & FIX_X != 0 {
+                new[0] = v[0];
+            }
+            if fix[node] & FIX_Y != 0 {
+                new[1] = v[1];
+            }
+            let fw = [
+                m * (new[0] - v[0]) / gamma_dt,
+                m * (new[1] - v[1]) / gamma_dt,
+            ];
+            wall_r[k][0] += fw[0];
+            wall_r[k][1] += fw[1];
+            force[node][0] += fw[0];
+            force[node][1] += fw[1];
+            v = new;
+        }
+        n[1] = v[0];
+        n[2] = v[1];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::walls::CONTACT_SLIP;
+
+    const N: [f64; 2] = [0.0, 1.0];
+
+    #[test]
+    fn stick_stops() {
+        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_STICK, 0.0), [0.0, 0.0]);
+    }
+
+    #[test]
+    fn slip_removes_approach_only() {
+        assert_eq!(wall_velocity([1.0, -2.0], N, CONTACT_SLIP, 0.0), [1.0, 0.0]);
+        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_SLIP, 0.0), [1.0, 2.0]);
+    }
+
+    #[test]
+    fn friction_is_coulomb() {
+        // Δv_n = 2, μ Δv_n = 1: a tangential speed of 3 loses 1, 0.5 stops.
+        assert_eq!(
+            wall_velocity([3.0, -2.0], N, CONTACT_FRICTION, 0.5),
+            [2.0, 0.0]
+        );
+        assert_eq!(
+            wall_velocity([-0.5, -2.0], N, CONTACT_FRICTION, 0.5),
+            [0.0, 0.0]
+        );
+        // Separating: untouched.
+        assert_eq!(
+            wall_velocity([3.0, 2.0], N, CONTACT_FRICTION, 0.5),
+            [3.0, 2.0]
+        );
+    }
 }

@@ -88,7 +88,7 @@ impl CpuBackend {
             cache: ShapeCache::new(n, model.shape.max_nodes()),
             mv: vec![[0.0; 3]; nodes],
             force: vec![[0.0; 2]; nodes],
-            reactions: vec![[0.0; 2]; model.constraints.groups.len()],
+            reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -216,7 +216,14 @@ impl CpuBackend {
         let m = &mut self.model;
         let p = &mut m.particles;
         // The stress is at the step's end (t + Δt), so are the loads.
-        let body = body_force(m.gravity, &m.manufactured, &p.x0, self.t + self.dt);
+        let body = body_force(
+            m.gravity,
+            &m.manufactured,
+            &m.external,
+            &p.x0,
+            &p.mass,
+            self.t + self.dt,
+        );
         stress::stress_forces(
             &self.cache,
             &self.mv,
@@ -263,9 +270,14 @@ impl CpuBackend {
                     &mut self.p2g_scatter,
                 );
             }
-            Stage::GridPredict => {
-                grid_update::predict(&mut self.mv, &m.constraints.fix, self.mass_eps)
-            }
+            Stage::GridPredict => grid_update::predict(
+                &mut self.mv,
+                &m.constraints.fix,
+                &m.constraints.groups,
+                &m.walls,
+                self.t + self.dt,
+                self.mass_eps,
+            ),
             Stage::Stress => stress::stress(
                 &self.cache,
                 &self.mv,
@@ -279,7 +291,14 @@ impl CpuBackend {
             )?,
             Stage::Forces => {
                 // The stress is already at the step's end (t + Δt), so are the loads.
-                let body = body_force(m.gravity, &m.manufactured, &p.x0, self.t + self.dt);
+                let body = body_force(
+                    m.gravity,
+                    &m.manufactured,
+                    &m.external,
+                    &p.x0,
+                    &p.mass,
+                    self.t + self.dt,
+                );
                 if let Some(mls) = &mut self.mls {
                     mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
                     return Ok(());
@@ -299,6 +318,7 @@ impl CpuBackend {
                 &mut self.force,
                 &m.constraints.fix,
                 &m.constraints.groups,
+                &m.walls,
                 &mut self.reactions,
                 gamma * self.dt,
                 self.mass_eps,
@@ -328,20 +348,28 @@ impl CpuBackend {
 
 /// Body force per unit mass on particle `i` at time `t` (m/s²): gravity
 /// with its ramp, plus a manufactured solution's load at the particle's
-/// reference position.
+/// reference position, plus the particle's share of the tractions and
+/// point loads divided by its mass (the stages multiply by m_p again).
 fn body_force<'a>(
     gravity: Option<crate::model::Gravity>,
     mms: &'a Option<crate::model::AlignedVibration>,
+    ext: &'a Option<crate::model::ExternalForces>,
     x0: &'a [[f64; 2]],
+    mass: &'a [f64],
     t: f64,
 ) -> impl Fn(usize) -> [f64; 2] + Sync + 'a {
     let g = gravity.map_or([0.0; 2], |g| g.at(t));
-    move |i: usize| match mms {
-        None => g,
-        Some(s) => {
-            let b = s.body_force(x0[i], t);
-            [g[0] + b[0], g[1] + b[1]]
+    move |i: usize| {
+        let mut b = g;
+        if let Some(s) = mms {
+            let s = s.body_force(x0[i], t);
+            b = [b[0] + s[0], b[1] + s[1]];
         }
+        if let Some(e) = ext {
+            let f = e.at(i, t);
+            b = [b[0] + f[0] / mass[i], b[1] + f[1] / mass[i]];
+        }
+        b
     }
 }
 

@@ -7,8 +7,8 @@
 use super::GpuOptions;
 use super::context::GpuContext;
 use super::layout::{
-    GpuConstraint, GpuMaterial, MODEL_LINEAR_ELASTIC, MODEL_NEO_HOOKEAN, NODE_STRIDE, PROBE_STRIDE,
-    Params, Sim,
+    GpuConstraint, GpuMaterial, GpuWall, MODEL_LINEAR_ELASTIC, MODEL_NEO_HOOKEAN, NODE_STRIDE,
+    PROBE_STRIDE, Params, Sim,
 };
 use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
@@ -49,10 +49,13 @@ pub enum Buf {
     MlsCell,
     MlsOcc,
     MlsCoef,
+    Walls,
+    WallMask,
+    ExtForce,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 30] = [
+    pub const ALL: [Buf; 33] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -83,6 +86,9 @@ impl Buf {
         Buf::MlsCell,
         Buf::MlsOcc,
         Buf::MlsCoef,
+        Buf::Walls,
+        Buf::WallMask,
+        Buf::ExtForce,
     ];
 
     pub fn binding(self) -> u32 {
@@ -114,6 +120,8 @@ pub struct Buffers {
     pub n_nodes: usize,
     pub n_probes: usize,
     pub n_groups: usize,
+    /// Walls (their reactions follow the groups' in `Buf::Reactions`).
+    pub n_walls: usize,
     /// MLS: grid cells and Gauss points (0 without MLS).
     pub n_cells: usize,
     pub n_gauss: usize,
@@ -166,6 +174,7 @@ impl Buffers {
             n_nodes: g.n_nodes(),
             n_probes: model.probes.len(),
             n_groups: groups,
+            n_walls: model.walls.list.len(),
             n_cells: if model.mls {
                 (g.nx - 1) * (g.ny - 1)
             } else {
@@ -257,6 +266,13 @@ fn particle_data(
         let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
         data.push((Buf::DefGrad, bytes(&f)));
     }
+    if let Some(e) = &model.external {
+        // (fx, fy, ramp_time) per particle.
+        let f: Vec<f32> = (0..n)
+            .flat_map(|i| [e.force[i][0], e.force[i][1], e.ramp_time[i]].map(|c| c as f32))
+            .collect();
+        data.push((Buf::ExtForce, bytes(&f)));
+    }
 }
 
 /// Initial contents of the nodal, constraint, probe, energy and MLS buffers.
@@ -274,8 +290,30 @@ fn grid_and_output_data(model: &Model, params: &Params, data: &mut Vec<(Buf, Vec
             bytes(&flat2(&mut g.pos.iter().map(|x| rel(*x)))),
         ));
     }
-    let groups = model.constraints.groups.len();
-    data.push((Buf::Reactions, vec![0u8; 8 * groups.max(1)]));
+    let reactions = model.constraints.groups.len() + model.walls.list.len();
+    data.push((Buf::Reactions, vec![0u8; 8 * reactions.max(1)]));
+    if !model.walls.is_empty() {
+        let walls: Vec<GpuWall> = model
+            .walls
+            .list
+            .iter()
+            .map(|w| GpuWall {
+                point: [
+                    (w.point[0] - origin[0]) as f32,
+                    (w.point[1] - origin[1]) as f32,
+                ],
+                normal: f32x2(w.normal),
+                mu: w.mu as f32,
+                contact: w.contact,
+                _pad: [0; 2],
+            })
+            .collect();
+        data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
+        data.push((
+            Buf::WallMask,
+            bytemuck::cast_slice(&model.walls.mask).to_vec(),
+        ));
+    }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
     let probe_idx = if probe_idx.is_empty() {
         vec![0]
@@ -400,7 +438,9 @@ pub fn constraint_boxes(model: &Model) -> Result<Vec<GpuConstraint>> {
             j0,
             j1,
             fix: (grp.fix & FIX_X) as u32 | (grp.fix & FIX_Y) as u32,
-            _pad: [0; 3],
+            vx: grp.velocity[0] as f32,
+            vy: grp.velocity[1] as f32,
+            ramp_time: grp.ramp_time as f32,
         });
     }
     if out.is_empty() {
@@ -411,7 +451,9 @@ pub fn constraint_boxes(model: &Model) -> Result<Vec<GpuConstraint>> {
             j0: 1,
             j1: 0,
             fix: 0,
-            _pad: [0; 3],
+            vx: 0.0,
+            vy: 0.0,
+            ramp_time: 0.0,
         });
     }
     Ok(out)

@@ -94,9 +94,27 @@ pub struct GpuConstraint {
     pub j0: u32,
     pub j1: u32,
     pub fix: u32,
-    pub _pad: [u32; 3],
+    /// Prescribed velocity of the fixed components at full ramp (m/s).
+    pub vx: f32,
+    pub vy: f32,
+    /// Linear ramp time of the velocity (s); 0 = from the start.
+    pub ramp_time: f32,
 }
 const _: () = assert!(std::mem::size_of::<GpuConstraint>() == 32);
+
+/// A wall (shaders/shared/types.wgsl `Wall`): its line through `point`
+/// (m, grid-relative), unit normal into the material, contact code
+/// (`model::walls::CONTACT_*`) and μ.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuWall {
+    pub point: [f32; 2],
+    pub normal: [f32; 2],
+    pub mu: f32,
+    pub contact: u32,
+    pub _pad: [u32; 2],
+}
+const _: () = assert!(std::mem::size_of::<GpuWall>() == 32);
 
 /// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
 pub const NODE_STRIDE: usize = 5;

@@ -178,11 +178,11 @@ impl GpuBackend {
             .collect())
     }
 
-    /// Reactions per constraint group, as last computed on the device.
+    /// Reactions per constraint group then per wall, as last computed on the device.
     pub fn read_reactions(&self) -> Result<Vec<[f64; 2]>> {
         Ok(self
             .read(&[Buf::Reactions])?
-            .pairs(Buf::Reactions, self.buffers.n_groups))
+            .pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls))
     }
 
     /// Sets the device's stop time (`Sim::t_stop_hi`, `t_stop_lo`: adjacent
@@ -523,7 +523,7 @@ impl Backend for GpuBackend {
                 strain: e[1] as f64,
                 gravity_work_bound: e[2] as f64,
             },
-            reactions: b.pairs(Buf::Reactions, self.buffers.n_groups),
+            reactions: b.pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls),
         })
     }
 

@@ -45,7 +45,7 @@ pub enum Pass {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Domain {
     Particles,
-    /// Nodes, and at least 2 per constraint group (clear_grid zeroes reactions).
+    /// Nodes, and at least 2 per constraint group and wall (clear_grid zeroes reactions).
     Nodes,
     One,
     Probes,
@@ -165,6 +165,10 @@ pub struct Variant {
     pub mms: bool,
     /// MLS reconstruction at Gauss points.
     pub mls: bool,
+    /// Rigid walls (the `Walls` and `WallMask` buffers).
+    pub walls: bool,
+    /// Tractions or point loads (the `ExtForce` buffer).
+    pub ext_force: bool,
 }
 
 impl Variant {
@@ -189,6 +193,8 @@ impl Variant {
             lme_side: lme_side(model),
             mms: model.manufactured.is_some(),
             mls: model.mls,
+            walls: !model.walls.is_empty(),
+            ext_force: model.external.is_some(),
         }
     }
 
@@ -214,7 +220,9 @@ impl Variant {
             .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
             .flag("DEF_GRAD", self.def_grad)
             .flag("MMS", self.mms)
-            .flag("MLS", self.mls);
+            .flag("MLS", self.mls)
+            .flag("WALLS", self.walls)
+            .flag("EXT_FORCE", self.ext_force);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
@@ -448,7 +456,10 @@ impl Pipelines {
         Ok(Pipelines {
             built,
             n_particles: buffers.n_particles as u32,
-            n_nodes_or_groups: buffers.n_nodes.max(2 * buffers.n_groups) as u32,
+            n_nodes_or_groups: buffers
+                .n_nodes
+                .max(2 * (buffers.n_groups + buffers.n_walls))
+                as u32,
             n_probes: buffers.n_probes as u32,
             n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
             n_gauss: buffers.n_gauss as u32,
@@ -551,6 +562,8 @@ mod tests {
                                 def_grad: neo_hookean,
                                 mms,
                                 mls: false,
+                                walls: mms,
+                                ext_force: mms,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)

@@ -16,6 +16,7 @@
 //! and b_y the same with y for x. The test `momentum_balance_holds`
 //! checks it against finite differences of the exact fields.
 
+use crate::error::SceneError;
 use crate::model::Particles;
 use crate::model::material::NeoHookean;
 use crate::scene::{Ramp, Scene};
@@ -156,5 +157,156 @@ impl AlignedVibration {
                     .sum::<f64>()
             })
             .fold(0.0, f64::max)
+    }
+}
+
+/// Linear ramp factor at time `t` (s) of a load or prescribed velocity
+/// reaching full value at `ramp_time` (s); 0 = full from the start.
+#[inline]
+pub fn ramp_factor(t: f64, ramp_time: f64) -> f64 {
+    if ramp_time > 0.0 {
+        (t / ramp_time).clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Tractions and point loads as forces on particles (dead loads: fixed in
+/// size and direction, carried by the same particles all run). Made only
+/// when the scene has such loads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExternalForces {
+    /// Full force per particle (N per unit thickness); zero for most.
+    pub force: Vec<[f64; 2]>,
+    /// Its ramp time (s), 0 = sudden.
+    pub ramp_time: Vec<f64>,
+}
+
+impl ExternalForces {
+    /// Force on particle `p` at time `t` (N/m).
+    #[inline]
+    pub fn at(&self, p: usize, t: f64) -> [f64; 2] {
+        let r = ramp_factor(t, self.ramp_time[p]);
+        [r * self.force[p][0], r * self.force[p][1]]
+    }
+
+    /// The loads of `scene` on `particles` (initial positions), or None
+    /// without `[tractions]` and `[point_loads]`.
+    ///
+    /// A traction on segment AB (length L) is carried by the layer of
+    /// particles nearest the segment: among the particles whose projection
+    /// on AB falls within it, those within `layer` (a quarter of the
+    /// smallest particle spacing, h / (4 ppc)) of the nearest one. Each
+    /// gets traction × the length of its share of AB: the half-way points
+    /// between neighbours (sorted along AB) split it, the ends go to the
+    /// first and last, so the shares add up to L exactly. A point load goes
+    /// to the nearest particle.
+    pub fn from_scene(
+        scene: &Scene,
+        particles: &Particles,
+    ) -> Result<Option<ExternalForces>, SceneError> {
+        let f = &scene.file;
+        if f.tractions.is_empty() && f.point_loads.is_empty() {
+            return Ok(None);
+        }
+        let h = f.grid.h;
+        let n = particles.len();
+        let ppc = scene.bodies().map(|(_, b)| b.ppc).max().unwrap_or(2) as f64;
+        let layer = 0.25 * h / ppc;
+        let mut out = ExternalForces {
+            force: vec![[0.0; 2]; n],
+            ramp_time: vec![0.0; n],
+        };
+        // Which load set each particle's ramp, to refuse two ramps on one particle.
+        let mut owner: Vec<Option<String>> = vec![None; n];
+        let mut add = |key: &str, p: usize, force: [f64; 2], ramp: f64| {
+            if let Some(prev) = &owner[p] {
+                if out.ramp_time[p] != ramp {
+                    return Err(SceneError::invalid(
+                        format!("{key}.ramp_time"),
+                        format!(
+                            "differs from that of `{prev}`, which loads the same particle at \
+                             ({:.6}, {:.6}); give loads that meet the same ramp_time",
+                            particles.x0[p][0], particles.x0[p][1]
+                        ),
+                    ));
+                }
+            }
+            owner[p] = Some(key.to_string());
+            out.ramp_time[p] = ramp;
+            out.force[p][0] += force[0];
+            out.force[p][1] += force[1];
+            Ok(())
+        };
+        for (name, t) in &f.tractions {
+            let key = format!("tractions.{name}");
+            let (a, b) = (t.from, t.to);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let len = d[0].hypot(d[1]);
+            let u = [d[0] / len, d[1] / len];
+            // (particle, position along AB, distance to AB)
+            let on: Vec<(usize, f64, f64)> = (0..n)
+                .filter_map(|p| {
+                    let x = particles.x0[p];
+                    let r = [x[0] - a[0], x[1] - a[1]];
+                    let s = r[0] * u[0] + r[1] * u[1];
+                    let dist = (r[0] * u[1] - r[1] * u[0]).abs();
+                    (s >= -1e-9 * h && s <= len + 1e-9 * h).then_some((p, s, dist))
+                })
+                .collect();
+            let nearest = on.iter().map(|c| c.2).fold(f64::INFINITY, f64::min);
+            if !(nearest <= h) {
+                return Err(SceneError::invalid(
+                    key,
+                    format!(
+                        "touches no particle: no particle lies within one cell (h = {h} m) of the \
+                         segment {a:?} to {b:?}; put it on a body's boundary"
+                    ),
+                ));
+            }
+            let mut layer_p: Vec<(usize, f64)> = on
+                .iter()
+                .filter(|c| c.2 <= nearest + layer)
+                .map(|c| (c.0, c.1))
+                .collect();
+            layer_p.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
+            let k = layer_p.len();
+            for i in 0..k {
+                let lo = if i == 0 {
+                    0.0
+                } else {
+                    0.5 * (layer_p[i - 1].1 + layer_p[i].1)
+                };
+                let hi = if i + 1 == k {
+                    len
+                } else {
+                    0.5 * (layer_p[i].1 + layer_p[i + 1].1)
+                };
+                let share = hi - lo;
+                add(
+                    &key,
+                    layer_p[i].0,
+                    [t.traction[0] * share, t.traction[1] * share],
+                    t.ramp_time,
+                )?;
+            }
+        }
+        for (name, l) in &f.point_loads {
+            let key = format!("point_loads.{name}");
+            let p = particles.nearest(l.at);
+            let x = particles.x0[p];
+            let d = (x[0] - l.at[0]).hypot(x[1] - l.at[1]);
+            if d > h {
+                return Err(SceneError::invalid(
+                    format!("{key}.at"),
+                    format!(
+                        "is {d:.4e} m from the nearest particle, more than one cell (h = {h} m): \
+                         it lies outside every body"
+                    ),
+                ));
+            }
+            add(&key, p, l.force, l.ramp_time)?;
+        }
+        Ok(Some(out))
     }
 }

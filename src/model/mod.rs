@@ -11,10 +11,12 @@ pub mod material;
 mod particles;
 pub mod shape;
 pub mod time_step;
+pub mod walls;
 
 pub use grid::Grid;
-pub use loads::{AlignedVibration, Gravity};
+pub use loads::{AlignedVibration, ExternalForces, Gravity};
 pub use particles::Particles;
+pub use walls::{Wall, Walls};
 
 use crate::error::SceneError;
 use crate::model::material::Material;
@@ -38,9 +40,27 @@ pub struct ConstraintGroup {
     pub nodes: Vec<u32>,
     /// `FIX_X`, `FIX_Y` or both.
     pub fix: u8,
+    /// Prescribed velocity of the fixed components at full ramp (m/s).
+    pub velocity: [f64; 2],
+    /// Time to reach `velocity` from 0, linearly (s); 0 = from the start.
+    pub ramp_time: f64,
 }
 
-/// Dirichlet (zero-velocity) nodes.
+impl ConstraintGroup {
+    /// Prescribed velocity at time `t` (m/s).
+    pub fn velocity_at(&self, t: f64) -> [f64; 2] {
+        let r = loads::ramp_factor(t, self.ramp_time);
+        [r * self.velocity[0], r * self.velocity[1]]
+    }
+
+    /// Whether it prescribes a non-zero velocity on a fixed component.
+    pub fn moves(&self) -> bool {
+        (self.fix & FIX_X != 0 && self.velocity[0] != 0.0)
+            || (self.fix & FIX_Y != 0 && self.velocity[1] != 0.0)
+    }
+}
+
+/// Dirichlet nodes (zero or prescribed velocity).
 #[derive(Debug, Clone, Default)]
 pub struct Constraints {
     /// Per node: `FIX_X | FIX_Y` bits (0 = free).
@@ -85,7 +105,11 @@ pub struct Model {
     pub body_material: Vec<u32>,
     pub body_names: Vec<String>,
     pub constraints: Constraints,
+    /// Rigid walls with their contact laws (empty: none).
+    pub walls: Walls,
     pub gravity: Option<Gravity>,
+    /// Tractions and point loads as particle forces (None: the scene has none).
+    pub external: Option<ExternalForces>,
     pub integrator: Integrator,
     /// Courant number.
     pub cfl: f64,
@@ -146,6 +170,7 @@ impl Model {
         );
 
         let constraints = build_constraints(scene, &grid)?;
+        let walls = Walls::new(scene, &grid)?;
         let gravity = f.gravity.as_ref().map(|g| Gravity {
             g: g.g,
             ramp: g.ramp,
@@ -160,6 +185,7 @@ impl Model {
             }
         }
         let probes = build_probes(scene, &particles)?;
+        let external = ExternalForces::from_scene(scene, &particles)?;
 
         Ok(Model {
             grid,
@@ -169,7 +195,9 @@ impl Model {
             body_material,
             body_names,
             constraints,
+            walls,
             gravity,
+            external,
             integrator,
             cfl: f.solver.cfl,
             t_end: f.solver.t_end,
@@ -178,6 +206,17 @@ impl Model {
             probes,
             manufactured,
         })
+    }
+
+    /// Names of the reactions a sample reports, in order: the constraints',
+    /// then the walls'.
+    pub fn reaction_names(&self) -> Vec<String> {
+        self.constraints
+            .groups
+            .iter()
+            .map(|g| g.name.clone())
+            .chain(self.walls.list.iter().map(|w| w.name.clone()))
+            .collect()
     }
 
     /// Material of particle `p`.
@@ -452,6 +491,8 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
             name: name.clone(),
             nodes,
             fix: bits,
+            velocity: spec.velocity,
+            ramp_time: spec.ramp_time,
         });
     }
     Ok(c)

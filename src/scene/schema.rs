@@ -27,6 +27,15 @@ pub struct SceneFile {
     /// Node constraints by name; reactions are reported per constraint.
     #[serde(default)]
     pub constraints: BTreeMap<String, ConstraintSpec>,
+    /// Rigid walls (half-planes) by name; reactions are reported per wall.
+    #[serde(default)]
+    pub walls: BTreeMap<String, WallSpec>,
+    /// Distributed loads on a body's boundary by name.
+    #[serde(default)]
+    pub tractions: BTreeMap<String, TractionSpec>,
+    /// Concentrated loads by name.
+    #[serde(default)]
+    pub point_loads: BTreeMap<String, PointLoadSpec>,
     pub gravity: Option<GravitySpec>,
     pub solver: SolverSpec,
     #[serde(default)]
@@ -140,6 +149,67 @@ pub struct ConstraintSpec {
     /// Upper-right corner of the region (m); `inf` allowed.
     pub max: [f64; 2],
     pub fix: Fix,
+    /// Prescribed velocity of the fixed components (m/s). Default [0, 0].
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Linear ramp of `velocity` from 0 over this time (s); 0 = from the start. Default 0.
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+/// How a wall treats the material on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Contact {
+    /// Node velocity set to zero.
+    Stick,
+    /// Normal velocity into the wall removed; tangential free; separation free.
+    Slip,
+    /// Slip plus Coulomb friction on the tangential velocity (needs `friction`).
+    Friction,
+}
+
+/// A rigid wall: the half-plane behind the line through `point` with
+/// inward normal `normal`. Grid nodes with (x − point)·n ≤ 0 on the
+/// unperturbed lattice are its nodes.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    /// A point of the wall line (m).
+    pub point: [f64; 2],
+    /// Normal pointing into the region where material may be; normalised on reading.
+    pub normal: [f64; 2],
+    pub contact: Contact,
+    /// Coulomb friction coefficient μ ≥ 0, only with `contact = "friction"`.
+    pub friction: Option<f64>,
+}
+
+/// A traction on a segment of a body's boundary (dead load).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSpec {
+    /// Start of the segment (m).
+    pub from: [f64; 2],
+    /// End of the segment (m).
+    pub to: [f64; 2],
+    /// Force per unit boundary length per unit thickness (Pa).
+    pub traction: [f64; 2],
+    /// Linear ramp from 0 over this time (s); 0 = sudden. Default 0.
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+/// A concentrated force on the particle nearest to `at` (dead load).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoadSpec {
+    /// Where it acts (m).
+    pub at: [f64; 2],
+    /// Force per unit thickness (N/m).
+    pub force: [f64; 2],
+    /// Linear ramp from 0 over this time (s); 0 = sudden. Default 0.
+    #[serde(default)]
+    pub ramp_time: f64,
 }
 
 /// Time history of gravity.

@@ -69,6 +69,8 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     check_materials(&file)?;
     check_bodies(&file)?;
     check_constraints(&file)?;
+    check_walls(&file)?;
+    check_loads(&file)?;
     check_gravity(&file)?;
     let sample_interval = check_output(&file)?;
     check_manufactured_section(&mut file)?;
@@ -369,6 +371,115 @@ fn check_constraints(file: &SceneFile) -> Result<(), SceneError> {
                 ),
             ));
         }
+        finite_point(&format!("constraints.{cname}.velocity"), &c.velocity)?;
+        ramp_time(&format!("constraints.{cname}.ramp_time"), c.ramp_time)?;
+    }
+    Ok(())
+}
+
+/// A ramp time (s): finite and ≥ 0 (0 = sudden).
+fn ramp_time(key: &str, v: f64) -> Result<(), SceneError> {
+    finite(key, v)?;
+    if v < 0.0 {
+        return Err(SceneError::invalid(
+            key,
+            format!("must be >= 0 (0 = applied from the start), got {v}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Most walls a scene may have: the GPU marks a node's walls in one u32.
+pub const MAX_WALLS: usize = 32;
+
+/// `[walls]`: a point, a non-zero normal, a contact law and its μ.
+fn check_walls(file: &SceneFile) -> Result<(), SceneError> {
+    if file.walls.len() > MAX_WALLS {
+        return Err(SceneError::invalid(
+            "walls",
+            format!(
+                "has {} walls, more than {MAX_WALLS} (a node keeps its walls in 32 bits)",
+                file.walls.len()
+            ),
+        ));
+    }
+    for (name, w) in &file.walls {
+        let key = format!("walls.{name}");
+        if file.constraints.contains_key(name) {
+            return Err(SceneError::invalid(
+                key,
+                "has the name of a constraint; reactions are reported by name, so give it another",
+            ));
+        }
+        coord(&format!("{key}.point"), &w.point)?;
+        finite_point(&format!("{key}.normal"), &w.normal)?;
+        let len = w.normal[0].hypot(w.normal[1]);
+        if len == 0.0 {
+            return Err(SceneError::invalid(
+                format!("{key}.normal"),
+                format!("must have a non-zero length, got {:?}", w.normal),
+            ));
+        }
+        match (w.contact, w.friction) {
+            (Contact::Friction, None) => {
+                return Err(SceneError::invalid(
+                    format!("{key}.friction"),
+                    "is required with contact = \"friction\" (Coulomb's μ >= 0)",
+                ));
+            }
+            (Contact::Friction, Some(mu)) => {
+                finite(&format!("{key}.friction"), mu)?;
+                if mu < 0.0 {
+                    return Err(SceneError::invalid(
+                        format!("{key}.friction"),
+                        format!("must be >= 0, got {mu}"),
+                    ));
+                }
+            }
+            (_, Some(_)) => {
+                return Err(SceneError::invalid(
+                    format!("{key}.friction"),
+                    "is only read with contact = \"friction\"; drop it or set contact = \"friction\"",
+                ));
+            }
+            (_, None) => {}
+        }
+    }
+    Ok(())
+}
+
+/// `[tractions]` and `[point_loads]`: finite values, a segment of non-zero
+/// length, ramp times ≥ 0. Whether they touch a body is checked in
+/// `model::Model::new`, which has the particles.
+fn check_loads(file: &SceneFile) -> Result<(), SceneError> {
+    if file.solver.mls && !(file.tractions.is_empty() && file.point_loads.is_empty()) {
+        return Err(SceneError::invalid(
+            "solver.mls",
+            "cannot carry tractions or point loads (MLS fits the body force as a smooth field, \
+             which would smear a load on a few particles); drop the loads or set mls = false",
+        ));
+    }
+    for (name, t) in &file.tractions {
+        let key = format!("tractions.{name}");
+        coord(&format!("{key}.from"), &t.from)?;
+        coord(&format!("{key}.to"), &t.to)?;
+        finite_point(&format!("{key}.traction"), &t.traction)?;
+        ramp_time(&format!("{key}.ramp_time"), t.ramp_time)?;
+        if (t.to[0] - t.from[0]).hypot(t.to[1] - t.from[1]) <= 1e-9 * file.grid.h.abs() {
+            return Err(SceneError::invalid(
+                format!("{key}.to"),
+                format!(
+                    "must differ from `from`: the segment {:?} to {:?} has zero length",
+                    t.from, t.to
+                ),
+            ));
+        }
+    }
+    for (name, l) in &file.point_loads {
+        let key = format!("point_loads.{name}");
+        coord(&format!("{key}.at"), &l.at)?;
+        finite_point(&format!("{key}.force"), &l.force)?;
+        ramp_time(&format!("{key}.ramp_time"), l.ramp_time)?;
     }
     Ok(())
 }
