@@ -4,6 +4,7 @@
 pub mod column;
 pub mod dyka;
 pub mod mms;
+pub mod sliding;
 
 use crate::model::{Model, Particles};
 use crate::scene::{ExactKind, Scene};
@@ -16,6 +17,7 @@ pub enum Errors {
     Dyka(dyka::DykaErrors),
     Column(column::ColumnErrors),
     Mms(mms::MmsErrors),
+    Sliding(sliding::SlidingErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact solution.
@@ -30,6 +32,9 @@ pub fn score(
         ExactKind::DykaBar => Errors::Dyka(dyka::DykaBar::from_scene(scene).score(particles, t)),
         ExactKind::ElasticColumn => {
             Errors::Column(column::ElasticColumn::from_scene(scene, model).score(particles, t))
+        }
+        ExactKind::SlidingBlock => {
+            Errors::Sliding(sliding::SlidingBlock::from_scene(scene).score(particles, t))
         }
         ExactKind::AlignedVibration => Errors::Mms(mms::score(
             &mms::AlignedVibration::from_scene(scene).expect("validated: a manufactured scene"),

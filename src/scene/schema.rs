@@ -385,6 +385,9 @@ pub enum ExactKind {
     ElasticColumn,
     /// The manufactured 2D aligned vibration (set by `[manufactured]`).
     AlignedVibration,
+    /// A block sliding from rest on one frictional (or slip) wall under
+    /// gravity: v = max(g_t − μ g_n, 0) t along the wall.
+    SlidingBlock,
 }
 
 /// Manufactured solutions known to the code.

@@ -661,6 +661,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ExactKind::DykaBar => "dyka_bar",
         ExactKind::ElasticColumn => "elastic_column",
         ExactKind::AlignedVibration => return Ok(()),
+        ExactKind::SlidingBlock => return check_sliding_block(file),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -692,7 +693,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ));
     }
     match kind {
-        ExactKind::AlignedVibration => {}
+        ExactKind::AlignedVibration | ExactKind::SlidingBlock => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(
@@ -725,6 +726,40 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
                 ));
             }
         }
+    }
+    Ok(())
+}
+
+/// `exact = "sliding_block"`: one slip or friction wall, gravity, bodies
+/// at rest, no other loads or constraints.
+fn check_sliding_block(file: &SceneFile) -> Result<(), SceneError> {
+    let fail = |why: &str| {
+        Err(SceneError::invalid(
+            "exact",
+            format!("= \"sliding_block\" needs {why}"),
+        ))
+    };
+    if file.walls.len() != 1
+        || file
+            .walls
+            .values()
+            .any(|w| w.contact == Contact::Stick)
+    {
+        return fail("exactly one wall, with contact = \"slip\" or \"friction\"");
+    }
+    if !file
+        .gravity
+        .as_ref()
+        .is_some_and(|g| g.g != [0.0, 0.0])
+    {
+        return fail("gravity");
+    }
+    if file.bodies.values().any(|b| b.velocity != [0.0, 0.0]) {
+        return fail("bodies at rest");
+    }
+    if !(file.constraints.is_empty() && file.tractions.is_empty() && file.point_loads.is_empty())
+    {
+        return fail("no constraints, tractions or point loads (gravity and the wall only)");
     }
     Ok(())
 }

@@ -138,6 +138,7 @@ fn error_figure(r: &JobResult) -> Option<String> {
         Errors::Mms(e) => Some(format!("u {}", sig(e.rms_displacement))),
         Errors::Dyka(e) => Some(format!("rms {}", sig(e.rms_velocity_relative))),
         Errors::Column(e) => Some(format!("settle {}", sig(e.settlement_rel_error))),
+        Errors::Sliding(e) => Some(format!("v {}", sig(e.velocity_rel_error))),
     }
 }
 
