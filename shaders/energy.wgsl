@@ -1,6 +1,7 @@
 // Energy diagnostics at sample times: Σ ½ m |v|², Σ V W(σ), and the bound
-// Σ m |g| |u| on gravity's work, reduced per workgroup then added into
-// energy_out[0..3]. CPU twin: src/cpu/energy.rs.
+// Σ (m |g| + |F|) |u| on the work of gravity and the loads (F the full
+// traction or point-load force of a particle, with EXT_FORCE), reduced per
+// workgroup then added into energy_out[0..3]. CPU twin: src/cpu/energy.rs.
 #include "shared/common.wgsl"
 #include "shared/material.wgsl"
 #if DEF_GRAD
@@ -12,6 +13,10 @@
 @group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
 @group(0) @binding({{B_STRESS}}) var<storage, read> stress: array<f32>;
+#if EXT_FORCE
+// (fx, fy, ramp_time) per particle (shared/body_force.wgsl).
+@group(0) @binding({{B_EXT_FORCE}}) var<storage, read> ext_force: array<f32>;
+#endif
 @group(0) @binding({{B_ENERGY_OUT}}) var<storage, read_write> energy_out: array<{{ATOMIC_T}}>;
 
 #include "shared/atomics.wgsl" ARR=energy_out FN=energy_add
@@ -37,10 +42,14 @@ fn main(
     if p < params.n_particles {
         let m = mass[p];
         let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+        var load = m * length(params.gravity);
+#if EXT_FORCE
+        load += length(vec2<f32>(ext_force[3u * p], ext_force[3u * p + 1u]));
+#endif
         e = vec4<f32>(
             0.5 * m * dot(v[p], v[p]),
             m / rho[p] * strain_energy_density(material_of(p), s, particle_def_grad(p)),
-            m * length(params.gravity) * length(u[p]),
+            load * length(u[p]),
             0.0,
         );
     }

@@ -69,7 +69,10 @@ fn wall_rules_on_an_inclined_normal() {
         v(2.5, 0.0)
     ));
     // μ Δv_n = 2 * 2 ≥ 3: it sticks.
-    assert!(close(wall_velocity(u, n, CONTACT_FRICTION, 2.0), [0.0, 0.0]));
+    assert!(close(
+        wall_velocity(u, n, CONTACT_FRICTION, 2.0),
+        [0.0, 0.0]
+    ));
     // Separating (v·n > 0) and resting (v·n = 0) velocities are free.
     for w in [v(3.0, 1.0), v(-1.0, 0.0)] {
         for c in [CONTACT_SLIP, CONTACT_FRICTION] {
@@ -128,5 +131,170 @@ fn sliding_block_matches_exact_on_gpu() {
             };
             assert!(e.velocity_rel_error < tol, "gpu {case} {sets:?}: {e:?}");
         }
+    }
+}
+
+/// A bar 1 m × 0.1 m (ν = 0, free all round) pulled at its right end by a
+/// traction p = 10 kPa applied suddenly at t = 0. The front runs left at
+/// c = sqrt(E/ρ) = 100 m/s; at t = 5 ms it is at x = 0.5 m, and behind it
+/// σ_xx = p and the material moves toward the load at v_x = p/(ρ c) = 0.1 m/s.
+const BAR: &str = r#"
+[grid]
+h = 0.02
+origin = [0.0, 0.0]
+margin = 0.02
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.0
+[bodies.bar]
+material = "m"
+rects = [[0.0, 0.0, 1.0, 0.1]]
+[tractions.end]
+from = [1.0, 0.0]
+to = [1.0, 0.1]
+traction = [1e4, 0.0]
+[solver]
+lme_gamma = 3.0
+t_end = 0.005
+[output]
+sample_interval = 0.001
+"#;
+
+/// The stress behind the front within 2% of the traction (the issue's
+/// bound) as the mean σ_xx of the particles with 0.6 ≤ X ≤ 0.9 m (five cells
+/// clear of the front and of the loaded layer), and v_x there likewise. We
+/// measure 0.5% (Q4) to 0.9% (LME NPC): the front's overshoot, not yet
+/// decayed 5 cells behind it.
+const BAR_STRESS_TOL: f64 = 0.02;
+/// The bar's momentum equals the impulse p H t: the particle shares add up
+/// to the traction exactly. We measure 4e-11 (LME), 2e-15 (Q4) and 1.2e-9
+/// (uGIMP) relative after 500 steps: round-off.
+const BAR_MOMENTUM_TOL: f64 = 1e-8;
+
+#[test]
+fn suddenly_loaded_bar_carries_the_traction() {
+    for sets in [
+        &[][..],
+        &["solver.integrator=fe"][..],
+        &["solver.shape=linear"][..],
+        &["solver.shape=ugimp"][..],
+    ] {
+        let scene = scene_of(BAR, sets);
+        let model = Model::new(&scene).unwrap();
+        let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
+        let t = sim.backend().time();
+        let p = sim.backend().particles().unwrap();
+        let behind: Vec<usize> = (0..p.len())
+            .filter(|&i| (0.6..=0.9).contains(&p.x0[i][0]))
+            .collect();
+        let sxx = behind.iter().map(|&i| p.stress[i][0]).sum::<f64>() / behind.len() as f64;
+        let vx = behind.iter().map(|&i| p.v[i][0]).sum::<f64>() / behind.len() as f64;
+        let momentum: f64 = (0..p.len()).map(|i| p.mass[i] * p.v[i][0]).sum();
+        let impulse = 1e4 * 0.1 * t;
+        let err = (sxx - 1e4).abs() / 1e4;
+        println!(
+            "bar {sets:?}: sigma_xx behind the front {sxx:.1} Pa (rel. error {err:.2e}), \
+             v_x {vx:.4} m/s (exact 0.1), momentum / impulse − 1 = {:.1e}",
+            momentum / impulse - 1.0
+        );
+        assert!(err < BAR_STRESS_TOL, "{sets:?}: {sxx}");
+        assert!((vx - 0.1).abs() < 0.1 * BAR_STRESS_TOL, "{sets:?}: {vx}");
+        assert!(
+            (momentum / impulse - 1.0).abs() < BAR_MOMENTUM_TOL,
+            "{sets:?}"
+        );
+    }
+}
+
+/// A column 4 m wide and 10 m high (ν = 0, E = 500 MPa, ρ0 = 6000 kg/m³)
+/// on a fixed base, under gravity ramped by eq. 45 (T = 20 s) and a
+/// surcharge p = 200 kPa on its top, ramped over 10 s; scored at t = 20 s,
+/// ten seconds after both are full. The column is stiff (strain 0.2%,
+/// period 4H/c = 0.14 s) so the ramps are slow against its period and it
+/// is at rest: the elastic block's 5 MPa leaves an oscillation of ±10% in
+/// σ_yy after a 10 s linear ramp.
+const COLUMN: &str = r#"
+[grid]
+h = 1.0
+origin = [0.0, 0.0]
+[materials.soil]
+model = "linear_elastic"
+density = 6000.0
+E = 5e8
+nu = 0.0
+[bodies.column]
+material = "soil"
+rects = [[0.0, 0.0, 4.0, 10.0]]
+[constraints.base]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "xy"
+[tractions.surcharge]
+from = [0.0, 10.0]
+to = [4.0, 10.0]
+traction = [0.0, -2e5]
+ramp_time = 10.0
+[gravity]
+g = [0.0, -9.81]
+ramp = "sine"
+ramp_period = 20.0
+[solver]
+lme_gamma = 3.0
+t_end = 20.0
+[output]
+sample_interval = 0.5
+"#;
+
+/// σ_yy = −p − ρ0 g (H − Y) within 1% (the issue's bound) at rest, as
+/// the mean σ_yy of each cell's layer of particles against the exact value
+/// at the layer's mid-height, for every layer but the two under the load;
+/// and the base reaction equals p W + ρ0 g H W within 1%. A particle's own
+/// σ_yy is off by up to ±ρ0 g h/4 (2% here) as the stress is nearly
+/// constant across a cell, and the two loaded layers are off by O(p): the
+/// traction enters as forces on the top particle row, h/(2 ppc) below the
+/// surface (docs/methods.md). The figures are printed and written in
+/// docs/verification.md.
+const COLUMN_TOL: f64 = 0.01;
+
+#[test]
+fn column_with_a_surcharge_matches_the_exact_stress() {
+    for sets in [
+        &[][..],
+        &["solver.shape=linear"][..],
+        &["solver.integrator=fe"][..],
+    ] {
+        let scene = scene_of(COLUMN, sets);
+        let model = Model::new(&scene).unwrap();
+        let (mut sim, rec) = run(&scene, Box::new(CpuBackend::new(model)));
+        let p = sim.backend().particles().unwrap();
+        let (rho, g, h, w, q, cell) = (6000.0, 9.81, 10.0, 4.0, 2e5, 1.0);
+        let exact = |y: f64| -q - rho * g * (h - y);
+        let layers = (h / cell) as usize;
+        let mut worst: f64 = 0.0;
+        let mut loaded = Vec::new();
+        for k in 0..layers {
+            let sel: Vec<usize> = (0..p.len())
+                .filter(|&i| (p.x0[i][1] / cell).floor() as usize == k)
+                .collect();
+            let mean = sel.iter().map(|&i| p.stress[i][1]).sum::<f64>() / sel.len() as f64;
+            let want = exact((k as f64 + 0.5) * cell);
+            let err = (mean - want).abs() / want.abs();
+            if k + 2 < layers {
+                worst = worst.max(err);
+            } else {
+                loaded.push(err);
+            }
+        }
+        let ry = rec.samples.last().unwrap().reactions[0][1];
+        let load = q * w + rho * g * h * w;
+        println!(
+            "column {sets:?}: worst layer-mean sigma_yy error {worst:.2e} (the two loaded \
+             layers: {loaded:?}); base reaction / load − 1 = {:.2e}",
+            ry / load - 1.0
+        );
+        assert!(worst < COLUMN_TOL, "{sets:?}: {worst}");
+        assert!((ry / load - 1.0).abs() < COLUMN_TOL, "{sets:?}: {ry}");
     }
 }

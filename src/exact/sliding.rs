@@ -84,7 +84,8 @@ impl SlidingBlock {
         if tp <= 0.0 {
             t
         } else if t <= 0.5 * tp {
-            0.5 * t - tp * (2.0 * std::f64::consts::PI * t / tp).sin() / (4.0 * std::f64::consts::PI)
+            0.5 * t
+                - tp * (2.0 * std::f64::consts::PI * t / tp).sin() / (4.0 * std::f64::consts::PI)
         } else {
             0.25 * tp + (t - 0.5 * tp)
         }
@@ -159,6 +160,9 @@ mod tests {
         assert!((r.ramp_integral(0.1) - 0.05).abs() < 1e-15);
         assert!((r.ramp_integral(0.5) - 0.45).abs() < 1e-15);
         let d = 1e-7;
-        assert!(((r.ramp_integral(0.05 + d) - r.ramp_integral(0.05 - d)) / (2.0 * d) - 0.5).abs() < 1e-6);
+        assert!(
+            ((r.ramp_integral(0.05 + d) - r.ramp_integral(0.05 - d)) / (2.0 * d) - 0.5).abs()
+                < 1e-6
+        );
     }
 }

@@ -10,7 +10,8 @@ use crate::model::Model;
 pub struct Energy {
     pub kinetic: f64,
     pub strain: f64,
-    /// Σ m_p |g| |x_p − x0_p|: no more work than this can gravity have done.
+    /// Σ (m_p |g| + |F_p|) |x_p − x0_p|: no more work than this can gravity
+    /// and the tractions and point loads (F_p at full value) have done.
     pub gravity_work_bound: f64,
 }
 
@@ -28,7 +29,12 @@ impl Energy {
                     &p.stress[i],
                     p.f.get(i).unwrap_or(&[1.0, 0.0, 0.0, 1.0]),
                 ),
-            gravity_work_bound: p.mass[i] * g * d[0].hypot(d[1]),
+            gravity_work_bound: (p.mass[i] * g
+                + model
+                    .external
+                    .as_ref()
+                    .map_or(0.0, |e| e.force[i][0].hypot(e.force[i][1])))
+                * d[0].hypot(d[1]),
         }
     }
 }

@@ -739,26 +739,16 @@ fn check_sliding_block(file: &SceneFile) -> Result<(), SceneError> {
             format!("= \"sliding_block\" needs {why}"),
         ))
     };
-    if file.walls.len() != 1
-        || file
-            .walls
-            .values()
-            .any(|w| w.contact == Contact::Stick)
-    {
+    if file.walls.len() != 1 || file.walls.values().any(|w| w.contact == Contact::Stick) {
         return fail("exactly one wall, with contact = \"slip\" or \"friction\"");
     }
-    if !file
-        .gravity
-        .as_ref()
-        .is_some_and(|g| g.g != [0.0, 0.0])
-    {
+    if !file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
         return fail("gravity");
     }
     if file.bodies.values().any(|b| b.velocity != [0.0, 0.0]) {
         return fail("bodies at rest");
     }
-    if !(file.constraints.is_empty() && file.tractions.is_empty() && file.point_loads.is_empty())
-    {
+    if !(file.constraints.is_empty() && file.tractions.is_empty() && file.point_loads.is_empty()) {
         return fail("no constraints, tractions or point loads (gravity and the wall only)");
     }
     Ok(())
