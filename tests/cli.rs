@@ -570,3 +570,131 @@ fn check_prints_the_estimate_and_warns_of_long_runs() {
     assert_eq!(code, Some(0), "{msg}");
     assert!(msg.contains("warning: a long run"), "{msg}");
 }
+
+/// Walls, prescribed velocities, tractions and point loads given wrong:
+/// exit 2, the message names the key, nothing is written.
+#[test]
+fn bad_boundaries_exit_2_naming_the_key() {
+    let sliding = common::case("sliding_block.toml");
+    let bounds = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/boundaries.toml");
+    let no_mu = std::fs::read_to_string(&sliding)
+        .unwrap()
+        .replace("friction = 0.3\n", "");
+    let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
+        (
+            "zero normal",
+            sliding.clone(),
+            vec!["walls.floor.normal=[0, 0]"],
+            "walls.floor.normal",
+        ),
+        (
+            "negative friction",
+            sliding.clone(),
+            vec!["walls.floor.friction=-0.1"],
+            "walls.floor.friction",
+        ),
+        (
+            "friction without mu",
+            scene_file(&tmp("nomu"), &no_mu),
+            vec![],
+            "walls.floor.friction",
+        ),
+        (
+            "mu without friction",
+            sliding.clone(),
+            vec!["walls.floor.contact=slip"],
+            "walls.floor.friction",
+        ),
+        (
+            "non-finite wall point",
+            sliding.clone(),
+            vec!["walls.floor.point=[nan, 0]"],
+            "walls.floor.point",
+        ),
+        (
+            "wall behind no node",
+            sliding.clone(),
+            vec!["walls.floor.point=[0, -100]"],
+            "walls.floor",
+        ),
+        (
+            "negative constraint ramp",
+            bounds.clone(),
+            vec!["constraints.drive.ramp_time=-1"],
+            "constraints.drive.ramp_time",
+        ),
+        (
+            "non-finite prescribed velocity",
+            bounds.clone(),
+            vec!["constraints.drive.velocity=[inf, 0]"],
+            "constraints.drive.velocity",
+        ),
+        (
+            "negative traction ramp",
+            bounds.clone(),
+            vec!["tractions.top.ramp_time=-1"],
+            "tractions.top.ramp_time",
+        ),
+        (
+            "zero-length traction segment",
+            bounds.clone(),
+            vec!["tractions.top.to=[0.5, 2.5]"],
+            "tractions.top.to",
+        ),
+        (
+            "traction touching no particle",
+            bounds.clone(),
+            vec![
+                "tractions.top.from=[0.5, 3.0]",
+                "tractions.top.to=[3.5, 3.0]",
+            ],
+            "tractions.top",
+        ),
+        (
+            "non-finite traction",
+            bounds.clone(),
+            vec!["tractions.top.traction=[nan, 0]"],
+            "tractions.top.traction",
+        ),
+        (
+            "point load outside every body",
+            bounds.clone(),
+            vec!["point_loads.side.at=[3.9, 2.9]"],
+            "point_loads.side.at",
+        ),
+        (
+            "negative point load ramp",
+            bounds.clone(),
+            vec!["point_loads.side.ramp_time=-2"],
+            "point_loads.side.ramp_time",
+        ),
+        (
+            "loads with MLS",
+            bounds.clone(),
+            vec!["solver.shape=bspline2", "solver.mls=true"],
+            "solver.mls",
+        ),
+        (
+            "sliding_block scored on a stick wall",
+            scene_file(&tmp("stick"), &no_mu),
+            vec!["walls.floor.contact=stick"],
+            "exact",
+        ),
+    ];
+    for (what, scene, sets, needle) in cases {
+        let out = tmp("never-written-bc");
+        let o = run_with(&scene, &out, &sets);
+        let msg = stderr(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{what}: exit {:?}, stderr: {msg}",
+            o.status.code()
+        );
+        assert!(
+            msg.contains(needle),
+            "{what}: message lacks {needle:?}: {msg}"
+        );
+        assert!(!out.exists(), "{what}: output folder was created");
+    }
+}

@@ -32,6 +32,11 @@ const TWO_MATERIAL_ENERGY_TOL: f64 = 3e-5;
 /// largest: worst 2.2e-6 (LME, history), 1.8e-6, 1.8e-6. 10 times, rounded up.
 const TWO_MATERIAL_TOL: f64 = 3e-5;
 
+/// Block on a frictional incline pushed by a traction and a point load:
+/// worst measured 1.1e-4 (LME FE, reaction history; final velocities
+/// 1.5e-5, stresses 5.7e-5; Q4 NPC 1.4e-6 to 3.3e-6). 9 times, rounded.
+const BOUNDARIES_TOL: f64 = 1e-3;
+
 struct Outcome {
     samples: Vec<Sample>,
     particles: Particles,
@@ -356,5 +361,50 @@ fn two_material_impact_gpu_matches_cpu() {
         );
         assert!(s_rms < TWO_MATERIAL_TOL, "final stresses differ: {s_rms}");
         check_energy(&format!("{sets:?}"), &cpu, &gpu, TWO_MATERIAL_ENERGY_TOL);
+    }
+}
+
+/// A block on a frictional 30° wall pushed along it by a ramped traction
+/// and a point load under gravity (tests/scenes/incline_traction.toml),
+/// 0.2 s: final velocities over the
+/// largest CPU speed, final stresses over the largest, and the reaction
+/// histories of every constraint and wall over the largest reaction.
+/// Measured worst figures are in the constant's comment.
+#[test]
+fn boundaries_gpu_matches_cpu() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/incline_traction.toml");
+    for sets in [&[][..], &["solver.shape=lme", "solver.integrator=fe"][..]] {
+        let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let scene = Scene::load(&path, &o).unwrap();
+        let Some((cpu, gpu)) = both_of("incline_traction", &scene, false) else {
+            return;
+        };
+        let vc: Vec<f64> = cpu.particles.v.iter().flatten().copied().collect();
+        let vg: Vec<f64> = gpu.particles.v.iter().flatten().copied().collect();
+        let v_max = vc.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        let v_rms = field_rms(&vc, &vg) / v_max;
+        let sc: Vec<f64> = cpu.particles.stress.iter().flatten().copied().collect();
+        let sg: Vec<f64> = gpu.particles.stress.iter().flatten().copied().collect();
+        let s_max = sc.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        let s_rms = field_rms(&sc, &sg) / s_max;
+        let n_r = cpu.samples[0].reactions.len();
+        let mut r_rms: f64 = 0.0;
+        for k in 0..n_r {
+            for c in 0..2 {
+                let (rms, scale) = history_rms(&cpu.samples, &gpu.samples, |s| s.reactions[k][c]);
+                if scale > 0.0 {
+                    r_rms = r_rms.max(rms / scale);
+                }
+            }
+        }
+        println!(
+            "{sets:?}: steps cpu {} gpu {}; final velocity RMS diff / max {v_rms:.2e}, \
+             final stress {s_rms:.2e}, worst reaction history {r_rms:.2e}",
+            cpu.steps, gpu.steps
+        );
+        assert!(v_rms < BOUNDARIES_TOL, "final velocities differ: {v_rms}");
+        assert!(s_rms < BOUNDARIES_TOL, "final stresses differ: {s_rms}");
+        assert!(r_rms < BOUNDARIES_TOL, "reaction histories differ: {r_rms}");
     }
 }
