@@ -255,7 +255,7 @@ impl ExternalForces {
                 })
                 .collect();
             let nearest = on.iter().map(|c| c.2).fold(f64::INFINITY, f64::min);
-            if !(nearest <= h) {
+            if nearest.is_nan() || nearest > h {
                 return Err(SceneError::invalid(
                     key,
                     format!(
