@@ -4,6 +4,7 @@
 pub mod column;
 pub mod dyka;
 pub mod mms;
+pub mod rolling;
 
 use crate::model::{Model, Particles};
 use crate::scene::{ExactKind, Scene};
@@ -16,6 +17,7 @@ pub enum Errors {
     Dyka(dyka::DykaErrors),
     Column(column::ColumnErrors),
     Mms(mms::MmsErrors),
+    Rolling(rolling::RollingErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact solution.
@@ -36,5 +38,8 @@ pub fn score(
             particles,
             t,
         )),
+        ExactKind::RollingDisk => {
+            Errors::Rolling(rolling::RollingDisk::from_scene(scene).score(particles, t))
+        }
     }
 }

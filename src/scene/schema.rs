@@ -315,6 +315,9 @@ pub enum ExactKind {
     ElasticColumn,
     /// The manufactured 2D aligned vibration (set by `[manufactured]`).
     AlignedVibration,
+    /// A disk rolling without slip down a wall under constant gravity
+    /// (implicit-MPM paper §5.2): a = (2/3) g_t.
+    RollingDisk,
 }
 
 /// Manufactured solutions known to the code.
