@@ -640,7 +640,7 @@ fn check_rolling_disk(file: &SceneFile) -> Result<(), SceneError> {
             file.walls.len()
         ));
     }
-    if file.walls.values().any(|w| w.contact == WallContact::Slip) {
+    if file.walls.values().any(|w| w.contact == Contact::Slip) {
         return bad("needs a `stick` or `friction` wall: a disk on a slip wall slides");
     }
     let Some(g) = file.gravity.as_ref() else {
