@@ -44,13 +44,25 @@ pub fn standard_cases() -> Vec<Case> {
 }
 
 /// Extra cases: LME with weights stored per slot on the GPU (the
-/// alternative to recomputing them from λ in each pass), and the B-splines
-/// with and without MLS reconstruction.
+/// alternative to recomputing them from λ in each pass), elastoplastic LME
+/// (Mohr–Coulomb), and the B-splines with and without MLS reconstruction.
 pub fn extra_cases() -> Vec<Case> {
     let mut stored = Case::new("lme-g3-stored", &["solver.shape=lme", "solver.lme_gamma=3"]);
     stored.gpu.lme_stored = true;
     vec![
         stored,
+        // Elastoplastic LME: the square's impact stresses (about 50 kPa)
+        // exceed this Mohr–Coulomb strength, so the return mapping runs.
+        Case::new(
+            "lme-g3-mohr-coulomb",
+            &[
+                "solver.shape=lme",
+                "solver.lme_gamma=3",
+                "materials.m.model=mohr_coulomb",
+                "materials.m.cohesion=1e4",
+                "materials.m.friction_angle=30",
+            ],
+        ),
         Case::new("bspline2", &["solver.shape=bspline2"]),
         Case::new("bspline3", &["solver.shape=bspline3"]),
         Case::new(

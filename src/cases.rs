@@ -5,6 +5,9 @@ pub const DYKA_BAR: &str = include_str!("../cases/dyka_bar.toml");
 pub const ELASTIC_BLOCK: &str = include_str!("../cases/elastic_block.toml");
 pub const PLATE_IMPACT: &str = include_str!("../cases/plate_impact.toml");
 pub const ALIGNED_VIBRATION: &str = include_str!("../cases/aligned_vibration.toml");
+pub const ROLLING_DISK: &str = include_str!("../cases/rolling_disk.toml");
+pub const COLUMN_COLLAPSE: &str = include_str!("../cases/column_collapse.toml");
+pub const GRANULAR_COLLAPSE: &str = include_str!("../cases/granular_collapse.toml");
 
 /// Dyka's bar length (m), as in `cases/dyka_bar.toml`.
 pub const DYKA_L: f64 = 0.1333;

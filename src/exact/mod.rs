@@ -5,6 +5,7 @@ pub mod column;
 pub mod dyka;
 pub mod mms;
 pub mod sliding;
+pub mod rolling;
 
 use crate::model::{Model, Particles};
 use crate::scene::{ExactKind, Scene};
@@ -18,6 +19,7 @@ pub enum Errors {
     Column(column::ColumnErrors),
     Mms(mms::MmsErrors),
     Sliding(sliding::SlidingErrors),
+    Rolling(rolling::RollingErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact solution.
@@ -41,5 +43,8 @@ pub fn score(
             particles,
             t,
         )),
+        ExactKind::RollingDisk => {
+            Errors::Rolling(rolling::RollingDisk::from_scene(scene).score(particles, t))
+        }
     }
 }

@@ -388,6 +388,9 @@ pub enum ExactKind {
     /// A block sliding from rest on one frictional (or slip) wall under
     /// gravity: v = max(g_t − μ g_n, 0) t along the wall.
     SlidingBlock,
+    /// A disk rolling without slip down a wall under constant gravity
+    /// (implicit-MPM paper §5.2): a = (2/3) g_t.
+    RollingDisk,
 }
 
 /// Manufactured solutions known to the code.

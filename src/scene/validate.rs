@@ -662,6 +662,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ExactKind::ElasticColumn => "elastic_column",
         ExactKind::AlignedVibration => return Ok(()),
         ExactKind::SlidingBlock => return check_sliding_block(file),
+        ExactKind::RollingDisk => return check_rolling_disk(file),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -693,7 +694,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ));
     }
     match kind {
-        ExactKind::AlignedVibration | ExactKind::SlidingBlock => {}
+        ExactKind::AlignedVibration | ExactKind::SlidingBlock | ExactKind::RollingDisk => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(
@@ -750,6 +751,45 @@ fn check_sliding_block(file: &SceneFile) -> Result<(), SceneError> {
     }
     if !(file.constraints.is_empty() && file.tractions.is_empty() && file.point_loads.is_empty()) {
         return fail("no constraints, tractions or point loads (gravity and the wall only)");
+    }
+    Ok(())
+}
+
+/// `exact = "rolling_disk"`: one body made of one disk, at rest, one wall,
+/// constant gravity with a component along the wall.
+fn check_rolling_disk(file: &SceneFile) -> Result<(), SceneError> {
+    let bad = |msg: &str| Err(SceneError::invalid("exact", format!("= \"rolling_disk\" {msg}")));
+    let one_disk = file.bodies.len() == 1
+        && file
+            .bodies
+            .values()
+            .all(|b| b.disks.len() == 1 && b.rects.is_empty() && b.polygons.is_empty());
+    if !one_disk {
+        return bad("needs one body made of one disk");
+    }
+    if file.bodies.values().any(|b| b.velocity != [0.0, 0.0]) {
+        return bad("needs the disk at rest");
+    }
+    if file.walls.len() != 1 {
+        return bad(&format!(
+            "needs exactly one wall (the plane), the scene has {}",
+            file.walls.len()
+        ));
+    }
+    if file.walls.values().any(|w| w.contact == Contact::Slip) {
+        return bad("needs a `stick` or `friction` wall: a disk on a slip wall slides");
+    }
+    let Some(g) = file.gravity.as_ref() else {
+        return bad("needs gravity");
+    };
+    if g.ramp != crate::scene::schema::Ramp::None {
+        return bad("needs constant gravity (ramp = \"none\")");
+    }
+    let w = file.walls.values().next().expect("one wall");
+    let nn = w.normal[0].hypot(w.normal[1]);
+    let along = (g.g[0] * w.normal[1] - g.g[1] * w.normal[0]).abs() / nn.max(f64::MIN_POSITIVE);
+    if along <= 1e-12 * g.g[0].hypot(g.g[1]) {
+        return bad("needs gravity with a component along the wall");
     }
     Ok(())
 }

@@ -1,0 +1,323 @@
+//! Study `column`: the cohesive soil column collapse (implicit-MPM paper
+//! §5.3) with linear, uGIMP, LME γ = 1.8 and quadratic B-splines on both of
+//! the paper's meshes (h = 0.05 and 0.025 m), profiles at 0.60, 0.88, 1.28
+//! and 2.0 s, run-out and final height with their change between meshes;
+//! and the cohesionless variant against the experimental run-out scaling of
+//! 2D granular collapses, (L_f − L_0)/L_0 ≈ 1.2 H/W (Lajeunesse et al.
+//! 2005; Lube et al. 2005).
+
+use super::runner::{Job, JobResult};
+use super::{backend_slug, image, sig, table};
+use crate::cases::{COLUMN_COLLAPSE, GRANULAR_COLLAPSE};
+use crate::chart::{LineChart, Series};
+use crate::error::Result;
+use crate::model::Particles;
+use crate::simulation::BackendChoice;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// (label, shape, γ) of each method.
+pub const METHODS: [(&str, &str, f64); 4] = [
+    ("linear", "linear", 0.0),
+    ("ugimp", "ugimp", 0.0),
+    ("lme-g1.8", "lme", 1.8),
+    ("bspline2", "bspline2", 0.0),
+];
+
+/// The paper's output times (s).
+pub const TIMES: [f64; 4] = [0.60, 0.88, 1.28, 2.0];
+
+/// The paper's meshes (m).
+pub const MESHES: [f64; 2] = [0.05, 0.025];
+
+/// Cohesive column: width and height (m), from `cases/column_collapse.toml`.
+pub const COLUMN: (f64, f64) = (2.0, 4.0);
+/// Cohesionless column: width and height (m), from `cases/granular_collapse.toml`.
+pub const GRANULAR: (f64, f64) = (1.0, 2.0);
+
+/// Particles per cell per direction in both cases.
+const PPC: f64 = 2.0;
+
+pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
+    let mut out = Vec::new();
+    // The quick sweep: mesh 1 only, up to the first output time.
+    let meshes: &[f64] = if quick { &MESHES[..1] } else { &MESHES };
+    let times: Vec<f64> = if quick {
+        TIMES[..1].to_vec()
+    } else {
+        TIMES.to_vec()
+    };
+    for &b in backends {
+        for &h in meshes {
+            for (label, shape, gamma) in METHODS {
+                let mut j = Job::new(
+                    format!("{}-cohesive-{label}-h{h}", backend_slug(b)),
+                    COLUMN_COLLAPSE,
+                    "column_collapse",
+                )
+                .set(format!("grid.h={h}"))
+                .set(format!("solver.shape={shape}"))
+                .set("output.vtk_interval=1e9")
+                .tag("backend", backend_slug(b))
+                .tag("case", "cohesive")
+                .tag("method", label)
+                .tag("h", h);
+                if gamma > 0.0 {
+                    j = j.set(format!("solver.lme_gamma={gamma}"));
+                }
+                if quick {
+                    j = j.set(format!("solver.t_end={}", times[times.len() - 1]));
+                }
+                j.snapshot_times = times.clone();
+                j.keep_final = true;
+                j.backend = b;
+                out.push(j);
+            }
+        }
+        if quick {
+            continue;
+        }
+        for (label, shape, gamma) in METHODS {
+            let mut j = Job::new(
+                format!("{}-granular-{label}", backend_slug(b)),
+                GRANULAR_COLLAPSE,
+                "granular_collapse",
+            )
+            .set(format!("solver.shape={shape}"))
+            .set("output.vtk_interval=1e9")
+            .tag("backend", backend_slug(b))
+            .tag("case", "granular")
+            .tag("method", label)
+            .tag("h", 0.025);
+            if gamma > 0.0 {
+                j = j.set(format!("solver.lme_gamma={gamma}"));
+            }
+            j.keep_final = true;
+            j.backend = b;
+            out.push(j);
+        }
+    }
+    out
+}
+
+/// Half the particle spacing at cell size `h`: a particle's extent beyond
+/// its centre.
+fn half_spacing(h: f64) -> f64 {
+    0.5 * h / PPC
+}
+
+/// Run-out: the largest x reached by the material (particle centre plus
+/// half a spacing), m.
+pub fn run_out(p: &Particles, h: f64) -> f64 {
+    p.x.iter().map(|x| x[0]).fold(f64::NEG_INFINITY, f64::max) + half_spacing(h)
+}
+
+/// Height: the largest y of the material, m.
+pub fn height(p: &Particles, h: f64) -> f64 {
+    p.x.iter().map(|x| x[1]).fold(f64::NEG_INFINITY, f64::max) + half_spacing(h)
+}
+
+/// Free-surface profile: per column of width h from x = 0, the top of the
+/// highest particle in it (m); columns without particles end the profile
+/// at the run-out.
+pub fn profile(p: &Particles, h: f64) -> Vec<(f64, f64)> {
+    let reach = run_out(p, h);
+    let n = (reach / h).ceil().max(1.0) as usize;
+    let mut top = vec![f64::NEG_INFINITY; n];
+    for x in &p.x {
+        let k = ((x[0] / h).floor().max(0.0) as usize).min(n - 1);
+        top[k] = top[k].max(x[1] + half_spacing(h));
+    }
+    let mut pts: Vec<(f64, f64)> = top
+        .iter()
+        .enumerate()
+        .filter(|(_, y)| y.is_finite())
+        .map(|(k, y)| ((k as f64 + 0.5) * h, *y))
+        .collect();
+    pts.insert(0, (0.0, pts.first().map_or(0.0, |p| p.1)));
+    pts.push((reach, 0.0));
+    pts
+}
+
+/// The snapshot nearest to `t`.
+fn at(r: &JobResult, t: f64) -> Option<&Particles> {
+    let d = r.data()?;
+    d.snapshots
+        .iter()
+        .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+        .filter(|(ts, _)| (ts - t).abs() < 1e-6 + 1e-3 * t)
+        .map(|(_, p)| p)
+}
+
+pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
+    let main = results
+        .first()
+        .and_then(|r| r.job.tag_value("backend"))
+        .unwrap_or("cpu")
+        .to_string();
+    let mine = |case: &str| -> Vec<&JobResult> {
+        results
+            .iter()
+            .filter(|r| {
+                r.job.tag_value("backend") == Some(main.as_str())
+                    && r.job.tag_value("case") == Some(case)
+            })
+            .collect()
+    };
+    let cohesive = mine("cohesive");
+    let granular = mine("granular");
+    let get = |m: &str, h: f64| {
+        cohesive.iter().copied().find(|r| {
+            r.job.tag_value("method") == Some(m)
+                && r.job.tag_value("h") == Some(h.to_string().as_str())
+        })
+    };
+    let meshes: &[f64] = if quick { &MESHES[..1] } else { &MESHES };
+    let times: &[f64] = if quick { &TIMES[..1] } else { &TIMES };
+    let mut charts = Vec::new();
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "A Mohr–Coulomb column (c = 5 kPa, φ = 25°, ψ = 0, K = 1.5 MPa with ν = 0.366, ρ = 1850 kg/m³), \
+         {} m wide and {} m high against a smooth (`slip`) wall on a rough (`stick`) floor, collapses under \
+         gravity applied at t = 0 (`cases/column_collapse.toml`; geometry read from the paper's Fig. 9). \
+         2 × 2 particles per cell, NPC, CFL 0.3, on the paper's two meshes (h = 0.05 and 0.025 m). The \
+         paper compares its implicit MPM and GMM with the SPH of Bui et al. (2008) by pictures only, so \
+         there is no exact figure: the table gives run-out and final height and how much they move \
+         between meshes.\n",
+        COLUMN.0, COLUMN.1
+    );
+
+    // --- profiles, one chart per time -----------------------------------------
+    for &t in times {
+        let stem = format!("study-column-profile-t{t:.2}");
+        let mut c = LineChart::new(
+            format!("Column collapse ({main}): free surface at t = {t:.2} s"),
+            "x (m)",
+            "y (m)",
+        );
+        for (k, (m, ..)) in METHODS.iter().enumerate() {
+            for (mi, &h) in meshes.iter().enumerate() {
+                let Some(p) = get(m, h).and_then(|r| at(r, t)) else {
+                    continue;
+                };
+                let s = Series::line(format!("{m}, h = {h}"), profile(p, h), k);
+                c.series.push(if mi == 0 { s.dashed() } else { s });
+            }
+        }
+        c.legend = plotters::prelude::SeriesLabelPosition::UpperRight;
+        c.size = (800, 440);
+        c.save(&dir.join(&stem))?;
+        charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
+        md.push_str(&image(
+            &format!("free surface at {t:.2} s"),
+            &format!("{stem}.png"),
+        ));
+    }
+    md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+
+    // --- run-out and height table ----------------------------------------------
+    let t_last = times[times.len() - 1];
+    let mut header: Vec<String> = vec!["method".into()];
+    for &h in meshes {
+        header.push(format!("h = {h}: status"));
+        header.push(format!("run-out at {t_last} s (m)"));
+        header.push(format!("height at {t_last} s (m)"));
+    }
+    if meshes.len() == 2 {
+        header.push("run-out change".into());
+        header.push("height change".into());
+    }
+    let mut rows = Vec::new();
+    for (m, ..) in METHODS {
+        let mut row = vec![m.to_string()];
+        let mut figs = Vec::new();
+        for &h in meshes {
+            match get(m, h) {
+                Some(r) if r.completed() => {
+                    let p = at(r, t_last);
+                    let (ro, ht) = p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
+                    row.extend(["completed".into(), sig(ro), sig(ht)]);
+                    figs.push((ro, ht));
+                }
+                Some(r) => row.extend([super::failure_text(r), "-".into(), "-".into()]),
+                None => row.extend(["-".into(), "-".into(), "-".into()]),
+            }
+        }
+        if meshes.len() == 2 {
+            if let [(r1, h1), (r2, h2)] = figs[..] {
+                row.push(format!("{:+.1} %", 100.0 * (r2 - r1) / r1));
+                row.push(format!("{:+.1} %", 100.0 * (h2 - h1) / h1));
+            } else {
+                row.extend(["-".into(), "-".into()]);
+            }
+        }
+        rows.push(row);
+    }
+    md.push_str(&table(&header, &rows));
+    md.push('\n');
+
+    // --- cohesionless variant ----------------------------------------------------
+    if !granular.is_empty() {
+        let (w, hgt) = GRANULAR;
+        let a = hgt / w;
+        let _ = writeln!(
+            md,
+            "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
+             sits at the apex), φ = 30°, a = H/W = {}, h = 0.025 m, t_end = 2 s. Experiments on 2D \
+             collapses give (L_f − L_0)/L_0 ≈ 1.2 a = {} for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. \
+             2005), with L_0 = W the initial length.\n",
+            sig(a),
+            sig(1.2 * a)
+        );
+        let header: Vec<String> = [
+            "method",
+            "status",
+            "L_f (m)",
+            "(L_f − L_0)/L_0",
+            "vs 1.2 a",
+            "final height (m)",
+            "kinetic energy at end / m g H",
+        ]
+        .map(String::from)
+        .to_vec();
+        let rows: Vec<Vec<String>> = granular
+            .iter()
+            .map(|r| {
+                let m = r.job.tag_value("method").unwrap_or("").to_string();
+                let p = r.data().and_then(|d| d.final_particles.as_ref());
+                match p {
+                    Some(p) if r.completed() => {
+                        let lf = run_out(p, 0.025);
+                        let ratio = (lf - w) / w;
+                        let mass: f64 = p.mass.iter().sum();
+                        let ke: f64 = (0..p.len())
+                            .map(|i| 0.5 * p.mass[i] * (p.v[i][0].powi(2) + p.v[i][1].powi(2)))
+                            .sum();
+                        vec![
+                            m,
+                            "completed".into(),
+                            sig(lf),
+                            sig(ratio),
+                            format!("{:+.0} %", 100.0 * (ratio / (1.2 * a) - 1.0)),
+                            sig(height(p, 0.025)),
+                            sig(ke / (mass * 9.81 * hgt)),
+                        ]
+                    }
+                    _ => vec![
+                        m,
+                        super::failure_text(r),
+                        "-".into(),
+                        "-".into(),
+                        "-".into(),
+                        "-".into(),
+                        "-".into(),
+                    ],
+                }
+            })
+            .collect();
+        md.push_str(&table(&header, &rows));
+        md.push('\n');
+    }
+    Ok((md, charts))
+}
