@@ -4,8 +4,8 @@
 pub mod column;
 pub mod dyka;
 pub mod mms;
-pub mod sliding;
 pub mod rolling;
+pub mod sliding;
 
 use crate::model::{Model, Particles};
 use crate::scene::{ExactKind, Scene};

@@ -758,7 +758,12 @@ fn check_sliding_block(file: &SceneFile) -> Result<(), SceneError> {
 /// `exact = "rolling_disk"`: one body made of one disk, at rest, one wall,
 /// constant gravity with a component along the wall.
 fn check_rolling_disk(file: &SceneFile) -> Result<(), SceneError> {
-    let bad = |msg: &str| Err(SceneError::invalid("exact", format!("= \"rolling_disk\" {msg}")));
+    let bad = |msg: &str| {
+        Err(SceneError::invalid(
+            "exact",
+            format!("= \"rolling_disk\" {msg}"),
+        ))
+    };
     let one_disk = file.bodies.len() == 1
         && file
             .bodies

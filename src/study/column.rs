@@ -236,7 +236,8 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             match get(m, h) {
                 Some(r) if r.completed() => {
                     let p = at(r, t_last);
-                    let (ro, ht) = p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
+                    let (ro, ht) =
+                        p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
                     row.extend(["completed".into(), sig(ro), sig(ht)]);
                     figs.push((ro, ht));
                 }
