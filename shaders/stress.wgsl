@@ -12,6 +12,9 @@
 #if DEF_GRAD
 @group(0) @binding({{B_DEF_GRAD}}) var<storage, read_write> def_grad: array<vec4<f32>>;
 #endif
+#if PLASTIC
+@group(0) @binding({{B_PLASTIC}}) var<storage, read_write> plastic: array<vec4<f32>>;
+#endif
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
@@ -64,8 +67,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #else
     let f = vec4<f32>(1.0, 0.0, 0.0, 1.0);
 #endif
+#if PLASTIC
+    let q = plastic[p];
+#else
+    let q = vec4<f32>(0.0);
+#endif
     let s0 = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
-    let up = material_update(material_of(p), l, dt, s0, f);
+    let up = material_update(material_of(p), l, dt, s0, f, q);
     if up.fault != 0u {
         report_fault(up.fault, p);
         return;
@@ -79,6 +87,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     rho[p] = rho_p;
 #if DEF_GRAD
     def_grad[p] = up.f;
+#endif
+#if PLASTIC
+    plastic[p] = up.q;
 #endif
     stress[3u * p] = s.x;
     stress[3u * p + 1u] = s.y;

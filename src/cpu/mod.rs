@@ -120,6 +120,9 @@ impl CpuBackend {
         if !p.f.is_empty() {
             per += 32.0;
         }
+        if !p.plastic.is_empty() {
+            per += 32.0;
+        }
         if model.mls {
             // Sort order and cells per particle, the Gauss points' share.
             let slots = model.shape.max_nodes() as f64;
@@ -229,6 +232,7 @@ impl CpuBackend {
             &mut p.stress,
             &mut p.rho,
             &mut p.f,
+            &mut p.plastic,
             &mut self.force,
             &mut self.force_scatter,
         )
@@ -276,6 +280,7 @@ impl CpuBackend {
                 &mut p.stress,
                 &mut p.rho,
                 &mut p.f,
+                &mut p.plastic,
             )?,
             Stage::Forces => {
                 // The stress is already at the step's end (t + Δt), so are the loads.

@@ -1,13 +1,20 @@
 //! Materials: one enum, one `update`. Each model in its own file with a
 //! WGSL twin in `shaders/shared/material_*.wgsl`. A model stores only the
 //! per-particle state it needs (linear elastic: the stress alone;
-//! Neo-Hookean: the deformation gradient too).
+//! Neo-Hookean: the deformation gradient too; Mohr–Coulomb and
+//! Drucker–Prager: σzz and the plastic strains, `plastic::PlasticState`).
 
+pub mod drucker_prager;
 pub mod linear_elastic;
+pub mod mohr_coulomb;
 pub mod neo_hookean;
+pub mod plastic;
 
+pub use drucker_prager::DruckerPrager;
 pub use linear_elastic::LinearElastic;
+pub use mohr_coulomb::MohrCoulomb;
 pub use neo_hookean::{DefGrad, NeoHookean};
+pub use plastic::PlasticState;
 
 use crate::model::fault::FaultKind;
 use crate::scene::{MaterialModel, MaterialSpec};
@@ -16,7 +23,13 @@ use crate::scene::{MaterialModel, MaterialSpec};
 pub enum Material {
     LinearElastic(LinearElastic),
     NeoHookean(NeoHookean),
+    MohrCoulomb(MohrCoulomb),
+    DruckerPrager(DruckerPrager),
 }
+
+/// The tangent a later implicit solver asks of a material: dσ/dε in Voigt
+/// form [xx, yy, xy] (engineering shear), plane strain (Pa).
+pub type Tangent = [[f64; 3]; 3];
 
 impl Material {
     pub fn new(spec: &MaterialSpec) -> Material {
@@ -24,6 +37,33 @@ impl Material {
         match spec.model {
             MaterialModel::LinearElastic => Material::LinearElastic(LinearElastic::new(e, nu, rho)),
             MaterialModel::NeoHookean => Material::NeoHookean(NeoHookean::new(e, nu, rho)),
+            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
+                // Validation has made the two required keys present.
+                let c = spec.cohesion.unwrap_or(0.0);
+                let phi = spec.friction_angle.unwrap_or(0.0);
+                let psi = spec.dilation_angle.unwrap_or(0.0);
+                if spec.model == MaterialModel::MohrCoulomb {
+                    Material::MohrCoulomb(MohrCoulomb::new(
+                        e,
+                        nu,
+                        rho,
+                        c,
+                        phi,
+                        psi,
+                        spec.tension_cutoff,
+                    ))
+                } else {
+                    Material::DruckerPrager(DruckerPrager::new(
+                        e,
+                        nu,
+                        rho,
+                        c,
+                        phi,
+                        psi,
+                        spec.tension_cutoff,
+                    ))
+                }
+            }
         }
     }
 
@@ -32,6 +72,8 @@ impl Material {
         match self {
             Material::LinearElastic(m) => m.density,
             Material::NeoHookean(m) => m.density,
+            Material::MohrCoulomb(m) => m.density,
+            Material::DruckerPrager(m) => m.density,
         }
     }
 
@@ -40,6 +82,18 @@ impl Material {
         match self {
             Material::LinearElastic(m) => (m.lame, m.shear),
             Material::NeoHookean(m) => (m.lame, m.shear),
+            Material::MohrCoulomb(m) => (m.elastic.lame, m.elastic.shear),
+            Material::DruckerPrager(m) => (m.elastic.lame, m.elastic.shear),
+        }
+    }
+
+    /// Young's modulus E (Pa) and Poisson's ratio ν.
+    pub fn youngs_nu(&self) -> (f64, f64) {
+        match self {
+            Material::LinearElastic(m) => (m.youngs, m.nu),
+            Material::NeoHookean(m) => (m.youngs, m.nu),
+            Material::MohrCoulomb(m) => (m.youngs, m.nu),
+            Material::DruckerPrager(m) => (m.youngs, m.nu),
         }
     }
 
@@ -48,9 +102,15 @@ impl Material {
         matches!(self, Material::NeoHookean(_))
     }
 
+    /// The model keeps a `PlasticState` (σzz, plastic strains) per particle.
+    pub fn needs_plastic_state(&self) -> bool {
+        matches!(self, Material::MohrCoulomb(_) | Material::DruckerPrager(_))
+    }
+
     /// One step of the constitutive update from the velocity gradient
     /// `l` = [∂vx/∂x, ∂vx/∂y, ∂vy/∂x, ∂vy/∂y] (1/s) over `dt` (s): updates the
-    /// stress (and F), and returns the volume ratio V_new / V_old.
+    /// stress (and F, or the plastic state `q`), and returns the volume
+    /// ratio V_new / V_old. Models ignore the state they do not keep.
     #[inline]
     pub fn update(
         &self,
@@ -58,8 +118,11 @@ impl Material {
         dt: f64,
         stress: &mut [f64; 3],
         f: &mut DefGrad,
+        q: &mut PlasticState,
     ) -> Result<f64, FaultKind> {
         match self {
+            Material::MohrCoulomb(m) => m.update(l, dt, stress, q),
+            Material::DruckerPrager(m) => m.update(l, dt, stress, q),
             Material::LinearElastic(m) => {
                 let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
                 let j = 1.0 + de[0] + de[1];
@@ -102,16 +165,45 @@ impl Material {
         match self {
             Material::LinearElastic(m) => m.wave_speed(rho),
             Material::NeoHookean(m) => m.wave_speed(rho),
+            // The elastic P-wave speed bounds the elastoplastic one.
+            Material::MohrCoulomb(m) => {
+                ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt()
+            }
+            Material::DruckerPrager(m) => {
+                ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt()
+            }
         }
     }
 
     /// Stored elastic energy per unit current volume (J/m³), from the
-    /// stress (linear elastic) or the deformation gradient (Neo-Hookean).
+    /// stress (linear elastic), the deformation gradient (Neo-Hookean), or
+    /// for the plastic models the elastic part: ½ σ : C : σ on the current
+    /// stress with its σzz (`q`).
     #[inline]
-    pub fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad) -> f64 {
+    pub fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64 {
+        let s4 = [stress[0], stress[1], q[plastic::SZZ], stress[2]];
         match self {
             Material::LinearElastic(m) => m.strain_energy_density(stress),
             Material::NeoHookean(m) => m.energy_density(f),
+            Material::MohrCoulomb(m) => m.elastic.energy(s4),
+            Material::DruckerPrager(m) => m.elastic.energy(s4),
+        }
+    }
+
+    /// Hook for the implicit solver (a later issue): the tangent dσ/dε of
+    /// the last `update` at this particle's state. Linear elastic gives its
+    /// plane-strain D; the others return `None` until their consistent
+    /// (algorithmic) tangents are written: for the plastic models it
+    /// follows from the return recorded in `q[plastic::RETURN]` (the active
+    /// surfaces) and de Souza Neto et al. box 8.4 (MC) / §8.3.3 (DP);
+    /// Neo-Hookean's from ∂σ/∂F at `f`.
+    pub fn tangent(&self, _stress: &[f64; 3], _f: &DefGrad, _q: &PlasticState) -> Option<Tangent> {
+        match self {
+            Material::LinearElastic(m) => {
+                let (l, g) = (m.lame, m.shear);
+                Some([[l + 2.0 * g, l, 0.0], [l, l + 2.0 * g, 0.0], [0.0, 0.0, g]])
+            }
+            _ => None,
         }
     }
 }
