@@ -151,3 +151,112 @@ pub fn p_sqrt_j2(s: [f64; 4]) -> (f64, f64) {
     let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + s[3] * s[3];
     (p, j2.sqrt())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::material::plastic::{EPS_EQ, EPS_VOL, RETURN};
+
+    /// E = 20 MPa, ν = 0.3, c = 10 kPa, φ = 30°: α = 0.1601, k = 8321.5 Pa.
+    fn dp(psi: f64, t: Option<f64>) -> DruckerPrager {
+        DruckerPrager::new(2.0e7, 0.3, 1800.0, 1.0e4, 30.0, psi, t)
+    }
+
+    /// |f| ≤ this · max(c, |p|) on a returned stress (f64 round-off).
+    const ON_SURFACE: f64 = 1e-8;
+
+    #[test]
+    fn matching_and_elastic_states() {
+        let m = dp(0.0, None);
+        // tan 30° = 0.57735: sqrt(9 + 12/3) = sqrt(13).
+        assert!((m.alpha - 0.577_350_269 / 13f64.sqrt()).abs() < 1e-9);
+        assert!((m.k - 3.0e4 / 13f64.sqrt()).abs() < 1e-6);
+        // The apex is Mohr–Coulomb's, c / tan φ.
+        assert!((m.tension.unwrap() - 1.0e4 * 3f64.sqrt()).abs() < 1e-6);
+        let t = [-2.0e4, -3.0e4, -2.5e4, 1.0e3];
+        assert!(m.yield_cone(t) < 0.0);
+        assert_eq!(m.return_stress(t), (t, 0));
+    }
+
+    #[test]
+    fn cone_cap_and_apex_returns() {
+        let m = dp(0.0, None);
+        // Cone, ψ = 0: p kept, sqrt J2 = k − 3αp, direction of s kept.
+        let t = [0.0, -1.0e5, -5.0e4, 2.0e4];
+        let (s, active) = m.return_stress(t);
+        assert_eq!(active, ACTIVE_MAIN);
+        let (p0, _) = p_sqrt_j2(t);
+        let (p1, j1) = p_sqrt_j2(s);
+        assert!((p1 - p0).abs() < 1e-9 && (j1 - (m.k - 3.0 * m.alpha * p1)).abs() < 1e-8);
+        // Golden value: p = −50 kPa, sqrt J2 = k + 3α·5e4 = 8320.50 + 24019.23.
+        assert!((j1 - 32_339.73).abs() < 0.01, "{j1}");
+        assert!(m.yield_cone(s).abs() < ON_SURFACE * 5.0e4);
+        // Past the apex (tension, a little deviatoric): the apex, where
+        // the cap at its default t = k / (3α) meets the cone.
+        let apex = m.k / (3.0 * m.alpha);
+        let (s, active) = m.return_stress([3.0e4, 3.1e4, 2.9e4, 0.0]);
+        assert_eq!(active, ACTIVE_MAIN | ACTIVE_T1);
+        assert!(s[..3].iter().all(|x| (x - apex).abs() < 1e-9 * apex) && s[3] == 0.0);
+        // A cap below the apex: p returns to t, s kept.
+        let m = dp(0.0, Some(2.0e3));
+        let t = [4.0e3, 2.0e3, 3.0e3, 500.0];
+        let (s, active) = m.return_stress(t);
+        assert_eq!(active, ACTIVE_T1);
+        assert!((s[0] - 3.0e3).abs() < 1e-9 && (s[1] - 1.0e3).abs() < 1e-9 && s[3] == 500.0);
+    }
+
+    #[test]
+    fn every_return_lands_on_the_surface() {
+        let mut seed = 777u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let models = [dp(0.0, None), dp(30.0, None), dp(10.0, Some(5.0e3))];
+        let mut seen = [false; 4];
+        for m in &models {
+            for k in 0..4000 {
+                // Every other trial near the hydrostatic axis (the cap's region).
+                let d = if k % 2 == 0 { 1.0 } else { 0.05 };
+                let p = rnd() * 1e5;
+                let t = [
+                    p + d * rnd() * 1e5,
+                    p + d * rnd() * 1e5,
+                    p + d * rnd() * 1e5,
+                    d * rnd() * 3e4,
+                ];
+                let (s, active) = m.return_stress(t);
+                seen[(active & 1 | (active >> 2) & 2) as usize] = true;
+                let p = ((t[0] + t[1] + t[2]) / 3.0).abs();
+                let tol = ON_SURFACE * m.cohesion.max(p);
+                let cap = m.tension.unwrap();
+                let (ps, _) = p_sqrt_j2(s);
+                assert!(m.yield_cone(s) <= tol && ps <= cap + tol, "{t:?} -> {s:?}");
+                if active != 0 {
+                    assert!(m.yield_cone(s).max(ps - cap) >= -tol, "{t:?} -> {s:?}");
+                }
+            }
+        }
+        assert_eq!(seen, [true; 4], "elastic, cone, cap, corner");
+    }
+
+    #[test]
+    fn plastic_strain_follows_the_flow_rule() {
+        let step = |m: &DruckerPrager| {
+            let mut s = [-1.0e5, -1.0e5, 0.0];
+            let mut q = [-1.0e5, 0.0, 0.0, 0.0];
+            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q).unwrap();
+            q
+        };
+        let q = step(&dp(0.0, None));
+        assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
+        assert!(q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ], "{q:?}");
+        // ψ = φ: Δεp = Δγ (s / (2 sqrt J2) + ᾱ I): εp_v / ε̄p = 3ᾱ / sqrt(2/3 (1/2 + 3ᾱ²)).
+        let m = dp(30.0, None);
+        let q = step(&m);
+        assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
+        let a = m.alpha_psi;
+        let want = 3.0 * a / (2.0 / 3.0 * (0.5 + 3.0 * a * a)).sqrt();
+        assert!((q[EPS_VOL] / q[EPS_EQ] - want).abs() < 1e-9, "{q:?} {want}");
+    }
+}

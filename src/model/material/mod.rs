@@ -207,3 +207,101 @@ impl Material {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Drained biaxial compression in plane strain: the lateral stress held
+    /// at −σc (solved each step by the secant method on ∂vx/∂x), the axial
+    /// strain rate fixed, many small steps of `Material::update`. Returns
+    /// the largest deviator (σc − σ_axial, compression positive) reached.
+    fn biaxial_peak(m: &Material, sigma_c: f64, steps: usize, dt: f64) -> f64 {
+        let mut s = [-sigma_c, -sigma_c, 0.0];
+        let mut f = [1.0, 0.0, 0.0, 1.0];
+        let mut q = [-sigma_c, 0.0, 0.0, 0.0];
+        let lyy = -1.0; // 1/s: Δεyy = −dt per step.
+        let (lame, shear) = m.lame_shear();
+        let mut peak: f64 = 0.0;
+        for _ in 0..steps {
+            let trial = |lxx: f64| {
+                let (mut s1, mut f1, mut q1) = (s, f, q);
+                m.update([lxx, 0.0, 0.0, lyy], dt, &mut s1, &mut f1, &mut q1)
+                    .unwrap();
+                (s1, f1, q1)
+            };
+            let r = |lxx: f64| trial(lxx).0[0] + sigma_c;
+            let mut a = -lame * lyy / (lame + 2.0 * shear);
+            let mut b = a * 1.01 + 1e-3;
+            let (mut ra, mut rb) = (r(a), r(b));
+            for _ in 0..60 {
+                if rb.abs() < 1e-9 * sigma_c || rb == ra {
+                    break;
+                }
+                let c = b - rb * (b - a) / (rb - ra);
+                (a, ra) = (b, rb);
+                (b, rb) = (c, r(c));
+            }
+            assert!(rb.abs() < 1e-6 * sigma_c, "lateral stress not held: {rb}");
+            (s, f, q) = trial(b);
+            peak = peak.max(-s[1] - sigma_c);
+        }
+        peak
+    }
+
+    fn spec(model: MaterialModel, psi: f64) -> MaterialSpec {
+        MaterialSpec {
+            model,
+            density: 1800.0,
+            youngs_modulus: 2.0e7,
+            nu: 0.3,
+            cohesion: Some(1.0e4),
+            friction_angle: Some(30.0),
+            dilation_angle: Some(psi),
+            tension_cutoff: None,
+        }
+    }
+
+    /// Mohr–Coulomb's plane-strain peak: (σ1 − σ3) = 2c cos φ + (σ1 + σ3) sin φ
+    /// with compression positive, σ3 = σc: q = (2c cos φ + 2σc sin φ)/(1 − sin φ).
+    fn mc_peak(c: f64, phi_deg: f64, sigma_c: f64) -> f64 {
+        let (sp, cp) = phi_deg.to_radians().sin_cos();
+        (2.0 * c * cp + 2.0 * sigma_c * sp) / (1.0 - sp)
+    }
+
+    /// The biaxial peak within this fraction of Mohr–Coulomb's (issue 11).
+    const PEAK_REL: f64 = 5e-3;
+
+    #[test]
+    fn biaxial_test_reaches_the_mohr_coulomb_peak() {
+        for sigma_c in [5.0e4, 2.0e5] {
+            let want = mc_peak(1.0e4, 30.0, sigma_c);
+            for psi in [0.0, 15.0] {
+                let m = Material::new(&spec(MaterialModel::MohrCoulomb, psi));
+                // Δεyy = 1e-5 per step to 4 % axial strain.
+                let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
+                let err = (got - want) / want;
+                println!("MC σc = {sigma_c}, ψ = {psi}: peak {got:.2} vs {want:.2} ({err:+.2e})");
+                assert!(err.abs() < PEAK_REL, "MC σc = {sigma_c} ψ = {psi}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn biaxial_test_of_matched_drucker_prager() {
+        // The plane-strain match is exact at collapse with associated flow
+        // (plastic εzz rate zero): ψ = φ reaches MC's peak; ψ = 0 (szz = 0
+        // at collapse) stays below it.
+        let sigma_c = 1.0e5;
+        let want = mc_peak(1.0e4, 30.0, sigma_c);
+        let m = Material::new(&spec(MaterialModel::DruckerPrager, 30.0));
+        let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
+        let err = (got - want) / want;
+        println!("DP ψ = φ: peak {got:.2} vs MC {want:.2} ({err:+.2e})");
+        assert!(err.abs() < PEAK_REL, "{got} vs {want}");
+        let m = Material::new(&spec(MaterialModel::DruckerPrager, 0.0));
+        let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
+        println!("DP ψ = 0: peak {got:.2} vs MC {want:.2}");
+        assert!(got < want, "{got} vs {want}");
+    }
+}

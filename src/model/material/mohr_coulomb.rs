@@ -299,3 +299,178 @@ pub fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     }
     Some(x)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::material::plastic::{
+        ACTIVE_EDGE_12, ACTIVE_EDGE_23, ACTIVE_MAIN, ACTIVE_T1, EPS_EQ, EPS_VOL, RETURN,
+    };
+
+    /// E = 20 MPa, ν = 0.3, c = 10 kPa, φ = 30°: G = 7.6923 MPa,
+    /// K = 16.667 MPa, apex c / tan φ = 17320.5 Pa.
+    fn mc(psi: f64, t: Option<f64>) -> MohrCoulomb {
+        MohrCoulomb::new(2.0e7, 0.3, 1800.0, 1.0e4, 30.0, psi, t)
+    }
+
+    /// |f| ≤ this · max(c, |p|) on a returned stress: the return is exact
+    /// up to f64 round-off (~1e-15 of the stresses).
+    const ON_SURFACE: f64 = 1e-8;
+
+    fn violation(m: &MohrCoulomb, s: [f64; 3]) -> f64 {
+        let t = m.tension.map_or(f64::NEG_INFINITY, |t| s[0] - t);
+        m.yield_mc(s).max(t)
+    }
+
+    #[test]
+    fn elastic_states_are_untouched() {
+        let m = mc(0.0, None);
+        let v = [-1.0e4, -2.0e4, -3.0e4];
+        assert!(m.yield_mc(v) < 0.0);
+        assert_eq!(m.return_principal(v, RETURN_TOL_F64), (v, 0));
+        // Through `update`: the Jaumann trial itself, bit for bit.
+        let (l, dt) = ([0.01, 0.02, -0.005, -0.03], 1e-3);
+        let s0 = [-2.0e4, -2.5e4, 1.0e3];
+        let mut q = [-1.5e4, 0.0, 0.0, 0.0];
+        let mut s = s0;
+        let j = m.update(l, dt, &mut s, &mut q).unwrap();
+        let (t, tzz) = m.elastic.jaumann_trial(l, dt, &s0, -1.5e4);
+        assert_eq!(s, t);
+        assert_eq!(q, [tzz, 0.0, 0.0, 0.0]);
+        assert_eq!(j, 1.0 + dt * (l[0] + l[3]));
+    }
+
+    #[test]
+    fn main_plane_return_matches_the_closed_form() {
+        // de Souza Neto et al. box 8.1 (H = 0): Δγ = Φ / a with
+        // a = 4G(1 + sin φ sin ψ / 3) + 4K sin φ sin ψ, then
+        // σ1 −= (2G(1 + sin ψ/3) + 2K sin ψ) Δγ, σ2 += (4G/3 − 2K) sin ψ Δγ,
+        // σ3 += (2G(1 − sin ψ/3) − 2K sin ψ) Δγ.
+        for psi in [0.0, 10.0, 30.0] {
+            let m = mc(psi, None);
+            let (g, k) = (m.elastic.shear, m.elastic.bulk);
+            let (sf, sp) = (m.sin_phi, m.sin_psi);
+            let v = [0.0, -5.0e4, -1.0e5];
+            let phi = m.yield_mc(v);
+            let dg = phi / (4.0 * g * (1.0 + sf * sp / 3.0) + 4.0 * k * sf * sp);
+            let want = [
+                v[0] - (2.0 * g * (1.0 + sp / 3.0) + 2.0 * k * sp) * dg,
+                v[1] + (4.0 / 3.0 * g - 2.0 * k) * sp * dg,
+                v[2] + (2.0 * g * (1.0 - sp / 3.0) - 2.0 * k * sp) * dg,
+            ];
+            let (s, active) = m.return_principal(v, RETURN_TOL_F64);
+            assert_eq!(active, ACTIVE_MAIN, "ψ = {psi}");
+            for i in 0..3 {
+                assert!((s[i] - want[i]).abs() < 1e-9 * 1e5, "ψ = {psi}: {s:?} vs {want:?}");
+            }
+            assert!(m.yield_mc(s).abs() <= ON_SURFACE * 1e4, "{}", m.yield_mc(s));
+        }
+        // Golden values (ψ = 0): Φ = 32679.49 Pa, Δγ = Φ / 4G = 1.062083e-3,
+        // σ1 = −2GΔγ, σ3 = −1e5 + 2GΔγ, σ2 unchanged.
+        let (s, _) = mc(0.0, None).return_principal([0.0, -5.0e4, -1.0e5], RETURN_TOL_F64);
+        let golden = [-16_339.746, -50_000.0, -83_660.254];
+        for i in 0..3 {
+            assert!((s[i] - golden[i]).abs() < 1e-3, "{s:?}");
+        }
+    }
+
+    #[test]
+    fn edges_and_apex_are_reached_from_their_regions() {
+        let m = mc(0.0, None);
+        // σ1 = σ2: the main-plane return would put σ1 below σ2.
+        let (s, active) = m.return_principal([0.0, 0.0, -1.0e5], RETURN_TOL_F64);
+        assert_eq!(active, ACTIVE_MAIN | ACTIVE_EDGE_12, "{s:?}");
+        assert!((s[0] - s[1]).abs() < 1e-9 * 1e5 && m.yield_mc(s).abs() < ON_SURFACE * 1e5);
+        // σ2 = σ3: it would put σ3 above σ2.
+        let (s, active) = m.return_principal([0.0, -1.0e5, -1.0e5], RETURN_TOL_F64);
+        assert_eq!(active, ACTIVE_MAIN | ACTIVE_EDGE_23, "{s:?}");
+        assert!((s[1] - s[2]).abs() < 1e-9 * 1e5 && m.yield_mc(s).abs() < ON_SURFACE * 1e5);
+        // ψ = 0: the flow is deviatoric, so the mean stress is kept.
+        let p = (s[0] + s[1] + s[2]) / 3.0;
+        assert!((p + 200_000.0 / 3.0).abs() < 1e-6, "p = {p}");
+        // Hydrostatic tension past the apex: the apex.
+        let apex = 1.0e4 / 30f64.to_radians().tan();
+        let (s, active) = m.return_principal([3.0e4, 3.0e4, 3.0e4], RETURN_TOL_F64);
+        assert_eq!(active, ACTIVE_APEX, "{s:?}");
+        assert!(s.iter().all(|x| (x - apex).abs() < 1e-9 * apex), "{s:?}");
+        // Tension cutoff below the apex: σ1 returns to t alone, σ2, σ3
+        // follow by −λΔγ, Δγ = (σ1 − t)/(λ + 2G).
+        let m = mc(0.0, Some(5.0e3));
+        let v = [8.0e3, 0.0, -1.0e3];
+        assert!(m.yield_mc(v) < 0.0);
+        let (s, active) = m.return_principal(v, RETURN_TOL_F64);
+        assert_eq!(active, ACTIVE_T1);
+        let dg = 3.0e3 / (m.elastic.lame + 2.0 * m.elastic.shear);
+        let want = [5.0e3, -m.elastic.lame * dg, -1.0e3 - m.elastic.lame * dg];
+        for i in 0..3 {
+            assert!((s[i] - want[i]).abs() < 1e-9, "{s:?} vs {want:?}");
+        }
+    }
+
+    #[test]
+    fn every_return_lands_on_the_surface() {
+        // Pseudo-random trials over all regions (tension and compression,
+        // with and without a cutoff below the apex, φ = 0 included).
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let models = [
+            mc(0.0, None),
+            mc(30.0, None),
+            mc(10.0, Some(4.0e3)),
+            MohrCoulomb::new(2.0e7, 0.3, 1800.0, 1.0e4, 0.0, 0.0, None),
+            MohrCoulomb::new(2.0e7, 0.3, 1800.0, 1.0e4, 0.0, 0.0, Some(2.0e3)),
+            MohrCoulomb::new(2.0e7, 0.3, 1800.0, 0.0, 35.0, 5.0, None),
+        ];
+        let mut counts = std::collections::BTreeMap::new();
+        for m in &models {
+            for _ in 0..4000 {
+                let mut v = [rnd() * 1.0e5, rnd() * 1.0e5, rnd() * 1.0e5];
+                v.sort_by(|a, b| b.total_cmp(a));
+                let (s, active) = m.return_principal(v, RETURN_TOL_F64);
+                *counts.entry(active).or_insert(0) += 1;
+                let p = (v[0] + v[1] + v[2]).abs() / 3.0;
+                let tol = ON_SURFACE * m.cohesion.max(p);
+                assert!(violation(m, s) <= tol, "{m:?} {v:?} -> {s:?} ({active})");
+                assert!(s[0] >= s[1] - tol && s[1] >= s[2] - tol, "{v:?} -> {s:?}");
+                if active != 0 {
+                    // On the surface, not inside it.
+                    assert!(violation(m, s) >= -tol, "{v:?} -> {s:?} ({active})");
+                }
+            }
+        }
+        // Every kind of return occurred.
+        for mask in [0, 1, 3, 5, 8, 9, 24, ACTIVE_APEX] {
+            assert!(counts.contains_key(&mask), "no return {mask}: {counts:?}");
+        }
+    }
+
+    #[test]
+    fn plastic_strain_follows_the_flow_rule() {
+        // A large shear step (Δεxy = 5e-3) from an isotropic state at
+        // −100 kPa: trial σ1 = −23 kPa, σ3 = −177 kPa, σzz between.
+        let step = |m: &MohrCoulomb| {
+            let mut s = [-1.0e5, -1.0e5, 0.0];
+            let mut q = [-1.0e5, 0.0, 0.0, 0.0];
+            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q).unwrap();
+            q
+        };
+        // ψ = 0: no plastic volume change.
+        let q = step(&mc(0.0, None));
+        assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
+        assert!(q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ], "{q:?}");
+        // ψ = φ (associated): Δεp = Δγ (1 + sin φ, 0, −(1 − sin φ)), so
+        // εp_v / ε̄p = 2 sin φ / sqrt(4/3 (1 + sin² φ)): dilation.
+        let q = step(&mc(30.0, None));
+        assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
+        let s: f64 = 0.5;
+        let want = 2.0 * s / (4.0 / 3.0 * (1.0 + s * s)).sqrt();
+        assert!(
+            (q[EPS_VOL] / q[EPS_EQ] - want).abs() < 1e-9,
+            "{} vs {want}",
+            q[EPS_VOL] / q[EPS_EQ]
+        );
+    }
+}
