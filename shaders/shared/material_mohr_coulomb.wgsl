@@ -128,6 +128,20 @@ fn mc_return(m: Material, v: vec3<f32>) -> McReturn {
         for (var c = 0u; c < count; c++) {
             s -= dg[c] * dn[c];
         }
+        // One step of iterative refinement: the residual of the active
+        // surfaces at s, solved with the same M (f32 corners of three
+        // planes otherwise keep ~3e-5 of the scale).
+        var res = vec3<f32>(0.0);
+        for (var r = 0u; r < count; r++) {
+            res[r] = mc_f(mc_plane(m, idx[r]), s);
+        }
+        for (var c = 0u; c < count; c++) {
+            var mc = cols;
+            mc[c] = res;
+            let ddg = determinant(mat3x3<f32>(mc[0], mc[1], mc[2])) / det;
+            dg[c] += ddg;
+            s -= ddg * dn[c];
+        }
         var viol = max(s.y - s.x, s.z - s.y);
         for (var c = 0u; c < count; c++) {
             viol = max(viol, -dg[c] * 2.0 * m.shear);

@@ -205,6 +205,22 @@ impl MohrCoulomb {
                     s[k] -= dg[c] * dn[c][k];
                 }
             }
+            // One step of iterative refinement on the active surfaces (the
+            // WGSL twin needs it in f32; kept here so the two stay alike).
+            let mut res = [0.0; 3];
+            for r in 0..count {
+                res[r] = f(&planes[idx[r]], s);
+            }
+            let Some(ddg) = solve3(m, res) else {
+                continue;
+            };
+            let mut dg = dg;
+            for c in 0..count {
+                dg[c] += ddg[c];
+                for k in 0..3 {
+                    s[k] -= ddg[c] * dn[c][k];
+                }
+            }
             let mut viol = (s[1] - s[0]).max(s[2] - s[1]);
             for c in 0..count {
                 viol = viol.max(-dg[c] * 2.0 * self.elastic.shear);
