@@ -48,7 +48,8 @@ fn dyka_text() -> String {
 fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
     let dyka = common::case("dyka_bar.toml");
     let mms = common::case("aligned_vibration.toml");
-    let slump = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
+    let slump =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
     let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
         (
             "malformed toml",
@@ -227,13 +228,19 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
         (
             "plastic model without cohesion",
             dyka.clone(),
-            vec!["materials.steel.model=mohr_coulomb", "materials.steel.friction_angle=30"],
+            vec![
+                "materials.steel.model=mohr_coulomb",
+                "materials.steel.friction_angle=30",
+            ],
             "materials.steel.cohesion",
         ),
         (
             "plastic model without friction angle",
             dyka.clone(),
-            vec!["materials.steel.model=drucker_prager", "materials.steel.cohesion=1e6"],
+            vec![
+                "materials.steel.model=drucker_prager",
+                "materials.steel.cohesion=1e6",
+            ],
             "materials.steel.friction_angle",
         ),
         (

@@ -82,6 +82,10 @@ fn elastoplastic_lme_stays_under_the_memory_bound() {
     let (no_plastic, p) = bpp(&plastic);
     println!("LME elastic {e:.1}, Mohr–Coulomb {p:.1} bytes per particle");
     assert!(no_state && !no_plastic);
-    assert!((p - e - 16.0).abs() < 0.5, "the plastic state costs {} bytes", p - e);
+    assert!(
+        (p - e - 16.0).abs() < 0.5,
+        "the plastic state costs {} bytes",
+        p - e
+    );
     assert!(p <= MAX_BYTES_PER_PARTICLE, "{p} bytes per particle");
 }

@@ -83,10 +83,11 @@ fn variants() -> Vec<Variant> {
                                 (false, false, false, true),
                                 (true, true, true, true),
                             ] {
-                                let models = [linear_elastic, neo_hookean, mohr_coulomb, drucker_prager]
-                                    .iter()
-                                    .filter(|m| **m)
-                                    .count();
+                                let models =
+                                    [linear_elastic, neo_hookean, mohr_coulomb, drucker_prager]
+                                        .iter()
+                                        .filter(|m| **m)
+                                        .count();
                                 if models > 1 && !multi_material {
                                     continue;
                                 }
@@ -102,8 +103,7 @@ fn variants() -> Vec<Variant> {
                                                 | ShapeKind::Bspline2
                                                 | ShapeKind::Bspline3
                                         );
-                                    if (mls && !mls_ok)
-                                        || (mms && (!neo_hookean || multi_material))
+                                    if (mls && !mls_ok) || (mms && (!neo_hookean || multi_material))
                                     {
                                         continue;
                                     }

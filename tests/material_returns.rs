@@ -105,10 +105,10 @@ fn golden() -> Vec<(Case, u32)> {
         (trial(0, [0.0, -1.0e5, 0.0, 0.0]), 3), // σ1 = σ2 (xx = zz): edge 12
         (trial(0, [0.0, -1.0e5, -1.0e5, 0.0]), 5), // σ2 = σ3: edge 23
         (trial(0, [3.0e4, 3.0e4, 3.0e4, 0.0]), 56), // apex
-        (trial(1, [8.0e3, 0.0, -1.0e3, 0.0]), 8),  // σ1 past t = 4 kPa alone
-        (trial(2, [0.0, -3.0e4, -1.5e4, 0.0]), 1),  // Tresca
+        (trial(1, [8.0e3, 0.0, -1.0e3, 0.0]), 8), // σ1 past t = 4 kPa alone
+        (trial(2, [0.0, -3.0e4, -1.5e4, 0.0]), 1), // Tresca
         (trial(3, [0.0, -1.0e5, -5.0e4, 2.0e4]), 1), // DP cone
-        (trial(3, [3.0e4, 3.1e4, 2.9e4, 0.0]), 9),  // DP apex (cone and cap)
+        (trial(3, [3.0e4, 3.1e4, 2.9e4, 0.0]), 9), // DP apex (cone and cap)
         (trial(4, [7.0e3, 5.0e3, 6.0e3, 500.0]), 8), // DP cap alone
     ]
 }
@@ -174,8 +174,22 @@ fn gpu_run(
         .iter()
         .flat_map(|c| {
             [
-                c.l[0], c.l[1], c.l[2], c.l[3], c.s[0], c.s[1], c.s[2], c.dt, c.q[0], c.q[1],
-                c.q[2], c.q[3], c.mat as f64, 0.0, 0.0, 0.0,
+                c.l[0],
+                c.l[1],
+                c.l[2],
+                c.l[3],
+                c.s[0],
+                c.s[1],
+                c.s[2],
+                c.dt,
+                c.q[0],
+                c.q[1],
+                c.q[2],
+                c.q[3],
+                c.mat as f64,
+                0.0,
+                0.0,
+                0.0,
             ]
         })
         .map(|v| v as f32)
@@ -282,7 +296,11 @@ fn scale(m: &Material, c: &Case) -> f64 {
         Material::DruckerPrager(dp) => dp.cohesion,
         _ => 0.0,
     };
-    cohesion + c.s.iter().chain([&c.q[SZZ]]).fold(0.0f64, |a, v| a.max(v.abs()))
+    cohesion
+        + c.s
+            .iter()
+            .chain([&c.q[SZZ]])
+            .fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
 #[test]
@@ -346,8 +364,14 @@ fn plastic_returns_agree_on_both_twins() {
             // Plastic strains: the same within f32 (relative to ε̄p, or
             // to the elastic strain of the scale when tiny).
             let eps = STRESS_F32 * sc / 2.0e7;
-            assert!((gq[1] - q[1]).abs() <= 1e-3 * q[1].abs() + eps, "case {i}: ε̄p {gq:?} vs {q:?}");
-            assert!((gq[2] - q[2]).abs() <= 1e-3 * q[2].abs() + eps, "case {i}: εp_v {gq:?} vs {q:?}");
+            assert!(
+                (gq[1] - q[1]).abs() <= 1e-3 * q[1].abs() + eps,
+                "case {i}: ε̄p {gq:?} vs {q:?}"
+            );
+            assert!(
+                (gq[2] - q[2]).abs() <= 1e-3 * q[2].abs() + eps,
+                "case {i}: εp_v {gq:?} vs {q:?}"
+            );
         }
     }
     println!(
@@ -357,6 +381,13 @@ fn plastic_returns_agree_on_both_twins() {
     );
     // Near a boundary between regions f32 may pick the neighbouring return
     // (both then land on the surface, checked above); that is rare.
-    assert!(same_mask * 100 >= cases.len() * 99, "{same_mask} of {}", cases.len());
-    assert!(plastic * 2 >= cases.len(), "too few plastic cases: {plastic}");
+    assert!(
+        same_mask * 100 >= cases.len() * 99,
+        "{same_mask} of {}",
+        cases.len()
+    );
+    assert!(
+        plastic * 2 >= cases.len(),
+        "too few plastic cases: {plastic}"
+    );
 }

@@ -374,7 +374,11 @@ fn two_material_impact_gpu_matches_cpu() {
 fn plastic_slump_gpu_matches_cpu() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
-    for sets in [&[][..], &["materials.soil.model=drucker_prager"], &["solver.shape=lme"]] {
+    for sets in [
+        &[][..],
+        &["materials.soil.model=drucker_prager"],
+        &["solver.shape=lme"],
+    ] {
         let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
         let scene = Scene::load(&path, &o).unwrap();
         let Some((cpu, gpu)) = both_of("soil_slump", &scene, false) else {
@@ -412,9 +416,20 @@ fn plastic_slump_gpu_matches_cpu() {
             cp.len()
         );
         // Plasticity must have happened, or the comparison says nothing.
-        assert!(yc * 4 >= cp.len() && e_max > 1e-3, "{sets:?}: {yc} yielded, ε̄p ≤ {e_max}");
-        assert!(yc.abs_diff(yg) * 50 <= cp.len(), "{sets:?}: yielded {yc} vs {yg}");
-        for (what, err) in [("toe vx history", hv), ("velocity", f_rms), ("stress", s_rms), ("ε̄p", e_rms)] {
+        assert!(
+            yc * 4 >= cp.len() && e_max > 1e-3,
+            "{sets:?}: {yc} yielded, ε̄p ≤ {e_max}"
+        );
+        assert!(
+            yc.abs_diff(yg) * 50 <= cp.len(),
+            "{sets:?}: yielded {yc} vs {yg}"
+        );
+        for (what, err) in [
+            ("toe vx history", hv),
+            ("velocity", f_rms),
+            ("stress", s_rms),
+            ("ε̄p", e_rms),
+        ] {
             assert!(err < SLUMP_TOL, "{sets:?}: {what} differs by {err:.2e}");
         }
         check_energy(&format!("{sets:?}"), &cpu, &gpu, SLUMP_TOL);

@@ -327,16 +327,30 @@ fn check_plastic(
         tol,
     );
     for (k, what) in [(1, "stress: ε̄p change"), (2, "stress: εp_v change")] {
-        rep.check(what, rel_err(&col(gp, k), &col(cp, k), Some(&col(before, k))), tol);
+        rep.check(
+            what,
+            rel_err(&col(gp, k), &col(cp, k), Some(&col(before, k))),
+            tol,
+        );
     }
     let yielded = cp.plastic.iter().filter(|q| q[3] != 0.0).count();
     let same = (0..cp.len())
         .filter(|&i| gp.plastic[i][3] == cp.plastic[i][3])
         .count();
-    println!("  {label}: {yielded} of {} particles yielded, {same} with the same return", cp.len());
-    assert!(yielded * 4 >= cp.len(), "{label}: only {yielded} particles yielded");
+    println!(
+        "  {label}: {yielded} of {} particles yielded, {same} with the same return",
+        cp.len()
+    );
+    assert!(
+        yielded * 4 >= cp.len(),
+        "{label}: only {yielded} particles yielded"
+    );
     assert!(yielded < cp.len(), "{label}: no particle stayed elastic");
-    assert!(same * 100 >= cp.len() * 99, "{label}: {same} of {} same returns", cp.len());
+    assert!(
+        same * 100 >= cp.len() * 99,
+        "{label}: {same} of {} same returns",
+        cp.len()
+    );
 }
 
 /// max |a − b| / max |b| (or / max |b − base| when `base` is given).
@@ -778,7 +792,11 @@ fn stages_match_plastic() {
     for (label, model, shape) in [
         ("mohr-coulomb, linear npc", &mc[..], "solver.shape=linear"),
         ("mohr-coulomb, lme npc", &mc[..], "solver.shape=lme"),
-        ("drucker-prager, bspline2 npc", &dp[..], "solver.shape=bspline2"),
+        (
+            "drucker-prager, bspline2 npc",
+            &dp[..],
+            "solver.shape=bspline2",
+        ),
     ] {
         let mut sets = model.to_vec();
         sets.push(shape);

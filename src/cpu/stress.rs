@@ -17,10 +17,7 @@ use rayon::prelude::*;
 type Extra<'a> = (Option<&'a mut [f64; 4]>, Option<&'a mut PlasticState>);
 
 /// Per-particle `Option<&mut T>` over `v`, or `None` n times when `v` is empty.
-fn optional<T: Send>(
-    v: &mut [T],
-    n: usize,
-) -> impl IndexedParallelIterator<Item = Option<&mut T>> {
+fn optional<T: Send>(v: &mut [T], n: usize) -> impl IndexedParallelIterator<Item = Option<&mut T>> {
     if v.is_empty() {
         Either::Left((0..n).into_par_iter().map(|_| None))
     } else {
@@ -144,16 +141,17 @@ pub fn stress_forces(
 ) -> Result<(), Fault> {
     let n = mass.len();
     let len = Scatter::<2>::range_len(n);
-    let particle = |p: usize, s: &mut [f64; 3], r: &mut f64, extra: Extra<'_>, acc: &mut [[f64; 2]]| {
-        let material = &materials[body_material[body[p] as usize] as usize];
-        if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra) {
-            return Some(fault);
-        }
-        let g = body_force(p);
-        let m = mass[p];
-        add_particle_forces(cache, p, m / *r, *s, [m * g[0], m * g[1]], acc);
-        None
-    };
+    let particle =
+        |p: usize, s: &mut [f64; 3], r: &mut f64, extra: Extra<'_>, acc: &mut [[f64; 2]]| {
+            let material = &materials[body_material[body[p] as usize] as usize];
+            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra) {
+                return Some(fault);
+            }
+            let g = body_force(p);
+            let m = mass[p];
+            add_particle_forces(cache, p, m / *r, *s, [m * g[0], m * g[1]], acc);
+            None
+        };
     let ranges = (
         stress.par_chunks_mut(len),
         rho.par_chunks_mut(len),

@@ -170,13 +170,13 @@ impl Checkpoint {
             .all(|l| l == 0 || l == n);
         let fields_ok = optional_ok
             && [particles.v.len(), particles.mass.len(), particles.rho.len()]
-            .into_iter()
-            .chain([
-                particles.stress.len(),
-                particles.body.len(),
-                particles.x0.len(),
-            ])
-            .all(|l| l == n);
+                .into_iter()
+                .chain([
+                    particles.stress.len(),
+                    particles.body.len(),
+                    particles.x0.len(),
+                ])
+                .all(|l| l == n);
         if !fields_ok {
             return Err(bad("holds particle fields of different lengths"));
         }
@@ -313,7 +313,9 @@ mod tests {
             particles.rho.push(7833.0);
             particles.stress.push([1.0, 2.0, 3.0]);
             particles.f.push([1.0, 0.0, 0.0, 1.0]);
-            particles.plastic.push([-4.5e4, 0.0123 + i as f64, -1e-19, 5.0]);
+            particles
+                .plastic
+                .push([-4.5e4, 0.0123 + i as f64, -1e-19, 5.0]);
             particles.body.push(i);
         }
         Checkpoint {

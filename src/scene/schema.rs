@@ -79,7 +79,10 @@ pub enum MaterialModel {
 impl MaterialModel {
     /// The model has a yield surface (and the keys below).
     pub fn is_plastic(self) -> bool {
-        matches!(self, MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager)
+        matches!(
+            self,
+            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager
+        )
     }
 }
 

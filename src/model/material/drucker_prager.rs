@@ -209,7 +209,9 @@ mod tests {
     fn every_return_lands_on_the_surface() {
         let mut seed = 777u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         let models = [dp(0.0, None), dp(30.0, None), dp(10.0, Some(5.0e3))];
@@ -245,12 +247,16 @@ mod tests {
         let step = |m: &DruckerPrager| {
             let mut s = [-1.0e5, -1.0e5, 0.0];
             let mut q = [-1.0e5, 0.0, 0.0, 0.0];
-            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q).unwrap();
+            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q)
+                .unwrap();
             q
         };
         let q = step(&dp(0.0, None));
         assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
-        assert!(q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ], "{q:?}");
+        assert!(
+            q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ],
+            "{q:?}"
+        );
         // ψ = φ: Δεp = Δγ (s / (2 sqrt J2) + ᾱ I): εp_v / ε̄p = 3ᾱ / sqrt(2/3 (1/2 + 3ᾱ²)).
         let m = dp(30.0, None);
         let q = step(&m);

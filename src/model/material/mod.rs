@@ -166,12 +166,8 @@ impl Material {
             Material::LinearElastic(m) => m.wave_speed(rho),
             Material::NeoHookean(m) => m.wave_speed(rho),
             // The elastic P-wave speed bounds the elastoplastic one.
-            Material::MohrCoulomb(m) => {
-                ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt()
-            }
-            Material::DruckerPrager(m) => {
-                ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt()
-            }
+            Material::MohrCoulomb(m) => ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt(),
+            Material::DruckerPrager(m) => ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt(),
         }
     }
 
@@ -282,7 +278,10 @@ mod tests {
                 let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
                 let err = (got - want) / want;
                 println!("MC σc = {sigma_c}, ψ = {psi}: peak {got:.2} vs {want:.2} ({err:+.2e})");
-                assert!(err.abs() < PEAK_REL, "MC σc = {sigma_c} ψ = {psi}: {got} vs {want}");
+                assert!(
+                    err.abs() < PEAK_REL,
+                    "MC σc = {sigma_c} ψ = {psi}: {got} vs {want}"
+                );
             }
         }
     }

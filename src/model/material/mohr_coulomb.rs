@@ -148,7 +148,11 @@ impl MohrCoulomb {
     fn d_times(&self, n: [f64; 3]) -> [f64; 3] {
         let e = &self.elastic;
         let v = e.lame * (n[0] + n[1] + n[2]);
-        [v + 2.0 * e.shear * n[0], v + 2.0 * e.shear * n[1], v + 2.0 * e.shear * n[2]]
+        [
+            v + 2.0 * e.shear * n[0],
+            v + 2.0 * e.shear * n[1],
+            v + 2.0 * e.shear * n[2],
+        ]
     }
 
     /// Return of sorted principal trial stresses `v` (σ1 ≥ σ2 ≥ σ3):
@@ -161,6 +165,8 @@ impl MohrCoulomb {
     /// the set of the three tension planes, as the default cutoff t is the
     /// apex. Should no set pass (round-off at a boundary), the one with
     /// the smallest violation is taken.
+    // Index loops on purpose: they mirror mc_return in the WGSL twin.
+    #[allow(clippy::needless_range_loop)]
     pub fn return_principal(&self, v: [f64; 3], tol_rel: f64) -> ([f64; 3], u32) {
         let planes = self.planes();
         let has_t = self.tension.is_some();
@@ -272,7 +278,11 @@ pub fn principal_return(
     let c = 0.5 * (t[0] + t[1]);
     let hd = 0.5 * (t[0] - t[1]);
     let r = hd.hypot(t[2]);
-    let (cos2, sin2) = if r > 0.0 { (hd / r, t[2] / r) } else { (1.0, 0.0) };
+    let (cos2, sin2) = if r > 0.0 {
+        (hd / r, t[2] / r)
+    } else {
+        (1.0, 0.0)
+    };
     // Values and where each came from (0: in-plane major, 1: minor, 2: zz).
     let mut v = [c + r, c - r, tzz];
     let mut idx = [0usize, 1, 2];
@@ -377,7 +387,10 @@ mod tests {
             let (s, active) = m.return_principal(v, RETURN_TOL_F64);
             assert_eq!(active, ACTIVE_MAIN, "ψ = {psi}");
             for i in 0..3 {
-                assert!((s[i] - want[i]).abs() < 1e-9 * 1e5, "ψ = {psi}: {s:?} vs {want:?}");
+                assert!(
+                    (s[i] - want[i]).abs() < 1e-9 * 1e5,
+                    "ψ = {psi}: {s:?} vs {want:?}"
+                );
             }
             assert!(m.yield_mc(s).abs() <= ON_SURFACE * 1e4, "{}", m.yield_mc(s));
         }
@@ -429,7 +442,9 @@ mod tests {
         // with and without a cutoff below the apex, φ = 0 included).
         let mut seed = 12345u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         let models = [
@@ -470,13 +485,17 @@ mod tests {
         let step = |m: &MohrCoulomb| {
             let mut s = [-1.0e5, -1.0e5, 0.0];
             let mut q = [-1.0e5, 0.0, 0.0, 0.0];
-            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q).unwrap();
+            m.update([0.0, 1.0, 1.0, 0.0], 5e-3, &mut s, &mut q)
+                .unwrap();
             q
         };
         // ψ = 0: no plastic volume change.
         let q = step(&mc(0.0, None));
         assert_eq!(q[RETURN], ACTIVE_MAIN as f64);
-        assert!(q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ], "{q:?}");
+        assert!(
+            q[EPS_EQ] > 1e-4 && q[EPS_VOL].abs() < 1e-12 * q[EPS_EQ],
+            "{q:?}"
+        );
         // ψ = φ (associated): Δεp = Δγ (1 + sin φ, 0, −(1 − sin φ)), so
         // εp_v / ε̄p = 2 sin φ / sqrt(4/3 (1 + sin² φ)): dilation.
         let q = step(&mc(30.0, None));

@@ -80,10 +80,20 @@ impl Elastic3 {
     /// return removed). Returns (Δε̄p = sqrt(2/3 Δεp : Δεp), Δεp_v = tr Δεp).
     #[inline]
     pub fn plastic_increment(&self, trial: [f64; 4], s: [f64; 4]) -> (f64, f64) {
-        let d = [trial[0] - s[0], trial[1] - s[1], trial[2] - s[2], trial[3] - s[3]];
+        let d = [
+            trial[0] - s[0],
+            trial[1] - s[1],
+            trial[2] - s[2],
+            trial[3] - s[3],
+        ];
         let dp = (d[0] + d[1] + d[2]) / 3.0;
         let g2 = 2.0 * self.shear;
-        let dev = [(d[0] - dp) / g2, (d[1] - dp) / g2, (d[2] - dp) / g2, d[3] / g2];
+        let dev = [
+            (d[0] - dp) / g2,
+            (d[1] - dp) / g2,
+            (d[2] - dp) / g2,
+            d[3] / g2,
+        ];
         let dv = dp / self.bulk;
         let e = [dev[0] + dv / 3.0, dev[1] + dv / 3.0, dev[2] + dv / 3.0];
         let norm2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + 2.0 * dev[3] * dev[3];
