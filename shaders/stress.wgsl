@@ -1,5 +1,6 @@
 // Stage `stress`: L = Σ v_I ⊗ ∇N_I, then the material's update over Δt
-// (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F)),
+// (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F);
+// plastic models: Jaumann trial and return, with the `plastic` state),
 // and ρ ← ρ / (V_new / V_old). CPU twin: src/cpu/stress.rs.
 // Built with FORCES (pass `StressForces`, what a whole step runs) it goes on
 // to stage `forces` for the same particle with the same weights (the stress

@@ -1,7 +1,9 @@
 //! Stage `stress`: velocity gradient from the (predicted) nodal velocities,
 //! L = Σ_I v_I ⊗ ∇N_I, then the material's update over Δt (paper Algorithm 1,
 //! steps 4–5; update stress first): linear elastic adds D : Δε with
-//! Δε = Δt sym(L); Neo-Hookean updates F ← (I + Δt L) F and evaluates σ(F).
+//! Δε = Δt sym(L); Neo-Hookean updates F ← (I + Δt L) F and evaluates σ(F);
+//! Mohr–Coulomb and Drucker–Prager take a Jaumann trial and return it to
+//! the yield surface, updating the plastic state (σzz, plastic strains).
 //! The density follows the volume ratio the material returns.
 //! GPU twin: `shaders/stress.wgsl`.
 
