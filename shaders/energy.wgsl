@@ -7,6 +7,9 @@
 #if DEF_GRAD
 @group(0) @binding({{B_DEF_GRAD}}) var<storage, read> def_grad: array<vec4<f32>>;
 #endif
+#if PLASTIC
+@group(0) @binding({{B_PLASTIC}}) var<storage, read> plastic: array<vec4<f32>>;
+#endif
 
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
 @group(0) @binding({{B_V}}) var<storage, read> v: array<vec2<f32>>;
@@ -31,6 +34,14 @@ fn particle_def_grad(p: u32) -> vec4<f32> {
 #endif
 }
 
+fn particle_plastic(p: u32) -> vec4<f32> {
+#if PLASTIC
+    return plastic[p];
+#else
+    return vec4<f32>(0.0);
+#endif
+}
+
 @compute @workgroup_size(256)
 fn main(
     @builtin(global_invocation_id) gid: vec3<u32>,
@@ -48,7 +59,7 @@ fn main(
 #endif
         e = vec4<f32>(
             0.5 * m * dot(v[p], v[p]),
-            m / rho[p] * strain_energy_density(material_of(p), s, particle_def_grad(p)),
+            m / rho[p] * strain_energy_density(material_of(p), s, particle_def_grad(p), particle_plastic(p)),
             load * length(u[p]),
             0.0,
         );

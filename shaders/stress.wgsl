@@ -1,5 +1,6 @@
 // Stage `stress`: L = Σ v_I ⊗ ∇N_I, then the material's update over Δt
-// (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F)),
+// (linear elastic: σ += D : Δt sym(L); Neo-Hookean: F ← (I + Δt L) F, σ(F);
+// plastic models: Jaumann trial and return, with the `plastic` state),
 // and ρ ← ρ / (V_new / V_old). CPU twin: src/cpu/stress.rs.
 // Built with FORCES (pass `StressForces`, what a whole step runs) it goes on
 // to stage `forces` for the same particle with the same weights (the stress
@@ -11,6 +12,9 @@
 #include "shared/material.wgsl"
 #if DEF_GRAD
 @group(0) @binding({{B_DEF_GRAD}}) var<storage, read_write> def_grad: array<vec4<f32>>;
+#endif
+#if PLASTIC
+@group(0) @binding({{B_PLASTIC}}) var<storage, read_write> plastic: array<vec4<f32>>;
 #endif
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
@@ -64,8 +68,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #else
     let f = vec4<f32>(1.0, 0.0, 0.0, 1.0);
 #endif
+#if PLASTIC
+    let q = plastic[p];
+#else
+    let q = vec4<f32>(0.0);
+#endif
     let s0 = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
-    let up = material_update(material_of(p), l, dt, s0, f);
+    let up = material_update(material_of(p), l, dt, s0, f, q);
     if up.fault != 0u {
         report_fault(up.fault, p);
         return;
@@ -79,6 +88,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     rho[p] = rho_p;
 #if DEF_GRAD
     def_grad[p] = up.f;
+#endif
+#if PLASTIC
+    plastic[p] = up.q;
 #endif
     stress[3u * p] = s.x;
     stress[3u * p + 1u] = s.y;

@@ -105,6 +105,7 @@ pub fn check_state(model: &Model, state: &State) -> Result<()> {
         && p.a.len() == q.a.len()
         && p.lambda.len() == q.lambda.len()
         && p.f.len() == q.f.len()
+        && p.plastic.len() == q.plastic.len()
         && state.mv.len() == model.grid.n_nodes()
         && state.force.len() == model.grid.n_nodes();
     if same {

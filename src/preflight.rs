@@ -315,6 +315,9 @@ fn memory(
     let needs_f = scene
         .materials()
         .any(|(_, m)| Material::new(m).needs_deformation_gradient());
+    let needs_plastic = scene
+        .materials()
+        .any(|(_, m)| Material::new(m).needs_plastic_state());
     let npc = f.solver.integrator == crate::scene::IntegratorKind::Npc;
     // Particle fields (model::Particles): x, v, x0, mass, rho, stress, body.
     let mut particle = 16.0 * 3.0 + 8.0 * 2.0 + 24.0 + 4.0;
@@ -325,6 +328,10 @@ fn memory(
         particle += 16.0;
     }
     if needs_f {
+        particle += 32.0;
+    }
+    if needs_plastic {
+        // The plastic state (σzz, ε̄p, εp_v, return).
         particle += 32.0;
     }
     // Shape cache (cpu::ShapeCache): a count and per slot a u32 and 3 f64.
@@ -354,7 +361,8 @@ fn memory(
     let build = n * (48.0 + particle) + nodes;
     // (b) The end of run::run.
     let csv = if f.output.particles_csv {
-        CSV_BYTES_PER_PARTICLE
+        // Four more columns with a plastic material, ~20 characters each.
+        CSV_BYTES_PER_PARTICLE + if needs_plastic { 80.0 } else { 0.0 }
     } else {
         0.0
     };

@@ -48,6 +48,8 @@ fn dyka_text() -> String {
 fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
     let dyka = common::case("dyka_bar.toml");
     let mms = common::case("aligned_vibration.toml");
+    let slump =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
     let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
         (
             "malformed toml",
@@ -186,6 +188,66 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
             mms.clone(),
             vec!["solver.dt=-1e-5"],
             "solver.dt",
+        ),
+        (
+            "negative cohesion",
+            slump.clone(),
+            vec!["materials.soil.cohesion=-1"],
+            "materials.soil.cohesion",
+        ),
+        (
+            "friction angle of 90 degrees",
+            slump.clone(),
+            vec!["materials.soil.friction_angle=90"],
+            "materials.soil.friction_angle",
+        ),
+        (
+            "dilation above friction",
+            slump.clone(),
+            vec!["materials.soil.dilation_angle=25"],
+            "materials.soil.dilation_angle",
+        ),
+        (
+            "negative dilation",
+            slump.clone(),
+            vec!["materials.soil.dilation_angle=-1"],
+            "materials.soil.dilation_angle",
+        ),
+        (
+            "tension cutoff above the apex",
+            slump.clone(),
+            vec!["materials.soil.tension_cutoff=3000"],
+            "materials.soil.tension_cutoff",
+        ),
+        (
+            "negative tension cutoff",
+            slump.clone(),
+            vec!["materials.soil.tension_cutoff=-5"],
+            "materials.soil.tension_cutoff",
+        ),
+        (
+            "plastic model without cohesion",
+            dyka.clone(),
+            vec![
+                "materials.steel.model=mohr_coulomb",
+                "materials.steel.friction_angle=30",
+            ],
+            "materials.steel.cohesion",
+        ),
+        (
+            "plastic model without friction angle",
+            dyka.clone(),
+            vec![
+                "materials.steel.model=drucker_prager",
+                "materials.steel.cohesion=1e6",
+            ],
+            "materials.steel.friction_angle",
+        ),
+        (
+            "plastic key on an elastic material",
+            slump.clone(),
+            vec!["materials.soil.model=linear_elastic"],
+            "materials.soil.cohesion",
         ),
     ];
     for (what, scene, sets, needle) in cases {

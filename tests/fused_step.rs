@@ -11,9 +11,23 @@ use lme_mpm::solver::STEP;
 
 #[test]
 fn fused_step_equals_the_stages_one_by_one() {
-    for shape in ["linear", "bspline2", "lme"] {
+    let mc = [
+        "materials.m.model=mohr_coulomb",
+        "materials.m.cohesion=10",
+        "materials.m.friction_angle=30",
+    ];
+    for (shape, plastic) in [
+        ("linear", false),
+        ("bspline2", false),
+        ("lme", false),
+        ("linear", true),
+    ] {
         let set = format!("solver.shape={shape}");
-        let case = Case::new("t", &[set.as_str()]);
+        let mut sets = vec![set.as_str()];
+        if plastic {
+            sets.extend(mc);
+        }
+        let case = Case::new("t", &sets);
         let model = Model::new(&scene(900, &case).unwrap()).unwrap();
         let mut fused = CpuBackend::new(model.clone());
         let mut staged = CpuBackend::new(model);
@@ -31,5 +45,13 @@ fn fused_step_equals_the_stages_one_by_one() {
         assert_eq!(fused.force, staged.force, "{shape}");
         assert_eq!(fused.mv, staged.mv, "{shape}");
         assert_eq!(a.lambda, b.lambda, "{shape}");
+        assert_eq!(a.plastic, b.plastic, "{shape}");
+        if plastic {
+            // The plastic path was exercised.
+            assert!(
+                a.plastic.iter().any(|q| q[1] > 0.0),
+                "{shape}: nothing yielded"
+            );
+        }
     }
 }

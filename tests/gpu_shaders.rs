@@ -73,11 +73,22 @@ fn variants() -> Vec<Variant> {
                             if lme_stored && shape != ShapeKind::Lme {
                                 continue;
                             }
-                            // Linear elastic, Neo-Hookean, or both (with several materials).
-                            for (linear_elastic, neo_hookean) in
-                                [(true, false), (false, true), (true, true)]
-                            {
-                                if linear_elastic && neo_hookean && !multi_material {
+                            // Linear elastic, Neo-Hookean, Mohr–Coulomb, Drucker–Prager
+                            // alone, or several (with several materials).
+                            for (linear_elastic, neo_hookean, mohr_coulomb, drucker_prager) in [
+                                (true, false, false, false),
+                                (false, true, false, false),
+                                (true, true, false, false),
+                                (false, false, true, false),
+                                (false, false, false, true),
+                                (true, true, true, true),
+                            ] {
+                                let models =
+                                    [linear_elastic, neo_hookean, mohr_coulomb, drucker_prager]
+                                        .iter()
+                                        .filter(|m| **m)
+                                        .count();
+                                if models > 1 && !multi_material {
                                     continue;
                                 }
                                 // MLS (linear and B-splines on regular grids), and the
@@ -92,8 +103,7 @@ fn variants() -> Vec<Variant> {
                                                 | ShapeKind::Bspline2
                                                 | ShapeKind::Bspline3
                                         );
-                                    if (mls && !mls_ok)
-                                        || (mms && (linear_elastic || multi_material))
+                                    if (mls && !mls_ok) || (mms && (!neo_hookean || multi_material))
                                     {
                                         continue;
                                     }
@@ -107,7 +117,10 @@ fn variants() -> Vec<Variant> {
                                         lme_stored,
                                         linear_elastic,
                                         neo_hookean,
+                                        mohr_coulomb,
+                                        drucker_prager,
                                         def_grad: neo_hookean,
+                                        plastic: mohr_coulomb || drucker_prager,
                                         mms,
                                         mls,
                                         // Walls and loads in every shape and
@@ -159,6 +172,17 @@ fn every_pass_validates_in_every_variant() {
                 !has(Buf::Mat) || v.multi_material,
                 "{pass:?} {v:?}: material index with one material"
             );
+            assert!(
+                !has(Buf::Plastic) || v.plastic,
+                "{pass:?} {v:?}: plastic state without a plastic material"
+            );
+            if matches!(pass, Pass::Stress | Pass::StressForces) {
+                assert_eq!(
+                    binds.iter().any(|x| x.buf == Buf::Plastic && x.writable),
+                    v.plastic,
+                    "{pass:?} {v:?}: the stress stage updates the plastic state"
+                );
+            }
             assert!(
                 !(has(Buf::MlsCount) || has(Buf::MlsOrder) || has(Buf::MlsCoef)) || v.mls,
                 "{pass:?} {v:?}: MLS buffers without MLS"
@@ -234,7 +258,8 @@ fn shared_structs_match_rust_layouts() {
     assert_eq!(wgsl_struct(&module, "Params"), params);
     let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
-    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model);
+    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model, bulk, cohesion,
+        sin_phi, cos_phi, sin_psi, tension, dp_alpha, dp_alpha_psi, dp_k);
     assert_eq!(wgsl_struct(&module, "Material"), mat);
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix, vx, vy, ramp_time);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
@@ -272,7 +297,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     let all = variants();
     let mls = all
         .iter()
-        .find(|v| v.mls && v.multi_material && v.shape == ShapeKind::Bspline2)
+        .find(|v| v.mls && v.multi_material && v.mohr_coulomb && v.shape == ShapeKind::Bspline2)
         .unwrap();
     let lme = all
         .iter()
@@ -300,6 +325,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
 #[test]
 fn constants_mirrored_in_wgsl_match_rust() {
     use lme_mpm::gpu::layout as l;
+    use lme_mpm::model::material::plastic;
     let f = |v: f64| Value::F32(v as f32);
     let u = Value::U32;
     let expected: Vec<(&str, Value)> = vec![
@@ -321,6 +347,14 @@ fn constants_mirrored_in_wgsl_match_rust() {
             "CONTACT_FRICTION",
             u(lme_mpm::model::walls::CONTACT_FRICTION),
         ),
+        ("MODEL_MOHR_COULOMB", u(l::MODEL_MOHR_COULOMB)),
+        ("MODEL_DRUCKER_PRAGER", u(l::MODEL_DRUCKER_PRAGER)),
+        ("ACTIVE_MAIN", u(plastic::ACTIVE_MAIN)),
+        ("ACTIVE_EDGE_12", u(plastic::ACTIVE_EDGE_12)),
+        ("ACTIVE_EDGE_23", u(plastic::ACTIVE_EDGE_23)),
+        ("ACTIVE_T1", u(plastic::ACTIVE_T1)),
+        ("ACTIVE_T2", u(plastic::ACTIVE_T2)),
+        ("ACTIVE_T3", u(plastic::ACTIVE_T3)),
         ("NODE_STRIDE", u(l::NODE_STRIDE as u32)),
         ("PROBE_STRIDE", u(l::PROBE_STRIDE as u32)),
         ("WG", u(l::WG)),

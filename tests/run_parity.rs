@@ -1,5 +1,6 @@
 //! Whole-run parity: Dyka's bar (1 mm cells), the elastic block, the
-//! manufactured vibration and a two-material impact run on the CPU (f64)
+//! manufactured vibration, a two-material impact and a Mohr–Coulomb slump
+//! run on the CPU (f64)
 //! and the GPU (f32). Probe and energy histories and final fields must
 //! agree within the tolerances below, and the GPU's error against the exact
 //! solution (where there is one) must be within 10% of the CPU's.
@@ -36,6 +37,12 @@ const TWO_MATERIAL_TOL: f64 = 3e-5;
 /// worst measured 1.1e-4 (LME FE, reaction history; final velocities
 /// 1.5e-5, stresses 5.7e-5; Q4 NPC 1.4e-6 to 3.3e-6). 9 times, rounded.
 const BOUNDARIES_TOL: f64 = 1e-3;
+
+/// Mohr–Coulomb / Drucker–Prager slump: toe probe vx history, final
+/// velocity, stress and ε̄p fields and the energies, each over its largest
+/// CPU value: worst 7.0e-6 (LME, final velocity; linear 8.0e-7), 10 times,
+/// rounded up.
+const SLUMP_TOL: f64 = 7e-5;
 
 struct Outcome {
     samples: Vec<Sample>,
@@ -406,5 +413,75 @@ fn boundaries_gpu_matches_cpu() {
         assert!(v_rms < BOUNDARIES_TOL, "final velocities differ: {v_rms}");
         assert!(s_rms < BOUNDARIES_TOL, "final stresses differ: {s_rms}");
         assert!(r_rms < BOUNDARIES_TOL, "reaction histories differ: {r_rms}");
+    }
+}
+
+/// A weak Mohr–Coulomb block slumping under gravity
+/// (tests/scenes/soil_slump.toml): most particles yield, on both backends,
+/// and the plastic state follows (140 of 144 particles yield, ε̄p up to
+/// 0.16).
+#[test]
+fn plastic_slump_gpu_matches_cpu() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
+    for sets in [
+        &[][..],
+        &["materials.soil.model=drucker_prager"],
+        &["solver.shape=lme"],
+    ] {
+        let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let scene = Scene::load(&path, &o).unwrap();
+        let Some((cpu, gpu)) = both_of("soil_slump", &scene, false) else {
+            return;
+        };
+        let (cp, gp) = (&cpu.particles, &gpu.particles);
+        let yielded = |p: &Particles| p.plastic.iter().filter(|q| q[1] > 0.0).count();
+        let (yc, yg) = (yielded(cp), yielded(gp));
+        // The largest velocity on the CPU path sets the scale of velocities.
+        let v_max = cpu
+            .samples
+            .iter()
+            .flat_map(|s| s.probes.iter().map(|p| p.v[0].hypot(p.v[1])))
+            .fold(0.0, f64::max);
+        let (hv, _) = history_rms(&cpu.samples, &gpu.samples, |s| s.probes[1].v[0]);
+        let vc: Vec<f64> = cp.v.iter().flatten().copied().collect();
+        let vg: Vec<f64> = gp.v.iter().flatten().copied().collect();
+        let sc: Vec<f64> = cp.stress.iter().flatten().copied().collect();
+        let sg: Vec<f64> = gp.stress.iter().flatten().copied().collect();
+        let s_max = sc.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        let ec: Vec<f64> = cp.plastic.iter().map(|q| q[1]).collect();
+        let eg: Vec<f64> = gp.plastic.iter().map(|q| q[1]).collect();
+        let e_max = ec.iter().copied().fold(0.0, f64::max);
+        let (hv, f_rms, s_rms, e_rms) = (
+            hv / v_max,
+            field_rms(&vc, &vg) / v_max,
+            field_rms(&sc, &sg) / s_max,
+            field_rms(&ec, &eg) / e_max,
+        );
+        println!(
+            "{sets:?}: steps cpu {} gpu {}; yielded cpu {yc} gpu {yg} of {}; max ε̄p {e_max:.3e}; \
+             toe vx history {hv:.2e}, final v {f_rms:.2e}, stress {s_rms:.2e}, ε̄p {e_rms:.2e}",
+            cpu.steps,
+            gpu.steps,
+            cp.len()
+        );
+        // Plasticity must have happened, or the comparison says nothing.
+        assert!(
+            yc * 4 >= cp.len() && e_max > 1e-3,
+            "{sets:?}: {yc} yielded, ε̄p ≤ {e_max}"
+        );
+        assert!(
+            yc.abs_diff(yg) * 50 <= cp.len(),
+            "{sets:?}: yielded {yc} vs {yg}"
+        );
+        for (what, err) in [
+            ("toe vx history", hv),
+            ("velocity", f_rms),
+            ("stress", s_rms),
+            ("ε̄p", e_rms),
+        ] {
+            assert!(err < SLUMP_TOL, "{sets:?}: {what} differs by {err:.2e}");
+        }
+        check_energy(&format!("{sets:?}"), &cpu, &gpu, SLUMP_TOL);
     }
 }

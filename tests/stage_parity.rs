@@ -293,8 +293,64 @@ fn random_model_of(text: &str, sets: &[&str], seed: u64) -> Model {
             let mut d = || rng.range(-0.1, 0.1);
             p.f[i] = [1.0 + d(), d(), d(), 1.0 + d()];
         }
+        if !p.plastic.is_empty() {
+            let s = p.stress[i];
+            p.plastic[i] = [
+                0.3 * (s[0] + s[1]) + rng.range(-2e4, 2e4),
+                rng.range(0.0, 1e-2),
+                rng.range(-1e-3, 1e-3),
+                0.0,
+            ];
+        }
     }
     m
+}
+
+/// Plastic-state checks of stage `stress`: σzz's change and the plastic
+/// strains' as the stress change, the same return on both twins for all
+/// but a few particles near a region's boundary, and some particles
+/// yielded (else the stage's plasticity went untested).
+fn check_plastic(
+    label: &str,
+    rep: &mut Report,
+    tol: f64,
+    gp: &lme_mpm::model::Particles,
+    cp: &lme_mpm::model::Particles,
+    before: &lme_mpm::model::Particles,
+) {
+    let col = |p: &lme_mpm::model::Particles, k: usize| -> Vec<f64> {
+        p.plastic.iter().map(|q| q[k]).collect()
+    };
+    rep.check(
+        "stress: σzz change",
+        rel_err(&col(gp, 0), &col(cp, 0), Some(&col(before, 0))),
+        tol,
+    );
+    for (k, what) in [(1, "stress: ε̄p change"), (2, "stress: εp_v change")] {
+        rep.check(
+            what,
+            rel_err(&col(gp, k), &col(cp, k), Some(&col(before, k))),
+            tol,
+        );
+    }
+    let yielded = cp.plastic.iter().filter(|q| q[3] != 0.0).count();
+    let same = (0..cp.len())
+        .filter(|&i| gp.plastic[i][3] == cp.plastic[i][3])
+        .count();
+    println!(
+        "  {label}: {yielded} of {} particles yielded, {same} with the same return",
+        cp.len()
+    );
+    assert!(
+        yielded * 4 >= cp.len(),
+        "{label}: only {yielded} particles yielded"
+    );
+    assert!(yielded < cp.len(), "{label}: no particle stayed elastic");
+    assert!(
+        same * 100 >= cp.len() * 99,
+        "{label}: {same} of {} same returns",
+        cp.len()
+    );
 }
 
 /// max |a − b| / max |b| (or / max |b − base| when `base` is given).
@@ -472,6 +528,9 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                     rel_err(&gp.rho, &cp.rho, None),
                     tol.density,
                 );
+                if !cp.plastic.is_empty() {
+                    check_plastic(label, &mut rep, tol.stress, &gp, cp, &before_p);
+                }
             }
             Stage::Forces => {
                 rep.check(
@@ -770,5 +829,39 @@ fn stages_match_boundaries() {
             assert!(r[0].hypot(r[1]) > 0.0, "{label}: wall {} idle", w.name);
         }
         parity_of(label, m, cas, GpuOptions::default(), 0.7);
+    }
+}
+
+/// Plastic materials (Mohr–Coulomb, Drucker–Prager) with random stresses
+/// of ±100 kPa against c = 10 kPa: most particles yield in every region
+/// (plane, edges, apex, tension), and the stress stage's twins must agree.
+#[test]
+fn stages_match_plastic() {
+    let mc = [
+        "materials.m.model=mohr_coulomb",
+        "materials.m.cohesion=1e4",
+        "materials.m.friction_angle=30",
+        "materials.m.dilation_angle=10",
+    ];
+    let dp = [
+        "materials.m.model=drucker_prager",
+        "materials.m.cohesion=1e4",
+        "materials.m.friction_angle=30",
+        "materials.m.tension_cutoff=5e3",
+    ];
+    for (label, model, shape) in [
+        ("mohr-coulomb, linear npc", &mc[..], "solver.shape=linear"),
+        ("mohr-coulomb, lme npc", &mc[..], "solver.shape=lme"),
+        (
+            "drucker-prager, bspline2 npc",
+            &dp[..],
+            "solver.shape=bspline2",
+        ),
+    ] {
+        let mut sets = model.to_vec();
+        sets.push(shape);
+        let m = random_model(&sets, 5);
+        assert!(!m.particles.plastic.is_empty(), "{label}");
+        parity_of(label, m, false, GpuOptions::default(), 0.0);
     }
 }

@@ -2,7 +2,7 @@
 // F ← (I + Δt L) F, σ = λ ln J / J I + μ / J (F Fᵀ − I).
 // CPU twin: src/material/neo_hookean.rs.
 
-fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, f: vec4<f32>) -> MatUpdate {
+fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, f: vec4<f32>, q: vec4<f32>) -> MatUpdate {
     let g = vec4<f32>(1.0 + dt * l.x, dt * l.y, dt * l.z, 1.0 + dt * l.w);
     let nf = vec4<f32>(
         g.x * f.x + g.y * f.z,
@@ -12,7 +12,7 @@ fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, f: vec4<f32>) -> MatUp
     );
     let j_old = f.x * f.w - f.y * f.z;
     let j = nf.x * nf.w - nf.y * nf.z;
-    var r = MatUpdate(vec3<f32>(0.0), f, 1.0, 0u);
+    var r = MatUpdate(vec3<f32>(0.0), f, q, 1.0, 0u);
     if !is_finite(j) {
         r.fault = FAULT_NON_FINITE_STRAIN;
         return r;

@@ -107,10 +107,22 @@ struct Material {
     p_modulus: f32,
     youngs: f32,
     nu: f32,
-    // MODEL_LINEAR_ELASTIC or MODEL_NEO_HOOKEAN (shared/material.wgsl).
+    // MODEL_* (shared/material.wgsl).
     model: u32,
-    _pad1: f32,
-    _pad2: f32,
+    // Plastic models: bulk modulus K, cohesion c (Pa).
+    bulk: f32,
+    cohesion: f32,
+    // Mohr–Coulomb: sin φ, cos φ, sin ψ.
+    sin_phi: f32,
+    cos_phi: f32,
+    sin_psi: f32,
+    // Plastic models: tension cutoff t (Pa); negative: none.
+    tension: f32,
+    // Drucker–Prager: α, ᾱ, k (Pa) of the plane-strain match.
+    dp_alpha: f32,
+    dp_alpha_psi: f32,
+    dp_k: f32,
+    _pad: f32,
 }
 
 // Nodes with i0 <= i <= i1 and j0 <= j <= j1 are fixed in the `fix` bits

@@ -120,6 +120,9 @@ impl CpuBackend {
         if !p.f.is_empty() {
             per += 32.0;
         }
+        if !p.plastic.is_empty() {
+            per += 32.0;
+        }
         if model.mls {
             // Sort order and cells per particle, the Gauss points' share.
             let slots = model.shape.max_nodes() as f64;
@@ -236,6 +239,7 @@ impl CpuBackend {
             &mut p.stress,
             &mut p.rho,
             &mut p.f,
+            &mut p.plastic,
             &mut self.force,
             &mut self.force_scatter,
         )
@@ -288,6 +292,7 @@ impl CpuBackend {
                 &mut p.stress,
                 &mut p.rho,
                 &mut p.f,
+                &mut p.plastic,
             )?,
             Stage::Forces => {
                 // The stress is already at the step's end (t + Δt), so are the loads.

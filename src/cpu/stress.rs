@@ -1,15 +1,44 @@
 //! Stage `stress`: velocity gradient from the (predicted) nodal velocities,
 //! L = Σ_I v_I ⊗ ∇N_I, then the material's update over Δt (paper Algorithm 1,
 //! steps 4–5; update stress first): linear elastic adds D : Δε with
-//! Δε = Δt sym(L); Neo-Hookean updates F ← (I + Δt L) F and evaluates σ(F).
+//! Δε = Δt sym(L); Neo-Hookean updates F ← (I + Δt L) F and evaluates σ(F);
+//! Mohr–Coulomb and Drucker–Prager take a Jaumann trial and return it to
+//! the yield surface, updating the plastic state (σzz, plastic strains).
 //! The density follows the volume ratio the material returns.
 //! GPU twin: `shaders/stress.wgsl`.
 
 use super::forces::add_particle_forces;
 use super::{ShapeCache, scatter::Scatter};
 use crate::model::fault::{Fault, FaultKind};
-use crate::model::material::Material;
+use crate::model::material::{Material, PlasticState};
+use rayon::iter::Either;
 use rayon::prelude::*;
+
+/// The state a particle may carry beyond its stress: F, the plastic state.
+/// Empty vectors (fields the scene does not use) give `None` per particle.
+type Extra<'a> = (Option<&'a mut [f64; 4]>, Option<&'a mut PlasticState>);
+
+/// Per-particle `Option<&mut T>` over `v`, or `None` n times when `v` is empty.
+fn optional<T: Send>(v: &mut [T], n: usize) -> impl IndexedParallelIterator<Item = Option<&mut T>> {
+    if v.is_empty() {
+        Either::Left((0..n).into_par_iter().map(|_| None))
+    } else {
+        Either::Right(v.par_iter_mut().map(Some))
+    }
+}
+
+/// `optional` by chunks of `len`.
+fn optional_chunks<T: Send>(
+    v: &mut [T],
+    n: usize,
+    len: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
+    if v.is_empty() {
+        Either::Left((0..n.div_ceil(len)).into_par_iter().map(|_| None))
+    } else {
+        Either::Right(v.par_chunks_mut(len).map(Some))
+    }
+}
 
 #[allow(clippy::too_many_arguments)]
 pub fn stress(
@@ -22,34 +51,31 @@ pub fn stress(
     stress: &mut [[f64; 3]],
     rho: &mut [f64],
     f: &mut [[f64; 4]],
+    plastic: &mut [PlasticState],
 ) -> Result<(), Fault> {
-    let kernel = |p: usize, s: &mut [f64; 3], r: &mut f64, f: &mut [f64; 4]| {
-        update_particle(
-            cache,
-            mv,
-            dt,
-            &materials[body_material[body[p] as usize] as usize],
-            p,
-            s,
-            r,
-            f,
-        )
-    };
-    let fault = if f.is_empty() {
-        (stress.par_iter_mut(), rho.par_iter_mut())
-            .into_par_iter()
-            .enumerate()
-            .with_min_len(256)
-            .map(|(p, (s, r))| kernel(p, s, r, &mut [1.0, 0.0, 0.0, 1.0]))
-            .reduce(|| None, Fault::first)
-    } else {
-        (stress.par_iter_mut(), rho.par_iter_mut(), f.par_iter_mut())
-            .into_par_iter()
-            .enumerate()
-            .with_min_len(256)
-            .map(|(p, (s, r, f))| kernel(p, s, r, f))
-            .reduce(|| None, Fault::first)
-    };
+    let n = stress.len();
+    let fault = (
+        stress.par_iter_mut(),
+        rho.par_iter_mut(),
+        optional(f, n),
+        optional(plastic, n),
+    )
+        .into_par_iter()
+        .enumerate()
+        .with_min_len(256)
+        .map(|(p, (s, r, f, q))| {
+            update_particle(
+                cache,
+                mv,
+                dt,
+                &materials[body_material[body[p] as usize] as usize],
+                p,
+                s,
+                r,
+                (f, q),
+            )
+        })
+        .reduce(|| None, Fault::first);
     fault.map_or(Ok(()), Err)
 }
 
@@ -65,7 +91,7 @@ fn update_particle(
     p: usize,
     s: &mut [f64; 3],
     r: &mut f64,
-    f: &mut [f64; 4],
+    extra: Extra<'_>,
 ) -> Option<Fault> {
     let (nodes, w) = cache.particle(p);
     // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
@@ -77,7 +103,11 @@ fn update_particle(
         l[2] += v[2] * wk[1];
         l[3] += v[2] * wk[2];
     }
-    match material.update(l, dt, s, f) {
+    // Fields the scene does not keep are stand-ins the models ignore.
+    let (mut id, mut q0) = ([1.0, 0.0, 0.0, 1.0], [0.0; 4]);
+    let f = extra.0.unwrap_or(&mut id);
+    let q = extra.1.unwrap_or(&mut q0);
+    match material.update(l, dt, s, f, q) {
         Err(kind) => Some(Fault::at(p, kind)),
         Ok(j) => {
             *r /= j;
@@ -107,15 +137,16 @@ pub fn stress_forces(
     stress: &mut [[f64; 3]],
     rho: &mut [f64],
     f: &mut [[f64; 4]],
+    plastic: &mut [PlasticState],
     force: &mut [[f64; 2]],
     scatter: &mut Scatter<2>,
 ) -> Result<(), Fault> {
     let n = mass.len();
     let len = Scatter::<2>::range_len(n);
     let particle =
-        |p: usize, s: &mut [f64; 3], r: &mut f64, f: &mut [f64; 4], acc: &mut [[f64; 2]]| {
+        |p: usize, s: &mut [f64; 3], r: &mut f64, extra: Extra<'_>, acc: &mut [[f64; 2]]| {
             let material = &materials[body_material[body[p] as usize] as usize];
-            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, f) {
+            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra) {
                 return Some(fault);
             }
             let g = body_force(p);
@@ -123,42 +154,30 @@ pub fn stress_forces(
             add_particle_forces(cache, p, m / *r, *s, [m * g[0], m * g[1]], acc);
             None
         };
-    let fault = if f.is_empty() {
-        let ranges = stress.par_chunks_mut(len).zip(rho.par_chunks_mut(len));
-        scatter.run_ranges(
-            force,
-            n,
-            ranges,
-            |first, (s, r), acc| {
-                let mut fault = None;
-                for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
-                    let mut id = [1.0, 0.0, 0.0, 1.0];
-                    fault = Fault::first(fault, particle(first + k, s, r, &mut id, acc));
-                }
-                fault
-            },
-            Fault::first,
-            || None,
-        )
-    } else {
-        let ranges = stress
-            .par_chunks_mut(len)
-            .zip(rho.par_chunks_mut(len))
-            .zip(f.par_chunks_mut(len));
-        scatter.run_ranges(
-            force,
-            n,
-            ranges,
-            |first, ((s, r), f), acc| {
-                let mut fault = None;
-                for (k, ((s, r), f)) in s.iter_mut().zip(r).zip(f).enumerate() {
-                    fault = Fault::first(fault, particle(first + k, s, r, f, acc));
-                }
-                fault
-            },
-            Fault::first,
-            || None,
-        )
-    };
+    let ranges = (
+        stress.par_chunks_mut(len),
+        rho.par_chunks_mut(len),
+        optional_chunks(f, n, len),
+        optional_chunks(plastic, n, len),
+    )
+        .into_par_iter();
+    let fault = scatter.run_ranges(
+        force,
+        n,
+        ranges,
+        |first, (s, r, mut f, mut q), acc| {
+            let mut fault = None;
+            for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
+                let extra = (
+                    f.as_deref_mut().map(|f| &mut f[k]),
+                    q.as_deref_mut().map(|q| &mut q[k]),
+                );
+                fault = Fault::first(fault, particle(first + k, s, r, extra, acc));
+            }
+            fault
+        },
+        Fault::first,
+        || None,
+    );
     fault.map_or(Ok(()), Err)
 }

@@ -7,8 +7,8 @@
 use super::GpuOptions;
 use super::context::GpuContext;
 use super::layout::{
-    GpuConstraint, GpuMaterial, GpuWall, MODEL_LINEAR_ELASTIC, MODEL_NEO_HOOKEAN, NODE_STRIDE,
-    PROBE_STRIDE, Params, Sim,
+    GpuConstraint, GpuMaterial, GpuWall, MODEL_DRUCKER_PRAGER, MODEL_LINEAR_ELASTIC,
+    MODEL_MOHR_COULOMB, MODEL_NEO_HOOKEAN, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
 };
 use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
@@ -37,6 +37,7 @@ pub enum Buf {
     LmeNodes,
     LmeW,
     DefGrad,
+    Plastic,
     NodeAcc,
     NodePos,
     Reactions,
@@ -55,7 +56,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 33] = [
+    pub const ALL: [Buf; 34] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -74,6 +75,7 @@ impl Buf {
         Buf::LmeNodes,
         Buf::LmeW,
         Buf::DefGrad,
+        Buf::Plastic,
         Buf::NodeAcc,
         Buf::NodePos,
         Buf::Reactions,
@@ -190,27 +192,55 @@ impl Buffers {
 }
 
 /// The materials as the shaders read them.
-fn gpu_materials(model: &Model) -> Vec<GpuMaterial> {
-    model
-        .materials
-        .iter()
-        .map(|m| {
-            let (lame, shear) = m.lame_shear();
-            let (youngs, nu, model) = match m {
-                Material::LinearElastic(e) => (e.youngs, e.nu, MODEL_LINEAR_ELASTIC),
-                Material::NeoHookean(e) => (e.youngs, e.nu, MODEL_NEO_HOOKEAN),
-            };
-            GpuMaterial {
-                lame: lame as f32,
-                shear: shear as f32,
-                p_modulus: (lame + 2.0 * shear) as f32,
-                youngs: youngs as f32,
-                nu: nu as f32,
-                model,
-                _pad: [0.0; 2],
-            }
-        })
-        .collect()
+pub fn gpu_materials(model: &Model) -> Vec<GpuMaterial> {
+    model.materials.iter().map(gpu_material).collect()
+}
+
+/// One material as the shaders read it (plastic fields zero for the elastic models).
+pub fn gpu_material(m: &Material) -> GpuMaterial {
+    let (lame, shear) = m.lame_shear();
+    let (youngs, nu) = m.youngs_nu();
+    let mut g = GpuMaterial {
+        lame: lame as f32,
+        shear: shear as f32,
+        p_modulus: (lame + 2.0 * shear) as f32,
+        youngs: youngs as f32,
+        nu: nu as f32,
+        model: MODEL_LINEAR_ELASTIC,
+        bulk: 0.0,
+        cohesion: 0.0,
+        sin_phi: 0.0,
+        cos_phi: 0.0,
+        sin_psi: 0.0,
+        tension: -1.0,
+        dp_alpha: 0.0,
+        dp_alpha_psi: 0.0,
+        dp_k: 0.0,
+        _pad: 0.0,
+    };
+    match m {
+        Material::LinearElastic(_) => {}
+        Material::NeoHookean(_) => g.model = MODEL_NEO_HOOKEAN,
+        Material::MohrCoulomb(mc) => {
+            g.model = MODEL_MOHR_COULOMB;
+            g.bulk = mc.elastic.bulk as f32;
+            g.cohesion = mc.cohesion as f32;
+            g.sin_phi = mc.sin_phi as f32;
+            g.cos_phi = mc.cos_phi as f32;
+            g.sin_psi = mc.sin_psi as f32;
+            g.tension = mc.tension.map_or(-1.0, |t| t as f32);
+        }
+        Material::DruckerPrager(dp) => {
+            g.model = MODEL_DRUCKER_PRAGER;
+            g.bulk = dp.elastic.bulk as f32;
+            g.cohesion = dp.cohesion as f32;
+            g.tension = dp.tension.map_or(-1.0, |t| t as f32);
+            g.dp_alpha = dp.alpha as f32;
+            g.dp_alpha_psi = dp.alpha_psi as f32;
+            g.dp_k = dp.k as f32;
+        }
+    }
+    g
 }
 
 /// Initial contents of the per-particle buffers.
@@ -272,6 +302,11 @@ fn particle_data(
             .flat_map(|i| [e.force[i][0], e.force[i][1], e.ramp_time[i]].map(|c| c as f32))
             .collect();
         data.push((Buf::ExtForce, bytes(&f)));
+    }
+    if !p.plastic.is_empty() {
+        // [σzz, ε̄p, εp_v, return] as vec4<f32>: 16 bytes per particle.
+        let q: Vec<f32> = p.plastic.iter().flat_map(|q| q.map(|c| c as f32)).collect();
+        data.push((Buf::Plastic, bytes(&q)));
     }
 }
 

@@ -76,15 +76,31 @@ pub struct GpuMaterial {
     pub p_modulus: f32,
     pub youngs: f32,
     pub nu: f32,
-    /// `MODEL_LINEAR_ELASTIC` or `MODEL_NEO_HOOKEAN`.
+    /// `MODEL_*`.
     pub model: u32,
-    pub _pad: [f32; 2],
+    /// Plastic models: bulk modulus K (Pa).
+    pub bulk: f32,
+    /// Plastic models: cohesion c (Pa).
+    pub cohesion: f32,
+    /// Mohr–Coulomb: sin φ, cos φ, sin ψ.
+    pub sin_phi: f32,
+    pub cos_phi: f32,
+    pub sin_psi: f32,
+    /// Plastic models: tension cutoff t (Pa); negative: none.
+    pub tension: f32,
+    /// Drucker–Prager: α, ᾱ and k (Pa) of the plane-strain match.
+    pub dp_alpha: f32,
+    pub dp_alpha_psi: f32,
+    pub dp_k: f32,
+    pub _pad: f32,
 }
 
 /// Material model codes (shared/material.wgsl).
 pub const MODEL_LINEAR_ELASTIC: u32 = 0;
 pub const MODEL_NEO_HOOKEAN: u32 = 1;
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 32);
+pub const MODEL_MOHR_COULOMB: u32 = 2;
+pub const MODEL_DRUCKER_PRAGER: u32 = 3;
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

@@ -239,6 +239,10 @@ impl GpuBackend {
             let f: Vec<f32> = p.f.iter().flat_map(|f| f.map(|c| c as f32)).collect();
             q.write_buffer(self.buffers.get(Buf::DefGrad), 0, bytemuck::cast_slice(&f));
         }
+        if !p.plastic.is_empty() {
+            let pl: Vec<f32> = p.plastic.iter().flat_map(|q| q.map(|c| c as f32)).collect();
+            q.write_buffer(self.buffers.get(Buf::Plastic), 0, bytemuck::cast_slice(&pl));
+        }
         let rho: Vec<f32> = p.rho.iter().map(|r| *r as f32).collect();
         q.write_buffer(self.buffers.get(Buf::Rho), 0, bytemuck::cast_slice(&rho));
         let s: Vec<f32> = p.stress.iter().flat_map(|s| s.map(|c| c as f32)).collect();
@@ -542,6 +546,10 @@ impl Backend for GpuBackend {
             if def_grad {
                 want.push(Buf::DefGrad);
             }
+            let plastic = !self.model.particles.plastic.is_empty();
+            if plastic {
+                want.push(Buf::Plastic);
+            }
             let b = self.read(&want)?;
             let p = &mut self.model.particles;
             let n = p.len();
@@ -567,6 +575,12 @@ impl Backend for GpuBackend {
                 let g = b.f32s(Buf::DefGrad);
                 for (i, f) in p.f.iter_mut().enumerate() {
                     *f = std::array::from_fn(|c| g[4 * i + c] as f64);
+                }
+            }
+            if plastic {
+                let g = b.f32s(Buf::Plastic);
+                for (i, q) in p.plastic.iter_mut().enumerate() {
+                    *q = std::array::from_fn(|c| g[4 * i + c] as f64);
                 }
             }
             self.fresh = true;

@@ -156,11 +156,16 @@ pub struct Variant {
     /// Material models compiled in.
     pub linear_elastic: bool,
     pub neo_hookean: bool,
+    pub mohr_coulomb: bool,
+    pub drucker_prager: bool,
     /// Particles carry a deformation gradient F (`Particles::f`, the
     /// `DefGrad` buffer): some material needs it. Neo-Hookean does today;
     /// a finite-strain plastic model would too, which is why this is not
     /// the `neo_hookean` flag.
     pub def_grad: bool,
+    /// Particles carry a plastic state (`Particles::plastic`, the `Plastic`
+    /// buffer): some material is plastic.
+    pub plastic: bool,
     /// A manufactured solution's body force is applied.
     pub mms: bool,
     /// MLS reconstruction at Gauss points.
@@ -183,7 +188,16 @@ impl Variant {
                 .materials
                 .iter()
                 .any(|m| matches!(m, Material::NeoHookean(_))),
+            mohr_coulomb: model
+                .materials
+                .iter()
+                .any(|m| matches!(m, Material::MohrCoulomb(_))),
+            drucker_prager: model
+                .materials
+                .iter()
+                .any(|m| matches!(m, Material::DruckerPrager(_))),
             def_grad: !model.particles.f.is_empty(),
+            plastic: !model.particles.plastic.is_empty(),
             lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
             shape: model.shape.kind(),
             integrator: model.integrator,
@@ -218,7 +232,10 @@ impl Variant {
             .flag("LME_STORED", self.lme_stored)
             .flag("MAT_LINEAR_ELASTIC", self.linear_elastic)
             .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
+            .flag("MAT_MOHR_COULOMB", self.mohr_coulomb)
+            .flag("MAT_DRUCKER_PRAGER", self.drucker_prager)
             .flag("DEF_GRAD", self.def_grad)
+            .flag("PLASTIC", self.plastic)
             .flag("MMS", self.mms)
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
@@ -559,7 +576,10 @@ mod tests {
                                 lme_stored: false,
                                 linear_elastic: !neo_hookean || multi_material,
                                 neo_hookean,
+                                mohr_coulomb: false,
+                                drucker_prager: false,
                                 def_grad: neo_hookean,
+                                plastic: false,
                                 mms,
                                 mls: false,
                                 walls: mms,

@@ -90,6 +90,18 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/material_neo_hookean.wgsl"),
     ),
     (
+        "shared/material_plastic.wgsl",
+        include_str!("../../shaders/shared/material_plastic.wgsl"),
+    ),
+    (
+        "shared/material_mohr_coulomb.wgsl",
+        include_str!("../../shaders/shared/material_mohr_coulomb.wgsl"),
+    ),
+    (
+        "shared/material_drucker_prager.wgsl",
+        include_str!("../../shaders/shared/material_drucker_prager.wgsl"),
+    ),
+    (
         "step_begin.wgsl",
         include_str!("../../shaders/step_begin.wgsl"),
     ),
@@ -151,6 +163,16 @@ pub fn expand(path: &str, defines: &Defines) -> Result<String, String> {
     let mut out = String::new();
     let mut seen = BTreeSet::new();
     expand_into(path, defines, &mut out, &mut seen)?;
+    Ok(out)
+}
+
+/// Expands WGSL `text` (named `name` in errors) with `defines`: its
+/// includes come from `SOURCES`. For kernels that are not passes, such as
+/// the material test harness (`tests/material_returns.rs`).
+pub fn expand_text(text: &str, name: &str, defines: &Defines) -> Result<String, String> {
+    let mut out = String::new();
+    let mut seen = BTreeSet::new();
+    expand_source(text, name, defines, &mut out, &mut seen)?;
     Ok(out)
 }
 

@@ -28,6 +28,7 @@ impl Energy {
                 * model.material_of(i).strain_energy_density(
                     &p.stress[i],
                     p.f.get(i).unwrap_or(&[1.0, 0.0, 0.0, 1.0]),
+                    p.plastic.get(i).unwrap_or(&[0.0; 4]),
                 ),
             gravity_work_bound: (p.mass[i] * g
                 + model

@@ -167,6 +167,7 @@ impl Model {
             matches!(integrator, Integrator::Npc { .. }),
             matches!(shape, Shape::Lme(_)),
             materials.iter().any(Material::needs_deformation_gradient),
+            materials.iter().any(Material::needs_plastic_state),
         );
 
         let constraints = build_constraints(scene, &grid)?;

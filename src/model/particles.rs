@@ -1,6 +1,8 @@
 //! Particle state as a structure of arrays, one `Vec` per field, holding only
-//! the fields the scene uses: `a` only for NPC, `lambda` only for LME.
+//! the fields the scene uses: `a` only for NPC, `lambda` only for LME,
+//! `f` only for finite-strain materials, `plastic` only for plastic ones.
 
+use crate::model::material::PlasticState;
 use crate::scene::seed::Seed;
 
 #[derive(Debug, Clone, Default)]
@@ -21,6 +23,9 @@ pub struct Particles {
     pub lambda: Vec<[f64; 2]>,
     /// Deformation gradient [xx, xy, yx, yy]; only when a material needs it, else empty.
     pub f: Vec<[f64; 4]>,
+    /// Plastic state [σzz (Pa), ε̄p, εp_v, last return's active surfaces]
+    /// (`material::plastic`); only when a material is plastic, else empty.
+    pub plastic: Vec<PlasticState>,
     /// Body index (scene order).
     pub body: Vec<u32>,
     /// Initial position (m).
@@ -37,6 +42,7 @@ impl Particles {
         with_acceleration: bool,
         with_lambda: bool,
         with_f: bool,
+        with_plastic: bool,
     ) -> Self {
         let n = seeds.len();
         let rho: Vec<f64> = seeds.iter().map(|s| density(s.body)).collect();
@@ -58,6 +64,11 @@ impl Particles {
             },
             f: if with_f {
                 vec![[1.0, 0.0, 0.0, 1.0]; n]
+            } else {
+                Vec::new()
+            },
+            plastic: if with_plastic {
+                vec![[0.0; 4]; n]
             } else {
                 Vec::new()
             },

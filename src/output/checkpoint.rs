@@ -24,8 +24,8 @@ use std::path::Path;
 /// File name in the output folder.
 pub const FILE: &str = "checkpoint.lmeck";
 const MAGIC: &[u8; 8] = b"LMEMPMCK";
-/// Bumped whenever the payload changes.
-pub const FORMAT: u32 = 1;
+/// Bumped whenever the payload changes (2: the plastic state).
+pub const FORMAT: u32 = 2;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -74,6 +74,7 @@ impl Checkpoint {
         e.list(&p.stress, |e, s| s.iter().for_each(|v| e.f64(*v)));
         e.pairs(&p.lambda);
         e.list(&p.f, |e, f| f.iter().for_each(|v| e.f64(*v)));
+        e.list(&p.plastic, |e, q| q.iter().for_each(|v| e.f64(*v)));
         e.list(&p.body, |e, b| e.u32(*b));
         e.pairs(&p.x0);
         e.list(&self.samples, |e, s| {
@@ -140,6 +141,7 @@ impl Checkpoint {
             stress: d.list(|d| Ok([d.f64()?, d.f64()?, d.f64()?]))?,
             lambda: d.pairs()?,
             f: d.list(|d| Ok([d.f64()?, d.f64()?, d.f64()?, d.f64()?]))?,
+            plastic: d.list(|d| Ok([d.f64()?, d.f64()?, d.f64()?, d.f64()?]))?,
             body: d.list(|d| d.u32())?,
             x0: d.pairs()?,
         };
@@ -162,14 +164,19 @@ impl Checkpoint {
             return Err(bad("has trailing bytes"));
         }
         let n = particles.len();
-        let fields_ok = [particles.v.len(), particles.mass.len(), particles.rho.len()]
+        let optional_ok = [particles.a.len(), particles.lambda.len()]
             .into_iter()
-            .chain([
-                particles.stress.len(),
-                particles.body.len(),
-                particles.x0.len(),
-            ])
-            .all(|l| l == n);
+            .chain([particles.f.len(), particles.plastic.len()])
+            .all(|l| l == 0 || l == n);
+        let fields_ok = optional_ok
+            && [particles.v.len(), particles.mass.len(), particles.rho.len()]
+                .into_iter()
+                .chain([
+                    particles.stress.len(),
+                    particles.body.len(),
+                    particles.x0.len(),
+                ])
+                .all(|l| l == n);
         if !fields_ok {
             return Err(bad("holds particle fields of different lengths"));
         }
@@ -306,6 +313,9 @@ mod tests {
             particles.rho.push(7833.0);
             particles.stress.push([1.0, 2.0, 3.0]);
             particles.f.push([1.0, 0.0, 0.0, 1.0]);
+            particles
+                .plastic
+                .push([-4.5e4, 0.0123 + i as f64, -1e-19, 5.0]);
             particles.body.push(i);
         }
         Checkpoint {
@@ -349,6 +359,7 @@ mod tests {
         assert_eq!(d.particles.v, c.particles.v);
         assert_eq!(d.particles.a, c.particles.a);
         assert_eq!(d.particles.f, c.particles.f);
+        assert_eq!(d.particles.plastic, c.particles.plastic);
         assert_eq!(d.particles.body, c.particles.body);
         assert!(d.particles.lambda.is_empty());
         assert_eq!((d.t, d.dt, d.steps), (c.t, c.dt, c.steps));

@@ -60,13 +60,22 @@ pub fn reactions(names: &[String], samples: &[Sample]) -> String {
     s
 }
 
-/// `id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume` (m, m/s, Pa, kg/m, m²).
+/// `id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume` (m, m/s, Pa, kg/m, m²),
+/// then with a plastic material `,szz,eps_p,eps_pv,plastic`: σzz (Pa),
+/// equivalent and volumetric plastic strain, and the surfaces active in the
+/// last step's return (bit mask, 0 = elastic; docs/outputs.md).
 /// `body_names` in scene order.
 pub fn particles(body_names: &[String], p: &Particles) -> String {
-    let mut s = String::with_capacity(p.len() * 160 + 64);
-    s.push_str("id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume\n");
+    let plastic = !p.plastic.is_empty();
+    let mut s = String::with_capacity(p.len() * if plastic { 240 } else { 160 } + 64);
+    s.push_str("id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume");
+    s.push_str(if plastic {
+        ",szz,eps_p,eps_pv,plastic\n"
+    } else {
+        "\n"
+    });
     for i in 0..p.len() {
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             i,
@@ -83,6 +92,11 @@ pub fn particles(body_names: &[String], p: &Particles) -> String {
             p.mass[i],
             p.volume(i)
         );
+        if plastic {
+            let q = &p.plastic[i];
+            let _ = write!(s, ",{},{},{},{}", q[0], q[1], q[2], q[3] as u32);
+        }
+        s.push('\n');
     }
     s
 }

@@ -22,6 +22,21 @@ pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
     arrays.push(("displacement", "Float32", 3, f32s(&mut disp)));
     let mut sig = (0..n).flat_map(|i| p.stress[i]);
     arrays.push(("stress_xx_yy_xy", "Float32", 3, f32s(&mut sig)));
+    if !p.plastic.is_empty() {
+        // σzz, ε̄p, εp_v and the last return's active surfaces (0 = elastic).
+        let mut szz = p.plastic.iter().map(|q| q[0]);
+        arrays.push(("stress_zz", "Float32", 1, f32s(&mut szz)));
+        let mut eq = p.plastic.iter().map(|q| q[1]);
+        arrays.push(("plastic_strain_eq", "Float32", 1, f32s(&mut eq)));
+        let mut vol = p.plastic.iter().map(|q| q[2]);
+        arrays.push(("plastic_strain_vol", "Float32", 1, f32s(&mut vol)));
+        let ret: Vec<u8> = p
+            .plastic
+            .iter()
+            .flat_map(|q| (q[3] as i32).to_le_bytes())
+            .collect();
+        arrays.push(("plastic", "Int32", 1, ret));
+    }
     let mut rho = p.rho.iter().copied();
     arrays.push(("density", "Float32", 1, f32s(&mut rho)));
     let mut speed = (0..n).map(|i| p.v[i][0].hypot(p.v[i][1]));

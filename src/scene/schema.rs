@@ -77,6 +77,22 @@ pub enum MaterialModel {
     LinearElastic,
     /// Compressible Neo-Hookean on the deformation gradient (finite strain).
     NeoHookean,
+    /// Elastic-perfectly plastic Mohr–Coulomb (plane strain, Jaumann rate),
+    /// with a Rankine tension cutoff.
+    MohrCoulomb,
+    /// Elastic-perfectly plastic Drucker–Prager matched to Mohr–Coulomb in
+    /// plane strain, with a tension cap on the mean stress.
+    DruckerPrager,
+}
+
+impl MaterialModel {
+    /// The model has a yield surface (and the keys below).
+    pub fn is_plastic(self) -> bool {
+        matches!(
+            self,
+            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager
+        )
+    }
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -90,6 +106,18 @@ pub struct MaterialSpec {
     pub youngs_modulus: f64,
     /// Poisson's ratio ν, in [0, 0.5).
     pub nu: f64,
+    /// Plastic models only: cohesion c (Pa), ≥ 0. Required.
+    pub cohesion: Option<f64>,
+    /// Plastic models only: friction angle φ (degrees), in [0, 90). Required.
+    pub friction_angle: Option<f64>,
+    /// Plastic models only: dilation angle ψ (degrees), in [0, φ].
+    /// Default 0 (non-associated, no plastic volume change).
+    pub dilation_angle: Option<f64>,
+    /// Plastic models only: tension cutoff t (Pa), in [0, c / tan φ].
+    /// Mohr–Coulomb: the largest principal stress σ1 ≤ t (Rankine);
+    /// Drucker–Prager: the mean stress p ≤ t. Default: the apex c / tan φ
+    /// (no cutoff when φ = 0).
+    pub tension_cutoff: Option<f64>,
 }
 
 /// How particles are placed inside each grid cell.

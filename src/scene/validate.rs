@@ -228,6 +228,83 @@ fn check_materials(file: &SceneFile) -> Result<(), SceneError> {
                 format!("must be in (-1, 0.5), got {}", m.nu),
             ));
         }
+        check_plastic_keys(m, &key)?;
+    }
+    Ok(())
+}
+
+/// The yield keys: required by the plastic models (cohesion, friction
+/// angle), in range, and refused on the elastic ones.
+fn check_plastic_keys(m: &MaterialSpec, key: &dyn Fn(&str) -> String) -> Result<(), SceneError> {
+    let given = [
+        ("cohesion", m.cohesion),
+        ("friction_angle", m.friction_angle),
+        ("dilation_angle", m.dilation_angle),
+        ("tension_cutoff", m.tension_cutoff),
+    ];
+    if !m.model.is_plastic() {
+        if let Some((k, _)) = given.iter().find(|(_, v)| v.is_some()) {
+            return Err(SceneError::invalid(
+                key(k),
+                "applies only to model = \"mohr_coulomb\" or \"drucker_prager\"; remove it for an elastic material",
+            ));
+        }
+        return Ok(());
+    }
+    let required = |k: &str, v: Option<f64>| {
+        v.ok_or_else(|| {
+            SceneError::invalid(
+                key(k),
+                "is required for model = \"mohr_coulomb\" and \"drucker_prager\"",
+            )
+        })
+    };
+    let c = required("cohesion", m.cohesion)?;
+    finite(&key("cohesion"), c)?;
+    if c < 0.0 {
+        return Err(SceneError::invalid(
+            key("cohesion"),
+            format!("must be ≥ 0 Pa, got {c}"),
+        ));
+    }
+    let phi = required("friction_angle", m.friction_angle)?;
+    finite(&key("friction_angle"), phi)?;
+    if !(0.0..90.0).contains(&phi) {
+        return Err(SceneError::invalid(
+            key("friction_angle"),
+            format!("must be in [0, 90) degrees, got {phi}"),
+        ));
+    }
+    if let Some(psi) = m.dilation_angle {
+        finite(&key("dilation_angle"), psi)?;
+        if !(0.0..=phi).contains(&psi) {
+            return Err(SceneError::invalid(
+                key("dilation_angle"),
+                format!("must be in [0, friction_angle = {phi}] degrees, got {psi}"),
+            ));
+        }
+    }
+    if let Some(t) = m.tension_cutoff {
+        finite(&key("tension_cutoff"), t)?;
+        if t < 0.0 {
+            return Err(SceneError::invalid(
+                key("tension_cutoff"),
+                format!("must be ≥ 0 Pa, got {t}"),
+            ));
+        }
+        if phi > 0.0 {
+            let apex = c / phi.to_radians().tan();
+            // A value written from a hand-computed apex may round a few ulps
+            // above it; the material clamps t to the apex.
+            if t > apex * (1.0 + 1e-9) {
+                return Err(SceneError::invalid(
+                    key("tension_cutoff"),
+                    format!(
+                        "must not exceed the apex c / tan(friction_angle) = {apex} Pa, got {t}"
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }

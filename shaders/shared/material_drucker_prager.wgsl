@@ -1,0 +1,63 @@
+// Elastic-perfectly plastic Drucker–Prager matched to Mohr–Coulomb in plane
+// strain (α, ᾱ, k in Material), with a cap p ≤ t on the mean stress:
+// Jaumann trial, cone return, cap or corner. CPU twin:
+// src/model/material/drucker_prager.rs.
+#include "shared/material_plastic.wgsl"
+
+struct DpReturn {
+    s: vec4<f32>,
+    surfaces: u32,
+}
+
+// (p, sqrt J2) of (xx, yy, zz, xy).
+fn dp_p_sqrt_j2(s: vec4<f32>) -> vec2<f32> {
+    let p = (s.x + s.y + s.z) / 3.0;
+    let d = s.xyz - vec3<f32>(p);
+    return vec2<f32>(p, sqrt(0.5 * dot(d, d) + s.w * s.w));
+}
+
+// t with mean stress p_new and sqrt J2 scaled from sj2 to sj2_new.
+fn dp_with(t: vec4<f32>, p: f32, sj2: f32, p_new: f32, sj2_new: f32) -> vec4<f32> {
+    var r = 0.0;
+    if sj2 > 0.0 {
+        r = sj2_new / sj2;
+    }
+    return vec4<f32>(vec3<f32>(p_new) + r * (t.xyz - vec3<f32>(p)), r * t.w);
+}
+
+fn dp_return(m: Material, t: vec4<f32>) -> DpReturn {
+    let inv = dp_p_sqrt_j2(t);
+    let p = inv.x;
+    let sj2 = inv.y;
+    let f = sj2 + 3.0 * m.dp_alpha * p - m.dp_k;
+    let has_cap = m.tension >= 0.0;
+    let cap = m.tension;
+    if f <= 0.0 && (!has_cap || p <= cap) {
+        return DpReturn(t, 0u);
+    }
+    if f > 0.0 {
+        let dg = f / (m.shear + 9.0 * m.bulk * m.dp_alpha * m.dp_alpha_psi);
+        let sj2_new = sj2 - m.shear * dg;
+        let p_new = p - 3.0 * m.bulk * m.dp_alpha_psi * dg;
+        if sj2_new >= 0.0 && (!has_cap || p_new <= cap) {
+            return DpReturn(dp_with(t, p, sj2, p_new, sj2_new), ACTIVE_MAIN);
+        }
+    }
+    if has_cap && p > cap && sj2 + 3.0 * m.dp_alpha * cap - m.dp_k <= 0.0 {
+        return DpReturn(dp_with(t, p, sj2, cap, sj2), ACTIVE_T1);
+    }
+    let sj2_new = max(m.dp_k - 3.0 * m.dp_alpha * cap, 0.0);
+    return DpReturn(dp_with(t, p, sj2, cap, min(sj2_new, sj2)), ACTIVE_MAIN | ACTIVE_T1);
+}
+
+fn drucker_prager_update(m: Material, l: vec4<f32>, dt: f32, s: vec3<f32>, f: vec4<f32>, q: vec4<f32>) -> MatUpdate {
+    var r = MatUpdate(s, f, q, 1.0, 0u);
+    if !plastic_volume_ratio(&r, l, dt) {
+        return r;
+    }
+    let t = jaumann_trial(m, l, dt, s, q.x);
+    let ret = dp_return(m, t);
+    r.s = vec3<f32>(ret.s.x, ret.s.y, ret.s.w);
+    r.q = plastic_record(m, q, t, ret.s, ret.surfaces);
+    return r;
+}

@@ -1,0 +1,189 @@
+//! What the elastoplastic models (Mohr–Coulomb, Drucker–Prager) share: the
+//! per-particle plastic state, the elastic trial stress on the Jaumann rate,
+//! the plastic strain measures and the elastic energy with σzz.
+//! WGSL twin: the helpers at the top of `shaders/shared/material.wgsl`
+//! (`jaumann_trial`, `plastic_increment`, `elastic_energy_3d`).
+
+/// Per-particle state of a plastic model:
+/// `[σzz (Pa), ε̄p, εp_v, return]`:
+/// - σzz: out-of-plane stress (plane strain: εzz = 0, but after yielding
+///   σzz ≠ ν(σxx + σyy), so it is carried);
+/// - ε̄p: accumulated equivalent plastic strain, Σ sqrt(2/3 Δεp : Δεp);
+/// - εp_v: accumulated volumetric plastic strain, Σ tr Δεp (dilation > 0);
+/// - return: the surfaces active in the last step's return as a bit mask
+///   (`ACTIVE_*`; 0 = the step was elastic), stored as a float.
+pub type PlasticState = [f64; 4];
+
+/// Index of each entry of `PlasticState`.
+pub const SZZ: usize = 0;
+pub const EPS_EQ: usize = 1;
+pub const EPS_VOL: usize = 2;
+pub const RETURN: usize = 3;
+
+/// Bits of `PlasticState[RETURN]`. Mohr–Coulomb, in the sorted principal
+/// stresses σ1 ≥ σ2 ≥ σ3: the main plane (σ1 with σ3), the plane of σ2 with
+/// σ3 (active with the main one on the edge σ1 = σ2), the plane of σ1 with
+/// σ2 (the edge σ2 = σ3), and the tension planes σi = t. Drucker–Prager
+/// uses `ACTIVE_MAIN` for the cone and `ACTIVE_T1` for the tension cap.
+/// The apex (with the default cutoff t = c / tan φ) is T1 | T2 | T3.
+pub const ACTIVE_MAIN: u32 = 1;
+pub const ACTIVE_EDGE_12: u32 = 2;
+pub const ACTIVE_EDGE_23: u32 = 4;
+pub const ACTIVE_T1: u32 = 8;
+pub const ACTIVE_T2: u32 = 16;
+pub const ACTIVE_T3: u32 = 32;
+pub const ACTIVE_APEX: u32 = ACTIVE_T1 | ACTIVE_T2 | ACTIVE_T3;
+
+/// Isotropic linear elasticity in 3D (the elastic part of the plastic models).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Elastic3 {
+    /// Lamé λ (Pa).
+    pub lame: f64,
+    /// Shear modulus G (Pa).
+    pub shear: f64,
+    /// Bulk modulus K = λ + 2G/3 (Pa).
+    pub bulk: f64,
+}
+
+impl Elastic3 {
+    pub fn new(youngs: f64, nu: f64) -> Self {
+        let lame = youngs * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let shear = youngs / (2.0 * (1.0 + nu));
+        Elastic3 {
+            lame,
+            shear,
+            bulk: lame + 2.0 * shear / 3.0,
+        }
+    }
+
+    /// Elastic trial stress on the Jaumann rate, plane strain:
+    /// σ_trial = σ + Δt (Wσ − σW) + D : Δε with W = skew(L), Δε = Δt sym(L),
+    /// Δεzz = 0. Returns ([σxx, σyy, σxy], σzz). `l` = [xx, xy, yx, yy].
+    #[inline]
+    pub fn jaumann_trial(&self, l: [f64; 4], dt: f64, s: &[f64; 3], szz: f64) -> ([f64; 3], f64) {
+        // W = [[0, w], [−w, 0]]: (Wσ − σW) = w [2σxy, −2σxy, σyy − σxx].
+        let w = 0.5 * dt * (l[1] - l[2]);
+        let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+        let vol = self.lame * (de[0] + de[1]);
+        (
+            [
+                s[0] + 2.0 * w * s[2] + vol + 2.0 * self.shear * de[0],
+                s[1] - 2.0 * w * s[2] + vol + 2.0 * self.shear * de[1],
+                s[2] + w * (s[1] - s[0]) + 2.0 * self.shear * de[2],
+            ],
+            szz + vol,
+        )
+    }
+
+    /// The plastic strain of a return from `trial` to `s` (both
+    /// [xx, yy, zz, xy]): Δεp = C : (σ_trial − σ) (the elastic strain the
+    /// return removed). Returns (Δε̄p = sqrt(2/3 Δεp : Δεp), Δεp_v = tr Δεp).
+    #[inline]
+    pub fn plastic_increment(&self, trial: [f64; 4], s: [f64; 4]) -> (f64, f64) {
+        let d = [
+            trial[0] - s[0],
+            trial[1] - s[1],
+            trial[2] - s[2],
+            trial[3] - s[3],
+        ];
+        let dp = (d[0] + d[1] + d[2]) / 3.0;
+        let g2 = 2.0 * self.shear;
+        let dev = [
+            (d[0] - dp) / g2,
+            (d[1] - dp) / g2,
+            (d[2] - dp) / g2,
+            d[3] / g2,
+        ];
+        let dv = dp / self.bulk;
+        let e = [dev[0] + dv / 3.0, dev[1] + dv / 3.0, dev[2] + dv / 3.0];
+        let norm2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + 2.0 * dev[3] * dev[3];
+        ((2.0 / 3.0 * norm2).sqrt(), dv)
+    }
+
+    /// Elastic energy per unit volume of the stress `s` = [xx, yy, zz, xy]:
+    /// ½ σ : C : σ = s : s / (4G) + p² / (2K) (J/m³).
+    #[inline]
+    pub fn energy(&self, s: [f64; 4]) -> f64 {
+        let p = (s[0] + s[1] + s[2]) / 3.0;
+        let d = [s[0] - p, s[1] - p, s[2] - p];
+        let ss = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * s[3] * s[3];
+        ss / (4.0 * self.shear) + p * p / (2.0 * self.bulk)
+    }
+}
+
+/// Volume ratio of a small-strain step, 1 + tr Δε, or the fault it signals.
+#[inline]
+pub fn volume_ratio(l: [f64; 4], dt: f64) -> Result<f64, crate::model::fault::FaultKind> {
+    use crate::model::fault::FaultKind;
+    let j = 1.0 + dt * (l[0] + l[3]);
+    if j.is_nan() {
+        return Err(FaultKind::NonFinite { field: "strain" });
+    }
+    if j <= 0.0 {
+        return Err(FaultKind::NonPositiveDensity);
+    }
+    Ok(j)
+}
+
+/// Adds a return's plastic strain to `q` and records its active surfaces.
+#[inline]
+pub fn record(q: &mut PlasticState, e: &Elastic3, trial: [f64; 4], s: [f64; 4], active: u32) {
+    let (deq, dvol) = if active == 0 {
+        (0.0, 0.0)
+    } else {
+        e.plastic_increment(trial, s)
+    };
+    q[SZZ] = s[2];
+    q[EPS_EQ] += deq;
+    q[EPS_VOL] += dvol;
+    q[RETURN] = active as f64;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::material::LinearElastic;
+
+    #[test]
+    fn energy_matches_plane_strain_linear_elastic() {
+        let e = Elastic3::new(2.0e7, 0.3);
+        let le = LinearElastic::new(2.0e7, 0.3, 1000.0);
+        let s = [-1.2e5, 3.0e4, 2.5e4];
+        let szz = 0.3 * (s[0] + s[1]);
+        let w3 = e.energy([s[0], s[1], szz, s[2]]);
+        let w2 = le.strain_energy_density(&s);
+        assert!((w3 - w2).abs() < 1e-12 * w2.abs(), "{w3} vs {w2}");
+    }
+
+    #[test]
+    fn jaumann_trial_without_spin_is_the_linear_elastic_step() {
+        let e = Elastic3::new(2.0e7, 0.3);
+        let le = LinearElastic::new(2.0e7, 0.3, 1000.0);
+        let s = [-1.0e5, 2.0e4, 3.0e4];
+        let (l, dt) = ([0.3, 0.2, 0.2, -0.1], 1e-4);
+        let (t, tzz) = e.jaumann_trial(l, dt, &s, 0.3 * (s[0] + s[1]));
+        let mut r = s;
+        le.update_stress(&mut r, [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])]);
+        for k in 0..3 {
+            assert!((t[k] - r[k]).abs() < 1e-9, "{t:?} vs {r:?}");
+        }
+        // σzz follows ν(σxx + σyy) while elastic.
+        assert!((tzz - 0.3 * (t[0] + t[1])).abs() < 1e-9);
+    }
+
+    #[test]
+    fn jaumann_spin_rotates_without_straining() {
+        // A rigid rotation (L skew) turns the stress, keeping its invariants
+        // to first order: tr and the in-plane norm change by O(Δt²).
+        let e = Elastic3::new(2.0e7, 0.3);
+        let s = [-1.0e5, 2.0e4, 3.0e4];
+        let omega = 2.0;
+        let (t, _) = e.jaumann_trial([0.0, omega, -omega, 0.0], 1e-4, &s, 0.0);
+        assert!((t[0] + t[1] - s[0] - s[1]).abs() < 1e-9);
+        let n0 = 0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2];
+        let n1 = 0.25 * (t[0] - t[1]).powi(2) + t[2] * t[2];
+        assert!((n1 - n0).abs() < 1e-6 * n0, "{n0} {n1}");
+        // σxy changes by Δt ω (σyy − σxx).
+        assert!((t[2] - s[2] - 1e-4 * omega * (s[1] - s[0])).abs() < 1e-9);
+    }
+}
