@@ -9,7 +9,7 @@
 use super::runner::{Job, JobResult};
 use super::{backend_slug, image, sig, table};
 use crate::cases::{COLUMN_COLLAPSE, GRANULAR_COLLAPSE};
-use crate::chart::{LineChart, Series};
+use crate::chart::{LineChart, Panel, ParticleImage, Series};
 use crate::error::Result;
 use crate::model::Particles;
 use crate::simulation::BackendChoice;
@@ -106,10 +106,21 @@ fn half_spacing(h: f64) -> f64 {
     0.5 * h / PPC
 }
 
-/// Run-out: the largest x reached by the material (particle centre plus
-/// half a spacing), m.
-pub fn run_out(p: &Particles, h: f64) -> f64 {
+/// The furthest particle's reach (centre plus half a spacing), m.
+pub fn front(p: &Particles, h: f64) -> f64 {
     p.x.iter().map(|x| x[0]).fold(f64::NEG_INFINITY, f64::max) + half_spacing(h)
+}
+
+/// Run-out: the right edge of the last column of width h (from x = 0)
+/// where the deposit is at least one cell (h) thick, m. A thin sheet of
+/// a few particles ahead of the deposit does not count, as in the
+/// experiments, where the run-out is the deposit's visible front.
+pub fn run_out(p: &Particles, h: f64) -> f64 {
+    profile(p, h)
+        .iter()
+        .filter(|(_, y)| *y >= h)
+        .map(|(x, _)| x + 0.5 * h)
+        .fold(0.0, f64::max)
 }
 
 /// Height: the largest y of the material, m.
@@ -121,7 +132,7 @@ pub fn height(p: &Particles, h: f64) -> f64 {
 /// highest particle in it (m); columns without particles end the profile
 /// at the run-out.
 pub fn profile(p: &Particles, h: f64) -> Vec<(f64, f64)> {
-    let reach = run_out(p, h);
+    let reach = front(p, h);
     let n = (reach / h).ceil().max(1.0) as usize;
     let mut top = vec![f64::NEG_INFINITY; n];
     for x in &p.x {
@@ -183,14 +194,15 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
          gravity applied at t = 0 (`cases/column_collapse.toml`; geometry read from the paper's Fig. 9). \
          2 × 2 particles per cell, NPC, CFL 0.3, on the paper's two meshes (h = 0.05 and 0.025 m). The \
          paper compares its implicit MPM and GMM with the SPH of Bui et al. (2008) by pictures only, so \
-         there is no exact figure: the table gives run-out and final height and how much they move \
-         between meshes.\n",
+         there is no exact figure: the table gives run-out (the front of the deposit where it is at \
+         least one cell thick) and final height, and how much they move between meshes.\n",
         COLUMN.0, COLUMN.1
     );
 
     // --- profiles, one chart per time -----------------------------------------
     for &t in times {
-        let stem = format!("study-column-profile-t{t:.2}");
+        // No dot in the stem: the chart writer sets the extension.
+        let stem = format!("study-column-profile-{:.0}ms", t * 1e3);
         let mut c = LineChart::new(
             format!("Column collapse ({main}): free surface at t = {t:.2} s"),
             "x (m)",
@@ -215,6 +227,39 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         ));
     }
     md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+
+    // --- equivalent plastic strain, LME on the finest mesh -------------------
+    let h_fine = meshes[meshes.len() - 1];
+    if let Some(r) = get("lme-g1.8", h_fine) {
+        let panels: Vec<Panel> = times
+            .iter()
+            .filter_map(|&t| {
+                let p = at(r, t)?;
+                Some(Panel {
+                    title: format!("t = {t:.2} s"),
+                    points: (0..p.len())
+                        .map(|i| (p.x[i][0], p.x[i][1], p.plastic.get(i).map_or(0.0, |q| q[1])))
+                        .collect(),
+                    size: h_fine / PPC,
+                })
+            })
+            .collect();
+        if !panels.is_empty() {
+            let stem = "study-column-plastic-strain";
+            ParticleImage {
+                title: format!("Column, LME γ = 1.8, h = {h_fine} m: ε̄p"),
+                value_label: "ε̄p".into(),
+                cols: panels.len().min(2),
+                panels,
+                range: (0.0, 1.0),
+                panel_size: (420, 260),
+            }
+            .save(&dir.join(stem))?;
+            charts.push(dir.join(format!("{stem}.png")));
+            md.push_str(&image("equivalent plastic strain", &format!("{stem}.png")));
+            md.push_str("\nColour scale clamped at ε̄p = 1.\n\n");
+        }
+    }
 
     // --- run-out and height table ----------------------------------------------
     let t_last = times[times.len() - 1];
@@ -267,7 +312,8 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
              sits at the apex), φ = 30°, a = H/W = {}, h = 0.025 m, t_end = 2 s. Experiments on 2D \
              collapses give (L_f − L_0)/L_0 ≈ 1.2 a = {} for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. \
-             2005), with L_0 = W the initial length.\n",
+             2005), with L_0 = W the initial length and L_f the front of the deposit where it is at \
+             least one cell thick (the furthest particle is listed too).\n",
             sig(a),
             sig(1.2 * a)
         );
@@ -275,6 +321,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             "method",
             "status",
             "L_f (m)",
+            "furthest particle (m)",
             "(L_f − L_0)/L_0",
             "vs 1.2 a",
             "final height (m)",
@@ -299,6 +346,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                             m,
                             "completed".into(),
                             sig(lf),
+                            sig(front(p, 0.025)),
                             sig(ratio),
                             format!("{:+.0} %", 100.0 * (ratio / (1.2 * a) - 1.0)),
                             sig(height(p, 0.025)),
@@ -308,6 +356,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                     _ => vec![
                         m,
                         super::failure_text(r),
+                        "-".into(),
                         "-".into(),
                         "-".into(),
                         "-".into(),

@@ -10,6 +10,7 @@ use crate::scene::{Override, Scene};
 use crate::simulation::{BackendChoice, BackendSpec, Simulation};
 use crate::solver::{Observer, RunStatus, Schedule};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::borrow::Cow;
 use std::collections::VecDeque;
 use std::sync::Mutex;
 use std::time::Instant;
@@ -19,8 +20,9 @@ use std::time::Instant;
 pub struct Job {
     /// Unique within the study.
     pub label: String,
-    /// Scene file text (one of `cases`), its name, and overrides.
-    pub case: &'static str,
+    /// Scene file text (one of `cases`, or a study's variant of one), its
+    /// name, and overrides.
+    pub case: Cow<'static, str>,
     pub case_name: &'static str,
     pub sets: Vec<String>,
     pub backend: BackendChoice,
@@ -33,10 +35,14 @@ pub struct Job {
 }
 
 impl Job {
-    pub fn new(label: impl Into<String>, case: &'static str, case_name: &'static str) -> Self {
+    pub fn new(
+        label: impl Into<String>,
+        case: impl Into<Cow<'static, str>>,
+        case_name: &'static str,
+    ) -> Self {
         Job {
             label: label.into(),
-            case,
+            case: case.into(),
             case_name,
             sets: Vec::new(),
             backend: BackendChoice::Cpu,
@@ -154,7 +160,7 @@ fn run_one(job: &Job, threads: usize, gpu_lock: &Mutex<()>) -> Result<RunData, S
         .map(|s| Override::parse(s))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let scene = Scene::from_str(job.case, job.case_name, job.case_name, &overrides)
+    let scene = Scene::from_str(&job.case, job.case_name, job.case_name, &overrides)
         .map_err(|e| e.to_string())?;
     // GPU jobs share one adapter: run them one at a time.
     let _gpu = (job.backend != BackendChoice::Cpu)
