@@ -16,7 +16,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 #[derive(Parser)]
-#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC time integration, linear elastic and Neo-Hookean materials, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
+#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC time integration, elastic, Neo-Hookean and Mohr-Coulomb/Drucker-Prager materials, walls and loads, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -568,8 +568,17 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
                 .ok()
                 .and_then(|v| v.as_str().map(String::from))
                 .unwrap_or_default();
+            let mut plastic = String::new();
+            if let (Some(c), Some(phi)) = (m.cohesion, m.friction_angle) {
+                plastic = format!(
+                    ", c = {c} Pa, phi = {phi} deg, psi = {} deg, tension cutoff {}",
+                    m.dilation_angle.unwrap_or(0.0),
+                    m.tension_cutoff
+                        .map_or("at the apex".to_string(), |t| format!("{t} Pa"))
+                );
+            }
             format!(
-                "{n} ({model}, E = {} Pa, nu = {}, rho = {} kg/m^3)",
+                "{n} ({model}, E = {} Pa, nu = {}, rho = {} kg/m^3{plastic})",
                 m.youngs_modulus, m.nu, m.density
             )
         })

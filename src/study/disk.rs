@@ -99,8 +99,9 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
         j.snapshot_times = times.clone();
         j.backend = b;
         out.push(j);
-        // The wall's grid contact error is of order h/R: one linear run on
-        // a grid twice as fine (R/h = 40) shows it.
+        // The wall's grid contact error shrinks with the contact patch's
+        // width sqrt(2 R h): one linear run on a grid twice as fine
+        // (R/h = 40) shows by how much.
         if !quick {
             let mut j = Job::new(
                 format!("{}-linear-fine", backend_slug(b)),
@@ -128,7 +129,10 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
 /// is refused on a stick wall, and an override cannot remove a key).
 pub fn stick_variant() -> String {
     let from = "contact = \"friction\"\nfriction = 0.5";
-    assert!(ROLLING_DISK.contains(from), "cases/rolling_disk.toml changed");
+    assert!(
+        ROLLING_DISK.contains(from),
+        "cases/rolling_disk.toml changed"
+    );
     ROLLING_DISK.replace(from, "contact = \"stick\"")
 }
 
@@ -308,8 +312,8 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         "**Findings.** From Δt1 to Δt{}: {}. The explicit step is bounded by the Courant limit, far \
          below what the time integration's accuracy needs, so the error left is spatial, and the largest \
          part of it is the wall's grid contact: every node behind the plane that carries disk mass gets \
-         the Coulomb rule, so a patch about sqrt(2 R h) wide under the disk drags on it, an error of \
-         order h/R.{}\n",
+         the Coulomb rule, so a patch about sqrt(2 R h) wide under the disk drags on it; the error \
+         shrinks with that width, as sqrt(h) (halving h should divide it by about 1.4).{}\n",
         last + 1,
         spread.join("; "),
         match (
