@@ -334,6 +334,10 @@ fn memory(
         // The plastic state (σzz, ε̄p, εp_v, return).
         particle += 32.0;
     }
+    if !(f.tractions.is_empty() && f.point_loads.is_empty()) {
+        // model::ExternalForces: force and ramp time per particle.
+        particle += 24.0;
+    }
     // Shape cache (cpu::ShapeCache): a count and per slot a u32 and 3 f64.
     let slots = shape.max_nodes() as f64;
     let cache = 2.0 + slots * (4.0 + 24.0);
@@ -344,6 +348,11 @@ fn memory(
     let mut per_node = 40.0 + 1.0 + 40.0 * per_thread;
     if f.grid.perturb > 0.0 {
         per_node += 16.0;
+    }
+    if !f.walls.is_empty() {
+        // model::Walls: the node mask, and at most every node in each
+        // wall's node list.
+        per_node += 4.0 + 4.0 * f.walls.len() as f64;
     }
     let mut mls = 0.0;
     if f.solver.mls {

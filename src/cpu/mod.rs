@@ -123,6 +123,10 @@ impl CpuBackend {
         if !p.plastic.is_empty() {
             per += 32.0;
         }
+        if model.external.is_some() {
+            // Traction and point-load forces and their ramp times.
+            per += 24.0;
+        }
         if model.mls {
             // Sort order and cells per particle, the Gauss points' share.
             let slots = model.shape.max_nodes() as f64;
@@ -132,8 +136,15 @@ impl CpuBackend {
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
-        // Nodes: [m, qx, qy] and [fx, fy] in f64.
-        per + model.grid.n_nodes() as f64 * 40.0 / n
+        // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask
+        // and node lists.
+        let walls = if model.walls.is_empty() {
+            0.0
+        } else {
+            4.0 * model.grid.n_nodes() as f64
+                + 4.0 * model.walls.list.iter().map(|w| w.nodes.len()).sum::<usize>() as f64
+        };
+        per + (model.grid.n_nodes() as f64 * 40.0 + walls) / n
     }
 
     /// Time step the next `step` would take (s).
