@@ -418,11 +418,12 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             let _ = writeln!(
                 md,
                 "**Findings.** The simulated deposits run further than the experiments: \
-                 (L_f − L_0)/L_0 = {}–{} against 1.2 a = {}. We have not found why. Candidates, none \
-                 tested yet: a rate-independent Mohr–Coulomb law with ψ = 0 has no collisional \
-                 dissipation, which the μ(I) rheology that fits these experiments adds; the fast thin \
-                 front's particles dilate (their density falls, see methods.md) and stop resisting shear; \
-                 the stick floor acts on grid nodes, not on the grains' contact.\n",
+                 (L_f − L_0)/L_0 = {}–{} against 1.2 a = {}. We have not found why. A Coulomb floor \
+                 with μ = tan φ instead of the stick floor changes little, and associated flow (ψ = φ) \
+                 runs out further still (both tried on mesh 1 with linear shapes). Candidates not yet \
+                 tested: a rate-independent Mohr–Coulomb law has no collisional dissipation, which the \
+                 μ(I) rheology that fits these experiments adds; the fast thin front's particles dilate \
+                 (their density falls, see methods.md) and stop resisting shear.\n",
                 sig(lo),
                 sig(hi),
                 sig(1.2 * a)
