@@ -142,7 +142,13 @@ impl CpuBackend {
             0.0
         } else {
             4.0 * model.grid.n_nodes() as f64
-                + 4.0 * model.walls.list.iter().map(|w| w.nodes.len()).sum::<usize>() as f64
+                + 4.0
+                    * model
+                        .walls
+                        .list
+                        .iter()
+                        .map(|w| w.nodes.len())
+                        .sum::<usize>() as f64
         };
         per + (model.grid.n_nodes() as f64 * 40.0 + walls) / n
     }
