@@ -59,15 +59,8 @@ pub fn report(results: &[JobResult], dir: &Path, _quick: bool) -> Result<(String
     let scene = Scene::from_str(ELASTIC_BLOCK, "elastic_block", "elastic_block", &[])?;
     let model = Model::new(&scene)?;
     let exact = ElasticColumn::from_scene(&scene, &model);
-    let main = results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string();
-    let mine: Vec<&JobResult> = results
-        .iter()
-        .filter(|r| r.job.tag_value("backend") == Some(main.as_str()))
-        .collect();
+    let main = super::main_backend(results);
+    let mine = super::on_backend(results, &main);
     let mut charts = Vec::new();
     let mut md = String::new();
 

@@ -162,18 +162,11 @@ fn at(r: &JobResult, t: f64) -> Option<&Particles> {
 }
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
-    let main = results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string();
+    let main = super::main_backend(results);
     let mine = |case: &str| -> Vec<&JobResult> {
-        results
-            .iter()
-            .filter(|r| {
-                r.job.tag_value("backend") == Some(main.as_str())
-                    && r.job.tag_value("case") == Some(case)
-            })
+        super::on_backend(results, &main)
+            .into_iter()
+            .filter(|r| r.job.tag_value("case") == Some(case))
             .collect()
     };
     let cohesive = mine("cohesive");

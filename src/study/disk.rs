@@ -161,24 +161,11 @@ pub fn error_percent(exact: &RollingDisk, r: &JobResult) -> Option<f64> {
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let scene = Scene::from_str(ROLLING_DISK, "rolling_disk", "rolling_disk", &[])?;
     let exact = RollingDisk::from_scene(&scene);
-    let main = results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string();
-    let mine: Vec<&JobResult> = results
-        .iter()
-        .filter(|r| r.job.tag_value("backend") == Some(main.as_str()))
-        .collect();
-    let methods: Vec<&str> = {
-        let mut v: Vec<&str> = Vec::new();
-        for m in mine.iter().filter_map(|r| r.job.tag_value("method")) {
-            if !v.contains(&m) && m != "linear-fine" && m != "linear-stick" {
-                v.push(m);
-            }
-        }
-        v
-    };
+    let main = super::main_backend(results);
+    let mine = super::on_backend(results, &main);
+    // The table's methods; the stick and fine runs are reported in the text.
+    let mut methods = super::tag_values(mine.iter().copied(), "method");
+    methods.retain(|m| *m != "linear-fine" && *m != "linear-stick");
     let dts = steps(quick);
     let get = |m: &str, k: usize| {
         mine.iter().copied().find(|r| {

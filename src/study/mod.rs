@@ -121,13 +121,41 @@ pub fn backend_slug(b: BackendChoice) -> &'static str {
 
 /// The backends the study's runs used, in order of first appearance.
 pub fn backends_of(results: &[runner::JobResult]) -> Vec<&str> {
-    let mut b: Vec<&str> = Vec::new();
-    for name in results.iter().filter_map(|r| r.job.tag_value("backend")) {
-        if !b.contains(&name) {
-            b.push(name);
+    tag_values(results, "backend")
+}
+
+/// The values of tag `key` among `results`, in order of first appearance.
+pub fn tag_values<'a>(
+    results: impl IntoIterator<Item = &'a runner::JobResult>,
+    key: &str,
+) -> Vec<&'a str> {
+    let mut v: Vec<&str> = Vec::new();
+    for value in results.into_iter().filter_map(|r| r.job.tag_value(key)) {
+        if !v.contains(&value) {
+            v.push(value);
         }
     }
-    b
+    v
+}
+
+/// The backend a study's report is about: its first job's ("cpu" if none).
+pub fn main_backend(results: &[runner::JobResult]) -> String {
+    results
+        .first()
+        .and_then(|r| r.job.tag_value("backend"))
+        .unwrap_or("cpu")
+        .to_string()
+}
+
+/// The results of the jobs run on `backend`, in job order.
+pub fn on_backend<'a>(
+    results: &'a [runner::JobResult],
+    backend: &str,
+) -> Vec<&'a runner::JobResult> {
+    results
+        .iter()
+        .filter(|r| r.job.tag_value("backend") == Some(backend))
+        .collect()
 }
 
 /// Runs one study (or all) and writes its outputs.

@@ -131,11 +131,7 @@ pub fn departure(a: &Particles, b: &Particles) -> f64 {
 }
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
-    let main = results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string();
+    let main = super::main_backend(results);
     let hh = h(quick);
     let mut charts = Vec::new();
     let mut md = String::new();

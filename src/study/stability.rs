@@ -153,11 +153,7 @@ fn error_figure(r: &JobResult) -> Option<String> {
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let cols = columns(quick);
-    let main = results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string();
+    let main = super::main_backend(results);
     let cell = |ri: usize, ci: usize| {
         results.iter().find(|r| {
             r.job.tag_value("backend") == Some(main.as_str())
