@@ -26,7 +26,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let m = mass[p];
     let vol = m / rho[p];
     let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+#if MUSL
+    // MUSL: forces from σ^t, so the loads at t (eq. 24).
+    let b = m * body_force(p, sim.t + sim.t_lo);
+#else
     let b = m * body_force(p, sim.t + sim.t_lo + sim.dt);
+#endif
     let c = shape_ctx(p, x0[p] + u[p]);
     add_particle_forces(c, vol, s, b);
 }

@@ -1,5 +1,5 @@
 // Stage `g2p`: particle update and checks.
-// FE:  v += Δt Σ N f/m;  u += Δt Σ N v_I.
+// FE and MUSL:  v += Δt Σ N f/m;  u += Δt Σ N v_I.
 // NPC: a = Σ N f/m;  v += Δt a;  u += Δt Σ N v_I (+ ½ Δt² a), v_I corrected or
 //      predicted as NPC_POSITION_* says. Positions live as x0 + u, and u is a
 //      compensated (Kahan) sum u − u_lo: a slow, steady motion would otherwise

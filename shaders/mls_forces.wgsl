@@ -34,7 +34,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let gp = mls_gauss_point(g);
     let qg = gp.x * params.inv_h;
     let r = mls_cells_around(qg);
+#if MUSL
+    // MUSL: forces from σ^t, so the loads at t (eq. 24).
+    let t = sim.t + sim.t_lo;
+#else
     let t = sim.t + sim.t_lo + sim.dt;
+#endif
     var sig = vec3<f32>(0.0);
     var rb = vec2<f32>(0.0);
     for (var j = r.lo.y; j <= r.hi.y; j++) {

@@ -19,6 +19,9 @@
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
 @group(0) @binding({{B_U}}) var<storage, read> u: array<vec2<f32>>;
+#if MUSL
+@group(0) @binding({{B_X_START}}) var<storage, read> x_start: array<vec2<f32>>;
+#endif
 @group(0) @binding({{B_RHO}}) var<storage, read_write> rho: array<f32>;
 @group(0) @binding({{B_STRESS}}) var<storage, read_write> stress: array<f32>;
 #if FORCES
@@ -50,7 +53,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if sim.running == 0u || p >= params.n_particles {
         return;
     }
+#if MUSL
+    // MUSL runs the stress last, after g2p moved the particles: the weights
+    // are those of the step's start (eq. 34), as on the CPU's shape cache.
+    let c = shape_ctx(p, x_start[p]);
+#else
     let c = shape_ctx(p, x0[p] + u[p]);
+#endif
     // Velocity gradient L = Σ v ⊗ ∇N as (xx, xy, yx, yy).
     var l = vec4<f32>(0.0);
     for (var k = 0u; k < STENCIL; k++) {

@@ -409,6 +409,7 @@ pub fn profile_gpu(
     let n = model.particles.len() as f64;
     let lme = !model.particles.lambda.is_empty();
     let mls = model.mls;
+    let musl = model.integrator == crate::model::Integrator::Musl;
     let ctx = crate::gpu::context::open(&crate::gpu::context::AdapterRequest {
         name: adapter.map(str::to_string),
         allow_software: true,
@@ -416,7 +417,7 @@ pub fn profile_gpu(
     })?;
     let mut gpu = GpuBackend::with_options(ctx, model, case.gpu)?;
     gpu.advance_steps(1).map_err(halted)?;
-    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(lme, mls).collect();
+    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(lme, mls, musl).collect();
     // Cost of a submission and wait alone.
     let start = Instant::now();
     for _ in 0..20 {

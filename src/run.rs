@@ -586,6 +586,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         .join(", ");
     let integrator = match model.integrator {
         crate::model::Integrator::Fe => "fe".to_string(),
+        crate::model::Integrator::Musl => "musl (B-spline paper eqs. 28-37)".to_string(),
         crate::model::Integrator::Npc { gamma, position } => {
             format!("npc (gamma = {gamma}, position: {position:?})")
         }

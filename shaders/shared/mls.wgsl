@@ -87,6 +87,11 @@ fn mls_cells_around(q: vec2<f32>) -> CellRange {
 // Offset of particle p from a Gauss point at lattice point qg, in units of h,
 // and its weight: (Δx, Δy, w(|Δx|/2) w(|Δy|/2)). Needs the x0 and u bindings.
 fn mls_sample(p: u32, qg: vec2<f32>) -> vec3<f32> {
-    let d = (x0[p] + u[p]) * params.inv_h - qg;
+    return mls_sample_at(x0[p] + u[p], qg);
+}
+
+// `mls_sample` of a particle at position xp (m, grid-relative).
+fn mls_sample_at(xp: vec2<f32>, qg: vec2<f32>) -> vec3<f32> {
+    let d = xp * params.inv_h - qg;
     return vec3<f32>(d, mls_weight(0.5 * abs(d.x)) * mls_weight(0.5 * abs(d.y)));
 }

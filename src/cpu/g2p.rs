@@ -1,7 +1,8 @@
 //! Stage `g2p`: move the particles with the nodal solution (paper eqs. 22–23
 //! for FE, Algorithm 1 step 8 for NPC), then check each particle is still
 //! finite and inside the grid.
-//! FE:  v_p += Δt Σ N f/m;  x_p += Δt Σ N v_I (v_I after the momentum update).
+//! FE and MUSL:  v_p += Δt Σ N f/m;  x_p += Δt Σ N v_I (v_I after the
+//!      momentum update; B-spline paper eqs. 29–30).
 //! NPC: a_p = Σ N f/m;  v_p += Δt a_p;  x_p += Δt Σ N v_I + ½ Δt² a_p, with
 //!      v_I the corrected or the predicted nodal velocity (`NpcPosition`).
 //! GPU twin: `shaders/g2p.wgsl`.
@@ -52,7 +53,8 @@ pub fn g2p(
             v[0] += dt * acc[0];
             v[1] += dt * acc[1];
             match prm.integrator {
-                Integrator::Fe => {
+                // MUSL moves as FE does (B-spline paper eqs. 29–30).
+                Integrator::Fe | Integrator::Musl => {
                     x[0] += dt * vel[0];
                     x[1] += dt * vel[1];
                 }

@@ -77,6 +77,8 @@ pub struct Mls {
     /// Per Gauss point: [ρ, ρv*x, ρv*y] (p2g), then [σxx, σyy, σxy, ρbx, ρby] (forces).
     pub gp_mv: Vec<[f64; 3]>,
     pub gp_f: Vec<[f64; 5]>,
+    /// Per Gauss point: the remap's (ρ^t v^{t+1}) (MUSL, eq. 31).
+    pub gp_remap: Vec<[f64; 2]>,
     mv_scatter: Scatter<3>,
     f_scatter: Scatter<2>,
 }
@@ -120,6 +122,7 @@ impl Mls {
             coef: vec![[0.0; 3]; n_gp],
             gp_mv: vec![[0.0; 3]; n_gp],
             gp_f: vec![[0.0; 5]; n_gp],
+            gp_remap: vec![[0.0; 2]; n_gp],
             mv_scatter: Scatter::default(),
             f_scatter: Scatter::default(),
         })
@@ -386,6 +389,59 @@ impl Mls {
                 let o = &mut acc[node as usize];
                 o[0] += om * (-(s[0] * wk[1] + s[2] * wk[2]) + wk[0] * s[3]);
                 o[1] += om * (-(s[2] * wk[1] + s[1] * wk[2]) + wk[0] * s[4]);
+            }
+        });
+    }
+
+    /// MLS remap of MUSL (paper eqs. 31–32): fits ρ_p v_p at the Gauss
+    /// points with this step's coefficients and the particles' positions at
+    /// the step's start (as `p2g` packed them; the particles have moved
+    /// since), ρ the density at the step's start (ρ_p^t, not yet updated),
+    /// v the particles' new velocities, and replaces the nodal momentum of
+    /// `mv` by its quadrature Σ_g N_I(x_g) (ρv)_g ω_g. The masses stay
+    /// m_I^t, so `grid_update::predict` then gives v^L (eq. 33).
+    pub fn remap(&mut self, grid: &Grid, rho: &[f64], v: &[[f64; 2]], mv: &mut [[f64; 3]]) {
+        let order = &self.order;
+        self.packed
+            .par_iter_mut()
+            .zip(order)
+            .with_min_len(4096)
+            .for_each(|(out, &p)| {
+                let p = p as usize;
+                out[2] = rho[p] * v[p][0];
+                out[3] = rho[p] * v[p][1];
+            });
+        let mut vals = std::mem::take(&mut self.gp_remap);
+        let this = &*self;
+        vals.par_chunks_mut(4).enumerate().for_each(|(ic, val)| {
+            val.fill([0.0; 2]);
+            if !this.occupied[ic] {
+                return;
+            }
+            let c = &this.coef[4 * ic..4 * ic + 4];
+            this.neighbours(grid, ic, |q, d, w| {
+                for k in 0..4 {
+                    let phi = w[k] * (c[k][0] + c[k][1] * d[k][0] + c[k][2] * d[k][1]);
+                    val[k][0] += phi * q[2];
+                    val[k][1] += phi * q[3];
+                }
+            });
+        });
+        self.gp_remap = vals;
+        super::remap::clear_momentum(mv);
+        let (shape, gw, gv) = (&self.gp_shape, &self.gp_w, &self.gp_remap);
+        let coef = &self.coef;
+        self.mv_scatter.run(mv, gv.len(), |g, acc| {
+            if coef[g][0] == 0.0 {
+                return;
+            }
+            let (nodes, w) = shape.particle(g);
+            let val = gv[g];
+            for (&node, wk) in nodes.iter().zip(w) {
+                let nw = wk[0] * gw[g];
+                let o = &mut acc[node as usize];
+                o[1] += nw * val[0];
+                o[2] += nw * val[1];
             }
         });
     }

@@ -10,6 +10,7 @@ pub mod g2p;
 pub mod grid_update;
 pub mod mls;
 pub mod p2g;
+pub mod remap;
 pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
@@ -18,7 +19,7 @@ use crate::backend::{Backend, Halt, ProbeState, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
-use crate::solver::{STEP, Stage};
+use crate::solver::{Stage, stages};
 use scatter::Scatter;
 use std::sync::atomic::AtomicBool;
 
@@ -183,14 +184,16 @@ impl CpuBackend {
     /// One step: the stages of `solver::STEP` in order. The time advances
     /// only when every stage succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
-        for stage in STEP {
-            // Without MLS, shape_eval and p2g run as one pass, and stress
-            // and forces as another (as on the GPU).
+        // Without MLS, shape_eval and p2g run as one pass, and stress and
+        // forces as another where they follow each other (not in MUSL), as
+        // on the GPU.
+        let fuse = self.mls.is_none() && self.model.integrator != Integrator::Musl;
+        for stage in stages(self.model.integrator) {
             match stage {
                 Stage::ShapeEval if self.mls.is_none() => self.shape_eval_p2g()?,
                 Stage::P2g if self.mls.is_none() => {}
-                Stage::Stress if self.mls.is_none() => self.stress_forces()?,
-                Stage::Forces if self.mls.is_none() => {}
+                Stage::Stress if fuse => self.stress_forces()?,
+                Stage::Forces if fuse => {}
                 _ => self.run_stage(*stage)?,
             }
         }
@@ -203,10 +206,10 @@ impl CpuBackend {
         Ok(())
     }
 
-    /// Factor of a_p in p2g's predicted momentum: (1 − γ)Δt for NPC, 0 for FE.
+    /// Factor of a_p in p2g's predicted momentum: (1 − γ)Δt for NPC, 0 for FE and MUSL.
     fn p2g_accel(&self) -> f64 {
         match self.model.integrator {
-            Integrator::Fe => 0.0,
+            Integrator::Fe | Integrator::Musl => 0.0,
             Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
         }
     }
@@ -268,8 +271,15 @@ impl CpuBackend {
         let m = &mut self.model;
         let p = &mut m.particles;
         let gamma = match m.integrator {
-            Integrator::Fe => 1.0,
+            Integrator::Fe | Integrator::Musl => 1.0,
             Integrator::Npc { gamma, .. } => gamma,
+        };
+        // The forces' loads: at the step's end where the stress already is
+        // (update stress first), at its start for MUSL (σ^t, b^t: eq. 24).
+        let t_load = if m.integrator == Integrator::Musl {
+            self.t
+        } else {
+            self.t + self.dt
         };
         match stage {
             Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
@@ -312,14 +322,13 @@ impl CpuBackend {
                 &mut p.plastic,
             )?,
             Stage::Forces => {
-                // The stress is already at the step's end (t + Δt), so are the loads.
                 let body = body_force(
                     m.gravity,
                     &m.manufactured,
                     &m.external,
                     &p.x0,
                     &p.mass,
-                    self.t + self.dt,
+                    t_load,
                 );
                 if let Some(mls) = &mut self.mls {
                     mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
@@ -362,6 +371,27 @@ impl CpuBackend {
                     &mut p.v,
                     &mut p.a,
                 )?;
+            }
+            Stage::Remap => {
+                if let Some(mls) = &mut self.mls {
+                    mls.remap(&m.grid, &p.rho, &p.v, &mut self.mv);
+                } else {
+                    remap::remap(
+                        &self.cache,
+                        &p.mass,
+                        &p.v,
+                        &mut self.mv,
+                        &mut self.p2g_scatter,
+                    );
+                }
+                grid_update::predict(
+                    &mut self.mv,
+                    &m.constraints.fix,
+                    &m.constraints.groups,
+                    &m.walls,
+                    self.t + self.dt,
+                    self.mass_eps,
+                );
             }
         }
         Ok(())

@@ -53,10 +53,13 @@ pub enum Buf {
     Walls,
     WallMask,
     ExtForce,
+    /// MUSL: each particle's position at the step's start (grid-relative),
+    /// for the remap and the stress, which run after g2p has moved it.
+    XStart,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 34] = [
+    pub const ALL: [Buf; 35] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -91,6 +94,7 @@ impl Buf {
         Buf::Walls,
         Buf::WallMask,
         Buf::ExtForce,
+        Buf::XStart,
     ];
 
     pub fn binding(self) -> u32 {
@@ -265,6 +269,9 @@ fn particle_data(
     data.push((Buf::V, bytes(&flat2(&mut p.v.iter().map(|v| f32x2(*v))))));
     if matches!(model.integrator, Integrator::Npc { .. }) {
         data.push((Buf::A, bytes(&flat2(&mut p.a.iter().map(|v| f32x2(*v))))));
+    }
+    if model.integrator == Integrator::Musl {
+        data.push((Buf::XStart, vec![0u8; 8 * n]));
     }
     let to32 = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
     data.push((Buf::Mass, bytes(&to32(&p.mass))));

@@ -344,7 +344,7 @@ pub fn params(model: &Model) -> Params {
         .fold(f64::INFINITY, f64::min);
     let (t_end_hi, t_end_lo) = split_f64(model.t_end);
     let (gamma, p2g_accel) = match model.integrator {
-        Integrator::Fe => (1.0, 0.0),
+        Integrator::Fe | Integrator::Musl => (1.0, 0.0),
         Integrator::Npc { gamma, .. } => (gamma, 1.0 - gamma),
     };
     let gravity = model

@@ -36,6 +36,12 @@ pub enum Pass {
     MlsForces,
     GridCorrect,
     G2p,
+    /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
+    /// then scatter the new velocities from particles (`Remap`) or Gauss
+    /// points (`MlsRemap`).
+    RemapClear,
+    Remap,
+    MlsRemap,
     StepEnd,
     Probes,
     Energy,
@@ -56,7 +62,7 @@ enum Domain {
 }
 
 impl Pass {
-    pub const ALL: [Pass; 19] = [
+    pub const ALL: [Pass; 22] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -73,6 +79,9 @@ impl Pass {
         Pass::MlsForces,
         Pass::GridCorrect,
         Pass::G2p,
+        Pass::RemapClear,
+        Pass::Remap,
+        Pass::MlsRemap,
         Pass::StepEnd,
         Pass::Probes,
         Pass::Energy,
@@ -99,6 +108,8 @@ impl Pass {
             Pass::MlsFill => "mls_fill.wgsl",
             Pass::MlsP2g => "mls_p2g.wgsl",
             Pass::MlsForces => "mls_forces.wgsl",
+            Pass::RemapClear | Pass::Remap => "remap.wgsl",
+            Pass::MlsRemap => "mls_remap.wgsl",
         }
     }
 
@@ -106,8 +117,10 @@ impl Pass {
         match self {
             Pass::StepBegin | Pass::StepEnd | Pass::MlsScan => Domain::One,
             Pass::MlsClear => Domain::Cells,
-            Pass::MlsP2g | Pass::MlsForces => Domain::GaussPoints,
-            Pass::ClearGrid | Pass::GridPredict | Pass::GridCorrect => Domain::Nodes,
+            Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
+            Pass::ClearGrid | Pass::GridPredict | Pass::GridCorrect | Pass::RemapClear => {
+                Domain::Nodes
+            }
             Pass::Probes => Domain::Probes,
             _ => Domain::Particles,
         }
@@ -137,6 +150,8 @@ impl Pass {
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect => &[Pass::GridCorrect],
             Stage::G2p => &[Pass::G2p],
+            Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
+            Stage::Remap => &[Pass::RemapClear, Pass::Remap, Pass::GridPredict],
         }
     }
 }
@@ -239,7 +254,8 @@ impl Variant {
             .flag("MMS", self.mms)
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
-            .flag("EXT_FORCE", self.ext_force);
+            .flag("EXT_FORCE", self.ext_force)
+            .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
@@ -274,7 +290,12 @@ impl Variant {
             | Pass::MlsFill
             | Pass::MlsP2g
             | Pass::MlsForces => self.mls,
-            Pass::P2g | Pass::Forces | Pass::StressForces => !self.mls,
+            Pass::P2g | Pass::Forces => !self.mls,
+            // MUSL runs the stress last, apart from the forces.
+            Pass::StressForces => !self.mls && self.integrator != Integrator::Musl,
+            Pass::RemapClear => self.integrator == Integrator::Musl,
+            Pass::Remap => self.integrator == Integrator::Musl && !self.mls,
+            Pass::MlsRemap => self.integrator == Integrator::Musl && self.mls,
             _ => true,
         }
     }
@@ -293,7 +314,8 @@ pub fn lme_side(model: &Model) -> u32 {
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
     d.flag("CORRECT", pass == Pass::GridCorrect)
-        .flag("FORCES", pass == Pass::StressForces);
+        .flag("FORCES", pass == Pass::StressForces)
+        .flag("CLEAR", pass == Pass::RemapClear);
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
@@ -372,6 +394,7 @@ pub struct Pipelines {
     max_groups: u32,
     pub lme: bool,
     pub mls: bool,
+    pub musl: bool,
 }
 
 impl Pipelines {
@@ -483,6 +506,7 @@ impl Pipelines {
             max_groups: ctx.limits.max_compute_workgroups_per_dimension,
             lme,
             mls: model.mls,
+            musl: model.integrator == Integrator::Musl,
         })
     }
 
@@ -504,15 +528,21 @@ impl Pipelines {
         cpass.dispatch_workgroups(x, y, 1);
     }
 
-    /// The passes of one whole step, in `solver::STEP` order; without MLS
-    /// `stress` and `forces` run fused as `StressForces`.
-    pub fn step_passes(lme: bool, mls: bool) -> impl Iterator<Item = Pass> {
-        crate::solver::STEP
-            .iter()
+    /// The passes of one whole step, in the order of the integrator's
+    /// stage list (`solver::stages`); without MLS, and where `forces`
+    /// follows `stress` (not MUSL), the two run fused as `StressForces`.
+    pub fn step_passes(lme: bool, mls: bool, musl: bool) -> impl Iterator<Item = Pass> {
+        let fuse = !mls && !musl;
+        let list = if musl {
+            crate::solver::STEP_MUSL
+        } else {
+            crate::solver::STEP
+        };
+        list.iter()
             .flat_map(move |stage| Pass::for_stage(*stage, lme, mls).iter().copied())
             .filter_map(move |pass| match pass {
-                Pass::Stress if !mls => Some(Pass::StressForces),
-                Pass::Forces => None,
+                Pass::Stress if fuse => Some(Pass::StressForces),
+                Pass::Forces if fuse => None,
                 p => Some(p),
             })
             .chain([Pass::StepEnd])
@@ -520,7 +550,7 @@ impl Pipelines {
 
     /// Records the passes of one whole step.
     pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
-        for pass in Pipelines::step_passes(self.lme, self.mls) {
+        for pass in Pipelines::step_passes(self.lme, self.mls, self.musl) {
             self.dispatch(cpass, pass);
         }
     }

@@ -81,6 +81,11 @@ pub const SOURCES: &[(&str, &str)] = &[
         "mls_forces.wgsl",
         include_str!("../../shaders/mls_forces.wgsl"),
     ),
+    ("remap.wgsl", include_str!("../../shaders/remap.wgsl")),
+    (
+        "mls_remap.wgsl",
+        include_str!("../../shaders/mls_remap.wgsl"),
+    ),
     (
         "shared/material_linear_elastic.wgsl",
         include_str!("../../shaders/shared/material_linear_elastic.wgsl"),

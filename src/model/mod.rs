@@ -72,7 +72,12 @@ pub struct Constraints {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Integrator {
     Fe,
-    Npc { gamma: f64, position: NpcPosition },
+    Npc {
+        gamma: f64,
+        position: NpcPosition,
+    },
+    /// Modified update stress last (B-spline paper eqs. 28–37).
+    Musl,
 }
 
 impl Integrator {
@@ -80,6 +85,7 @@ impl Integrator {
         match self {
             Integrator::Fe => IntegratorKind::Fe,
             Integrator::Npc { .. } => IntegratorKind::Npc,
+            Integrator::Musl => IntegratorKind::Musl,
         }
     }
 }
@@ -159,6 +165,7 @@ impl Model {
                 gamma: f.solver.npc_gamma,
                 position: f.solver.npc_position,
             },
+            IntegratorKind::Musl => Integrator::Musl,
         };
         let particles = Particles::from_seeds(
             &seeds,

@@ -290,6 +290,12 @@ pub enum IntegratorKind {
     Fe,
     /// Newmark predictor-corrector (paper Algorithm 1).
     Npc,
+    /// Modified update stress last, the B-spline paper's update (eqs.
+    /// 28–37): nodal momentum update, FLIP particle velocity, position from
+    /// the updated nodal momentum, remap of the new particle velocities to
+    /// the nodes (by MLS with `solver.mls`), velocity gradient from the
+    /// remapped nodal velocity, then F, density and stress.
+    Musl,
 }
 
 /// Which nodal velocity moves the particles in the NPC particle update.
