@@ -2,7 +2,7 @@
 //! and on the GPU (f32), and every field the stage writes is compared. The
 //! particles are random, plus ones exactly on cell edges, within 1e-3 h of
 //! the grid's edge, and on Dirichlet nodes. Every shape function, both
-//! integrators, regular and perturbed grids, both atomic modes, one and two
+//! integrators and MUSL, regular and perturbed grids, both atomic modes, one and two
 //! materials.
 
 mod common;
@@ -14,7 +14,7 @@ use lme_mpm::gpu::{GpuBackend, GpuOptions};
 use lme_mpm::model::Model;
 use lme_mpm::rng::SplitMix64;
 use lme_mpm::scene::{Override, Scene};
-use lme_mpm::solver::{STEP, Stage};
+use lme_mpm::solver::{STEP, Stage, stages};
 
 /// The shape-function families the tolerances are set for: MLS (any shape
 /// with `solver.mls = true`) has its own, its forces and momenta coming from
@@ -66,6 +66,9 @@ struct StageTol {
     forces: f64,
     grid_correct: f64,
     g2p: f64,
+    /// MUSL's remap: the remapped nodal velocities (after the Dirichlet
+    /// conditions), relative to the largest.
+    remap: f64,
 }
 
 // The tables below are 10 times the worst relative difference measured on
@@ -89,6 +92,7 @@ const LINEAR_TOL: StageTol = StageTol {
     forces: 8e-6,       // 7.3e-7
     grid_correct: 6e-6, // 5.7e-7 (vx change)
     g2p: 4e-5,          // 3.0e-6 (velocity change)
+    remap: 1e-5,        // 9.8e-7 (MUSL, stages_match_musl)
 };
 const UGIMP_TOL: StageTol = StageTol {
     cfl: 5e-7,          // 4.7e-8
@@ -99,6 +103,7 @@ const UGIMP_TOL: StageTol = StageTol {
     forces: 7e-6,       // 6.1e-7
     grid_correct: 4e-6, // 3.4e-7
     g2p: 3e-5,          // 2.6e-6 (velocity change)
+    remap: 9e-6,        // 8.3e-7 (MUSL, stages_match_musl)
 };
 const LME_TOL: StageTol = StageTol {
     cfl: 7e-7,          // 6.9e-8
@@ -109,6 +114,7 @@ const LME_TOL: StageTol = StageTol {
     forces: 2e-4,       // 5.9e-5 (3.4x: see above)
     grid_correct: 4e-6, // 3.5e-7
     g2p: 2e-5,          // 1.8e-6 (velocity change)
+    remap: 7e-6,        // 6.4e-7 (MUSL, stages_match_musl)
 };
 /// Quadratic and cubic B-splines without MLS.
 const BSPLINE_TOL: StageTol = StageTol {
@@ -120,6 +126,7 @@ const BSPLINE_TOL: StageTol = StageTol {
     forces: 2e-5,       // 1.4e-6
     grid_correct: 5e-6, // 4.1e-7
     g2p: 2e-5,          // 1.1e-6 (position change)
+    remap: 6e-6,        // 6.0e-7 (MUSL, stages_match_musl)
 };
 /// Any shape with MLS (linear, B-splines).
 const MLS_TOL: StageTol = StageTol {
@@ -131,6 +138,7 @@ const MLS_TOL: StageTol = StageTol {
     forces: 2e-5,       // 1.4e-6
     grid_correct: 2e-5, // 1.9e-6
     g2p: 2e-5,          // 1.6e-6
+    remap: 1e-5,        // 9.2e-7 (MUSL, stages_match_musl)
 };
 /// λ from f32 Newton against f64 Newton, as |Δλ| h, for particles at least
 /// 0.1 h inside the grid: the f32 stop at |r| ≤ 1e-5 h leaves λ off by
@@ -419,12 +427,19 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
     cpu.set_time(t);
     let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
     let mut rep = Report { family, worst: 0.0 };
-    for &stage in STEP {
-        // The state every stage starts from is the CPU's.
+    for &stage in stages(cpu.model.integrator) {
+        // The state every stage starts from is the CPU's. (MUSL's remap and
+        // stress also read what this step's p2g left on the GPU: the
+        // positions at the step's start and, with MLS, the fit.)
         gpu.upload_state(&cpu.state());
         let before_p = cpu.model.particles.clone();
         let before_mv = cpu.mv.clone();
-        let needs_cache = lme && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
+        // MUSL's remap and stress run after g2p at the step's start
+        // positions: they read the LME cache made there, not a new one.
+        let musl_late = cpu.model.integrator == lme_mpm::model::Integrator::Musl
+            && matches!(stage, Stage::Remap | Stage::Stress);
+        let needs_cache =
+            lme && !musl_late && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
         if needs_cache {
             // GPU LME passes read (λ, log Z, J⁻¹) from lme_newton, warm-started from the CPU's λ.
             gpu.run_pass(Pass::LmeNewton);
@@ -576,6 +591,15 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                     tol.grid_correct,
                 );
             }
+            Stage::Remap => {
+                rep.check("remap: vx", rel_err(&col(1), &cpu_col(1), None), tol.remap);
+                rep.check("remap: vy", rel_err(&col(2), &cpu_col(2), None), tol.remap);
+                rep.check(
+                    "remap: node mass kept",
+                    rel_err(&col(0), &cpu_col(0), None),
+                    tol.p2g,
+                );
+            }
             Stage::G2p => {
                 let gp = gpu.particles().unwrap().clone();
                 let cp = &cpu.model.particles;
@@ -720,6 +744,63 @@ fn stages_match_mls() {
         "bspline2 npc mls, CAS atomics",
         &["solver.shape=bspline2", "solver.mls=true"],
         true,
+    );
+}
+
+/// MUSL (the B-spline paper's update): every stage in its order, the remap
+/// by MLS and by the step-start weights, the stress after g2p from the
+/// step-start positions, and the forces' loads at t.
+#[test]
+fn stages_match_musl() {
+    parity(
+        "bspline2 musl mls",
+        &[
+            "solver.shape=bspline2",
+            "solver.mls=true",
+            "solver.integrator=musl",
+        ],
+        false,
+    );
+    parity(
+        "bspline3 musl mls, neo-hookean, CAS atomics",
+        &[
+            "solver.shape=bspline3",
+            "solver.mls=true",
+            "solver.integrator=musl",
+            "materials.m.model=neo_hookean",
+        ],
+        true,
+    );
+    parity(
+        "bspline2 musl",
+        &["solver.shape=bspline2", "solver.integrator=musl"],
+        false,
+    );
+    parity(
+        "linear musl",
+        &["solver.shape=linear", "solver.integrator=musl"],
+        false,
+    );
+    parity(
+        "ugimp musl",
+        &["solver.shape=ugimp", "solver.integrator=musl"],
+        false,
+    );
+    parity(
+        "lme musl",
+        &["solver.shape=lme", "solver.integrator=musl"],
+        false,
+    );
+    let mut m = random_model_of(MMS_SCENE, &["solver.mls=true", "solver.integrator=musl"], 7);
+    for s in &mut m.particles.stress {
+        *s = [0.0; 3];
+    }
+    parity_of(
+        "mms bspline2 musl mls",
+        m,
+        false,
+        GpuOptions::default(),
+        0.0137,
     );
 }
 

@@ -197,7 +197,7 @@ fn mms_quick_every_method_converges_or_reports_why_not() {
         results.len(),
         lme_mpm::study::mms::METHODS.len() * lme_mpm::study::mms::CELLS_QUICK.len()
     );
-    for (label, _, _, _) in lme_mpm::study::mms::METHODS {
+    for (label, _, _) in lme_mpm::study::mms::METHODS {
         let get = |n: &str| {
             results
                 .iter()

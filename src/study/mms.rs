@@ -1,97 +1,146 @@
-//! Study `mms`: the manufactured 2D aligned vibration (B-spline paper,
-//! SPEC benchmark 4) at 8, 16, 32 and 64 cells per side, 3 × 3 particles per
-//! cell, Δt = 1e-5 s, T = 0.2 s, for linear, uGIMP, LME, bspline2,
-//! bspline2 + MLS, bspline3 and bspline3 + MLS (NPC). Errors are RMS over
-//! the particles (paper eq. 43) at T and, from a snapshot, after one period
-//! (2L/c = 0.02 s). Charts: log-log convergence of displacement, velocity and
-//! stress, and displacement error against wall time.
+//! Study `mms`: the B-spline paper's convergence study, the manufactured 2D
+//! aligned vibration (SPEC benchmark 4) at 8, 16, 32 and 64 cells per side,
+//! 3 × 3 particles per cell, 2 × 2 Gauss points per integration cell,
+//! Δt = 1e-5 s, T = 0.2 s, with the paper's update (MUSL, eqs. 28–37) for
+//! plain MPM (linear), bspline2, bspline3, and bspline2/3 + MLS. The paper
+//! prints E as "10e^7 Pa", so both readings run: 1e7 and 1e8 Pa. Errors are
+//! RMS over the particles (paper eq. 43) at T and, from a snapshot, after one
+//! period 2L/c. Charts: log-log convergence of displacement, velocity and
+//! stress per reading, and displacement error against wall time.
+//!
+//! The full sweep is 40 runs, several hours on 2 cores (a 64-cell MLS run
+//! alone is about an hour). `LME_MPM_MMS_CELLS=8,16,32` restricts the full
+//! sweep to those resolutions; the report says which ran.
 
 use super::runner::{Job, JobResult};
 use super::{backend_slug, backends_of, image, sig, table};
 use crate::cases::ALIGNED_VIBRATION;
 use crate::chart::{LineChart, Series};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::exact::Errors;
 use crate::exact::mms::{AlignedVibration, MmsErrors};
-use crate::scene::Scene;
+use crate::scene::{Override, Scene};
 use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// Cells per side.
 pub const CELLS_FULL: [usize; 4] = [8, 16, 32, 64];
-/// `--quick`: two resolutions, one period.
+/// `--quick`: two resolutions, one period, E = 1e7 Pa.
 pub const CELLS_QUICK: [usize; 2] = [8, 16];
-/// One period of the vibration, 2L/c (s), for L = 1 m and c = 100 m/s.
-pub const PERIOD: f64 = 0.02;
-/// The rate the paper reports for B-spline MPM with MLS, and our goal for
-/// bspline2 + MLS up to 64 cells (displacement).
+/// Restricts the full sweep's resolutions (comma-separated, from `CELLS_FULL`).
+pub const CELLS_ENV: &str = "LME_MPM_MMS_CELLS";
+/// The rate the paper reports for B-spline MPM with MLS, and the acceptance
+/// goal for bspline2 + MLS (displacement, between successive resolutions).
 pub const GOAL_RATE: f64 = 1.8;
+/// Every method runs the paper's update.
+pub const INTEGRATOR: &str = "musl";
+/// The two readings of the paper's "E = 10e^7 Pa" (label, Pa).
+pub const E_READINGS: [(&str, f64); 2] = [("1e7", 1e7), ("1e8", 1e8)];
 
-/// (label, shape, MLS, LME γ) of each method.
-pub const METHODS: [(&str, &str, bool, f64); 7] = [
-    ("linear", "linear", false, 0.0),
-    ("ugimp", "ugimp", false, 0.0),
-    ("lme-g3", "lme", false, 3.0),
-    ("bspline2", "bspline2", false, 0.0),
-    ("bspline2-mls", "bspline2", true, 0.0),
-    ("bspline3", "bspline3", false, 0.0),
-    ("bspline3-mls", "bspline3", true, 0.0),
+/// (label, shape, MLS) of each method.
+pub const METHODS: [(&str, &str, bool); 5] = [
+    ("linear", "linear", false),
+    ("bspline2", "bspline2", false),
+    ("bspline2-mls", "bspline2", true),
+    ("bspline3", "bspline3", false),
+    ("bspline3-mls", "bspline3", true),
 ];
 
 /// Chart colour of method `m`: an MLS variant shares its B-spline's colour, dashed.
 fn color(m: usize) -> usize {
-    [0, 1, 2, 3, 3, 4, 4][m]
+    [0, 3, 3, 4, 4][m]
 }
 
-pub fn job(backend: BackendChoice, cells: usize, method: usize, quick: bool) -> Job {
-    let (label, shape, mls, gamma) = METHODS[method];
+/// The resolutions of a sweep: `CELLS_QUICK`, or `CELLS_FULL` restricted by
+/// `LME_MPM_MMS_CELLS`.
+pub fn cells(quick: bool) -> Result<Vec<usize>> {
+    if quick {
+        return Ok(CELLS_QUICK.to_vec());
+    }
+    let Ok(list) = std::env::var(CELLS_ENV) else {
+        return Ok(CELLS_FULL.to_vec());
+    };
+    let mut out = Vec::new();
+    for s in list.split(',') {
+        match s.trim().parse::<usize>() {
+            Ok(n) if CELLS_FULL.contains(&n) => out.push(n),
+            _ => {
+                return Err(Error::Scene(crate::error::SceneError::Override {
+                    arg: format!("{CELLS_ENV}={list}"),
+                    message: format!("each entry must be one of {CELLS_FULL:?}"),
+                }));
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+/// The E readings of a sweep (quick: the first only).
+fn readings(quick: bool) -> &'static [(&'static str, f64)] {
+    if quick { &E_READINGS[..1] } else { &E_READINGS }
+}
+
+/// One period 2L/c (s) of the case (L = 1 m, ρ0 = 1000 kg/m³) at modulus `e` (Pa).
+pub fn period(e: f64) -> f64 {
+    2.0 / (e / 1000.0).sqrt()
+}
+
+pub fn job(backend: BackendChoice, cells: usize, method: usize, e: usize, quick: bool) -> Job {
+    let (label, shape, mls) = METHODS[method];
+    let (e_label, e_pa) = E_READINGS[e];
     let mut j = Job::new(
-        format!("{}-{label}-n{cells}", backend_slug(backend)),
+        format!("{}-E{e_label}-{label}-n{cells}", backend_slug(backend)),
         ALIGNED_VIBRATION,
         "aligned_vibration",
     )
     .set(format!("grid.h={}", 1.0 / cells as f64))
     .set(format!("solver.shape={shape}"))
     .set(format!("solver.mls={mls}"))
+    .set(format!("solver.integrator={INTEGRATOR}"))
+    .set(format!("materials.rubber.E={e_pa}"))
     .tag("backend", backend_slug(backend))
+    .tag("E", e_label)
     .tag("method", label)
     .tag("cells", cells);
-    if gamma > 0.0 {
-        j = j.set(format!("solver.lme_gamma={gamma}"));
-    }
     if quick {
-        j = j.set(format!("solver.t_end={PERIOD}"));
+        j = j.set(format!("solver.t_end={}", period(e_pa)));
     } else {
-        j.snapshot_times = vec![PERIOD];
+        j.snapshot_times = vec![period(e_pa)];
     }
     j.backend = backend;
     j
 }
 
-pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
-    let cells: &[usize] = if quick { &CELLS_QUICK } else { &CELLS_FULL };
+pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+    let cells = cells(quick)?;
     let mut out = Vec::new();
     for &b in backends {
         // Finest first: the longest runs start early and do not trail.
         for &n in cells.iter().rev() {
-            for m in 0..METHODS.len() {
-                out.push(job(b, n, m, quick));
+            for e in 0..readings(quick).len() {
+                for m in 0..METHODS.len() {
+                    out.push(job(b, n, m, e, quick));
+                }
             }
         }
     }
-    out
+    Ok(out)
 }
 
 fn find<'a>(
     results: &'a [JobResult],
     backend: &str,
+    e: &str,
     method: &str,
     cells: usize,
 ) -> Option<&'a JobResult> {
     let n = cells.to_string();
     results.iter().find(|r| {
         r.job.tag_value("backend") == Some(backend)
+            && r.job.tag_value("E") == Some(e)
             && r.job.tag_value("method") == Some(method)
             && r.job.tag_value("cells") == Some(n.as_str())
     })
@@ -108,11 +157,12 @@ pub fn final_errors(r: &JobResult) -> Option<&MmsErrors> {
 /// Errors after one period, from the run's snapshot (the run must have got
 /// that far; quick runs end there).
 fn period_errors(r: &JobResult, exact: &AlignedVibration) -> Option<MmsErrors> {
+    let one = 2.0 * exact.length / exact.c;
     let d = r.data()?;
     if let Some((t, p)) = d.snapshots.first() {
         return Some(crate::exact::mms::score(exact, p, *t));
     }
-    (d.t_end <= PERIOD * (1.0 + 1e-9))
+    (d.t_end <= one * (1.0 + 1e-9))
         .then(|| final_errors(r).cloned())
         .flatten()
 }
@@ -136,111 +186,74 @@ const QUANTITIES: [(&str, &str, &str, Pick); 3] = [
     ("stress", "Pa", "sigma", |e| e.rms_stress),
 ];
 
-pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
-    let cells: &[usize] = if quick { &CELLS_QUICK } else { &CELLS_FULL };
+const RELATIVE: [(&str, Pick); 3] = [
+    ("displacement", |e| e.rms_displacement_relative),
+    ("velocity", |e| e.rms_velocity_relative),
+    ("stress", |e| e.rms_stress_relative),
+];
+
+fn fmt_orders(r: &[Option<f64>]) -> String {
+    r.iter()
+        .map(|x| x.map_or("-".into(), |v| format!("{v:.2}")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The exact field of reading `e` (Pa).
+fn exact_of(e: f64) -> Result<AlignedVibration> {
+    let o = Override::parse(&format!("materials.rubber.E={e}"))?;
     let scene = Scene::from_str(
         ALIGNED_VIBRATION,
         "aligned_vibration",
         "aligned_vibration",
-        &[],
+        &[o],
     )?;
-    let exact = AlignedVibration::from_scene(&scene).expect("the case is manufactured");
+    Ok(AlignedVibration::from_scene(&scene).expect("the case is manufactured"))
+}
+
+pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
+    let cells = super::tag_values(results, "cells")
+        .iter()
+        .filter_map(|c| c.parse::<usize>().ok())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect::<Vec<_>>();
     let backends = backends_of(results);
     let main = backends.first().copied().unwrap_or("cpu");
     let mut charts = Vec::new();
     let mut md = String::new();
-    let t_label = if quick {
-        "one period (0.02 s)"
-    } else {
-        "T = 0.2 s"
-    };
-
-    // --- convergence charts, one per quantity ----------------------------
-    for (name, unit, stem, pick) in QUANTITIES {
-        let mut c = LineChart::new(
-            format!("Aligned vibration: RMS {name} error at {t_label}"),
-            "cell size h (m)",
-            format!("RMS {name} error ({unit})"),
-        )
-        .log_log();
-        for (m, (label, _, mls, _)) in METHODS.iter().enumerate() {
-            let pts: Vec<(f64, f64)> = cells
-                .iter()
-                .filter_map(|&n| {
-                    let e = final_errors(find(results, main, label, n)?)?;
-                    Some((1.0 / n as f64, pick(e)))
-                })
-                .collect();
-            let s = Series::line(*label, pts, color(m)).markers();
-            c.series.push(if *mls { s.dashed() } else { s });
-        }
-        // Slope-2 guide through the finest bspline2-mls point, or any point.
-        if let Some(&(h, e)) = c
-            .series
-            .iter()
-            .find(|s| s.label == "bspline2-mls")
-            .and_then(|s| s.points.last())
-            .or_else(|| c.series.iter().find_map(|s| s.points.last()))
-        {
-            let h0 = 1.0 / cells[0] as f64;
-            c.series.push(
-                Series::line("slope 2", vec![(h0, e * (h0 / h).powi(2)), (h, e)], 7).dashed(),
-            );
-        }
-        c.size = (900, 560);
-        c.legend = plotters::chart::SeriesLabelPosition::LowerRight;
-        let stem = format!("study-mms-{stem}");
-        c.save(&dir.join(&stem))?;
-        charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
-    }
-
-    // --- error against wall time -------------------------------------------
-    let mut front = LineChart::new(
-        format!("Aligned vibration: displacement error at {t_label} against cost"),
-        "wall time of the run (s)",
-        "RMS displacement error (m)",
-    )
-    .log_log();
-    for b in &backends {
-        for (m, (label, _, mls, _)) in METHODS.iter().enumerate() {
-            let mut pts: Vec<(f64, f64)> = cells
-                .iter()
-                .filter_map(|&n| {
-                    let r = find(results, b, label, n)?;
-                    Some((r.data()?.wall_seconds, final_errors(r)?.rms_displacement))
-                })
-                .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let name = if backends.len() > 1 {
-                format!("{b} {label}")
-            } else {
-                label.to_string()
-            };
-            let s = Series::line(name, pts, color(m)).markers();
-            front.series.push(if *mls { s.dashed() } else { s });
-        }
-    }
-    front.size = (900, 560);
-    front.legend = plotters::chart::SeriesLabelPosition::UpperRight;
-    front.save(&dir.join("study-mms-front"))?;
-    charts.extend(["study-mms-front.png", "study-mms-front.svg"].map(|f| dir.join(f)));
-
-    // --- text ----------------------------------------------------------------
+    let t_label = if quick { "one period" } else { "T = 0.2 s" };
     let _ = writeln!(
         md,
-        "The manufactured aligned vibration (SPEC benchmark 4, `cases/aligned_vibration.toml`): unit square, \
-         Neo-Hookean E = 1e7 Pa, ν = 0.3, ρ0 = 1000 kg/m³, A = 0.1 m, NPC, Δt = 1e-5 s, t_end = {}, \
-         {} to {} cells per side, 3 × 3 particles per cell, {} runs{}. Errors: RMS over particles of \
-         |u − u_exact|, |v − v_exact| and the Cauchy stress difference (paper eq. 43). LME uses γ = 3. \
-         A run that went unstable shows when and why (`energy_runaway`: kinetic + stored energy above 10 \
-         times the exact field's peak). Raw results: `results.csv` of the study's output folder.\n",
+        "The B-spline paper's study (SPEC benchmark 4, `cases/aligned_vibration.toml`): unit square, \
+         Neo-Hookean, ν = 0.3, ρ0 = 1000 kg/m³, A = 0.1 m, the paper's update (`solver.integrator = \
+         \"musl\"`, eqs. 28–37) for every method, Δt = 1e-5 s, t_end = {}, 3 × 3 particles per cell, \
+         2 × 2 Gauss points per integration cell for MLS; cells per side: {}{}; E = {} Pa (the two \
+         readings of the paper's \"10e^7\"); {} runs{}. Errors: RMS over particles of |u − u_exact|, \
+         |v − v_exact| and the Cauchy stress difference (paper eq. 43), and the same divided by the \
+         exact field's RMS (1 = an error as large as the field). A run that went unstable shows when \
+         and why (`energy_runaway`: kinetic + stored energy above 10 times the exact field's peak). \
+         Raw results: `results.csv` of the study's output folder.\n",
         if quick {
-            "0.02 s (one period; quick sweep)"
+            "one period 2L/c (quick sweep)"
         } else {
-            "0.2 s (ten periods)"
+            "0.2 s"
         },
-        cells[0],
-        cells[cells.len() - 1],
+        cells
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        if !quick && cells.len() < CELLS_FULL.len() {
+            format!(" (restricted by {CELLS_ENV}; the full sweep is {CELLS_FULL:?})")
+        } else {
+            String::new()
+        },
+        readings(quick)
+            .iter()
+            .map(|r| r.0)
+            .collect::<Vec<_>>()
+            .join(" and "),
         results.len(),
         if backends.len() > 1 {
             " (tables: the first backend)"
@@ -248,20 +261,91 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             ""
         }
     );
-    let mut header = vec!["cells".to_string()];
-    header.extend(METHODS.iter().map(|m| m.0.to_string()));
-    for (name, unit, _, pick) in QUANTITIES {
+
+    for &(e_label, e_pa) in readings(quick) {
+        let exact = exact_of(e_pa)?;
+        let _ = writeln!(
+            md,
+            "### E = {e_label} Pa (c = {} m/s, one period 2L/c = {} s)\n",
+            sig(exact.c),
+            sig(period(e_pa))
+        );
+        // --- convergence charts, one per quantity -------------------------
+        for (name, unit, stem, pick) in QUANTITIES {
+            let mut c = LineChart::new(
+                format!("Aligned vibration, E = {e_label} Pa: RMS {name} error at {t_label}"),
+                "cell size h (m)",
+                format!("RMS {name} error ({unit})"),
+            )
+            .log_log();
+            for (m, (label, _, mls)) in METHODS.iter().enumerate() {
+                let pts: Vec<(f64, f64)> = cells
+                    .iter()
+                    .filter_map(|&n| {
+                        let e = final_errors(find(results, main, e_label, label, n)?)?;
+                        Some((1.0 / n as f64, pick(e)))
+                    })
+                    .collect();
+                let s = Series::line(*label, pts, color(m)).markers();
+                c.series.push(if *mls { s.dashed() } else { s });
+            }
+            if let Some(&(h, e)) = c
+                .series
+                .iter()
+                .find(|s| s.label == "bspline2-mls")
+                .and_then(|s| s.points.last())
+                .or_else(|| c.series.iter().find_map(|s| s.points.last()))
+            {
+                let h0 = 1.0 / cells[0] as f64;
+                c.series.push(
+                    Series::line("slope 2", vec![(h0, e * (h0 / h).powi(2)), (h, e)], 7).dashed(),
+                );
+            }
+            c.size = (900, 560);
+            c.legend = plotters::chart::SeriesLabelPosition::LowerRight;
+            let stem = format!("study-mms-{stem}-e{}", &e_label[2..]);
+            c.save(&dir.join(&stem))?;
+            charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
+        }
+
+        // --- tables ----------------------------------------------------------
+        let mut header = vec!["cells".to_string()];
+        header.extend(METHODS.iter().map(|m| m.0.to_string()));
+        let cell_text = |r: Option<&JobResult>, pick: Pick| match r {
+            Some(r) if r.completed() => final_errors(r).map_or("-".into(), |e| sig(pick(e))),
+            Some(r) => super::failure_text(r),
+            None => "-".into(),
+        };
+        for (name, unit, _, pick) in QUANTITIES {
+            let rows: Vec<Vec<String>> = cells
+                .iter()
+                .map(|&n| {
+                    let mut row = vec![n.to_string()];
+                    for (label, _, _) in METHODS {
+                        row.push(cell_text(find(results, main, e_label, label, n), pick));
+                    }
+                    row
+                })
+                .collect();
+            let _ = writeln!(
+                md,
+                "RMS {name} error ({unit}) at {t_label}, E = {e_label} Pa, {main} backend:\n\n{}",
+                table(&header, &rows)
+            );
+        }
         let rows: Vec<Vec<String>> = cells
             .iter()
             .map(|&n| {
                 let mut row = vec![n.to_string()];
-                for (label, _, _, _) in METHODS {
-                    row.push(match find(results, main, label, n) {
-                        Some(r) if r.completed() => {
-                            final_errors(r).map_or("-".into(), |e| sig(pick(e)))
-                        }
-                        Some(r) => super::failure_text(r),
-                        None => "-".into(),
+                for (label, _, _) in METHODS {
+                    let r = find(results, main, e_label, label, n);
+                    row.push(match r.and_then(final_errors) {
+                        Some(e) => RELATIVE
+                            .iter()
+                            .map(|(_, pick)| format!("{:.3}", pick(e)))
+                            .collect::<Vec<_>>()
+                            .join(" / "),
+                        None => cell_text(r, |e| e.rms_displacement),
                     });
                 }
                 row
@@ -269,110 +353,164 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             .collect();
         let _ = writeln!(
             md,
-            "RMS {name} error ({unit}) at {t_label}, {main} backend:\n\n{}",
+            "Relative errors (displacement / velocity / stress, each over the exact field's RMS) at \
+             {t_label}, E = {e_label} Pa:\n\n{}",
             table(&header, &rows)
         );
+
+        // --- orders ----------------------------------------------------------
+        let spans: Vec<String> = cells
+            .windows(2)
+            .map(|w| format!("{}→{}", w[0], w[1]))
+            .collect();
+        let mut rate_rows = Vec::new();
+        let mut goal = None;
+        for (label, _, _) in METHODS {
+            for (name, _, _, pick) in QUANTITIES {
+                let at = |f: &dyn Fn(&JobResult) -> Option<f64>| -> Vec<Option<f64>> {
+                    cells
+                        .iter()
+                        .map(|&n| find(results, main, e_label, label, n).and_then(f))
+                        .collect()
+                };
+                let at_t = at(&|r| final_errors(r).map(pick));
+                let at_p = at(&|r| period_errors(r, &exact).map(|e| pick(&e)));
+                let (rt, rp) = (rates(&at_t), rates(&at_p));
+                if label == "bspline2-mls" && name == "displacement" {
+                    goal = Some((rt.clone(), rp.clone()));
+                }
+                let mut row = vec![label.to_string(), name.to_string(), fmt_orders(&rt)];
+                if !quick {
+                    row.push(fmt_orders(&rp));
+                }
+                rate_rows.push(row);
+            }
+        }
+        let mut rh = vec![
+            "method".to_string(),
+            "quantity".to_string(),
+            format!("order at {t_label} ({})", spans.join(", ")),
+        ];
+        if !quick {
+            rh.push(format!("order after one period ({})", spans.join(", ")));
+        }
+        let _ = writeln!(
+            md,
+            "Observed orders of convergence, log₂(e_h / e_h/2), between successive resolutions \
+             (\"-\": a run did not complete), E = {e_label} Pa:\n\n{}",
+            table(&rh, &rate_rows)
+        );
+
+        // --- the issue's acceptance, as measured -------------------------------
+        let mls_done: Vec<String> = cells
+            .iter()
+            .map(|&n| match find(results, main, e_label, "bspline2-mls", n) {
+                Some(r) if r.completed() => format!("{n}: completed"),
+                Some(r) => format!("{n}: {}", super::failure_text(r)),
+                None => format!("{n}: not run"),
+            })
+            .collect();
+        let beats: Vec<String> = cells
+            .iter()
+            .filter(|&&n| n >= 32)
+            .map(|&n| {
+                let e = |m| {
+                    find(results, main, e_label, m, n)
+                        .and_then(final_errors)
+                        .map(|e| e.rms_displacement)
+                };
+                match (e("bspline2-mls"), e("bspline2")) {
+                    (Some(a), Some(b)) => format!(
+                        "{n} cells: {} vs {} ({})",
+                        sig(a),
+                        sig(b),
+                        if a < b { "below" } else { "not below" }
+                    ),
+                    (Some(a), None) => {
+                        format!("{n} cells: {} vs bspline2 not completed", sig(a))
+                    }
+                    _ => format!("{n} cells: bspline2 + MLS did not complete"),
+                }
+            })
+            .collect();
+        let _ = writeln!(
+            md,
+            "Acceptance figures for bspline2 + MLS at E = {e_label} Pa: completes every resolution? \
+             {}. Displacement error below plain bspline2 at 32 and 64 cells? {}. Displacement order \
+             ≥ {GOAL_RATE} between successive resolutions? at {t_label}: {}{}.\n",
+            mls_done.join("; "),
+            if beats.is_empty() {
+                "not run (no resolution ≥ 32)".to_string()
+            } else {
+                beats.join("; ")
+            },
+            goal.as_ref().map_or("-".into(), |(t, _)| verdict(t)),
+            if quick {
+                String::new()
+            } else {
+                format!(
+                    "; after one period: {}",
+                    goal.as_ref().map_or("-".into(), |(_, p)| verdict(p))
+                )
+            }
+        );
+        for (_, _, stem, _) in QUANTITIES {
+            md.push_str(&image(
+                &format!("MMS convergence ({stem}, E = {e_label} Pa)"),
+                &format!("study-mms-{stem}-e{}.png", &e_label[2..]),
+            ));
+            md.push('\n');
+        }
     }
 
-    // Observed rates of every quantity, at T and after one period.
-    let mut rate_rows = Vec::new();
-    let spans: Vec<String> = cells
-        .windows(2)
-        .map(|w| format!("{}→{}", w[0], w[1]))
-        .collect();
-    let mut goal = None;
-    for (label, _, _, _) in METHODS {
-        for (name, _, _, pick) in QUANTITIES {
-            let at_t: Vec<Option<f64>> = cells
-                .iter()
-                .map(|&n| {
-                    find(results, main, label, n)
-                        .and_then(final_errors)
-                        .map(pick)
-                })
-                .collect();
-            let at_p: Vec<Option<f64>> = cells
-                .iter()
-                .map(|&n| {
-                    find(results, main, label, n)
-                        .and_then(|r| period_errors(r, &exact))
-                        .map(|e| pick(&e))
-                })
-                .collect();
-            let (rt, rp) = (rates(&at_t), rates(&at_p));
-            if label == "bspline2-mls" && name == "displacement" {
-                goal = Some((rt.clone(), rp.clone()));
-            }
-            let fmt = |r: &[Option<f64>]| {
-                r.iter()
-                    .map(|x| x.map_or("-".into(), |v| format!("{v:.2}")))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            if quick {
-                rate_rows.push(vec![label.to_string(), name.to_string(), fmt(&rt)]);
-            } else {
-                rate_rows.push(vec![
-                    label.to_string(),
-                    name.to_string(),
-                    fmt(&rt),
-                    fmt(&rp),
-                ]);
+    // --- error against wall time -----------------------------------------------
+    let mut front = LineChart::new(
+        format!("Aligned vibration: displacement error at {t_label} against cost"),
+        "wall time of the run (s)",
+        "RMS displacement error (m)",
+    )
+    .log_log();
+    for b in &backends {
+        for &(e_label, _) in readings(quick) {
+            for (m, (label, _, mls)) in METHODS.iter().enumerate() {
+                let mut pts: Vec<(f64, f64)> = cells
+                    .iter()
+                    .filter_map(|&n| {
+                        let r = find(results, b, e_label, label, n)?;
+                        Some((r.data()?.wall_seconds, final_errors(r)?.rms_displacement))
+                    })
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut name = format!("E {e_label} {label}");
+                if backends.len() > 1 {
+                    name = format!("{b} {name}");
+                }
+                let s = Series::line(name, pts, color(m)).markers();
+                front.series.push(if *mls { s.dashed() } else { s });
             }
         }
     }
-    let mut rh = vec![
-        "method".to_string(),
-        "quantity".to_string(),
-        format!("order at {t_label} ({})", spans.join(", ")),
-    ];
-    if !quick {
-        rh.push(format!("order after one period ({})", spans.join(", ")));
-    }
-    let _ = writeln!(
-        md,
-        "Observed orders of convergence, log₂(e_h / e_h/2), between successive resolutions (\"-\": a run \
-         did not complete):\n\n{}",
-        table(&rh, &rate_rows)
-    );
-    if let Some((at_t, at_p)) = goal {
-        // Over one period and over the whole run: the quick sweep's T is
-        // one period, so it reports one line.
-        let verdict = |g: &[Option<f64>]| {
-            let orders = g
-                .iter()
-                .map(|x| x.map_or("-".into(), |v| format!("{v:.2}")))
-                .collect::<Vec<_>>()
-                .join(", ");
-            if !g.is_empty() && g.iter().all(|r| r.is_some_and(|v| v >= GOAL_RATE)) {
-                format!("met (orders {orders})")
-            } else if g.iter().any(Option::is_none) {
-                format!("not met (orders {orders}; \"-\": a run did not complete)")
-            } else {
-                format!("not met (orders {orders})")
-            }
-        };
-        let _ = write!(
-            md,
-            "Goal: bspline2 + MLS keeps an order ≥ {GOAL_RATE} in displacement up to {} cells. \
-             At {t_label}: {}.",
-            cells[cells.len() - 1],
-            verdict(&at_t)
-        );
-        if !quick {
-            let _ = write!(md, " After one period (0.02 s): {}.", verdict(&at_p));
-        }
-        md.push_str("\n\n");
-    }
-    for (_, _, stem, _) in QUANTITIES {
-        md.push_str(&image(
-            &format!("MMS convergence ({stem})"),
-            &format!("study-mms-{stem}.png"),
-        ));
-        md.push('\n');
-    }
+    front.size = (900, 560);
+    front.legend = plotters::chart::SeriesLabelPosition::UpperRight;
+    front.save(&dir.join("study-mms-front"))?;
+    charts.extend(["study-mms-front.png", "study-mms-front.svg"].map(|f| dir.join(f)));
     md.push_str(&image("MMS error against wall time", "study-mms-front.png"));
     Ok((md, charts))
+}
+
+/// "met" / "not met" with the orders.
+fn verdict(g: &[Option<f64>]) -> String {
+    let orders = fmt_orders(g);
+    if !g.is_empty() && g.iter().all(|r| r.is_some_and(|v| v >= GOAL_RATE)) {
+        format!("met (orders {orders})")
+    } else if g.iter().any(Option::is_none) {
+        format!("not met (orders {orders}; \"-\": a run did not complete)")
+    } else {
+        format!("not met (orders {orders})")
+    }
 }
 
 #[cfg(test)]
@@ -383,5 +521,11 @@ mod tests {
     fn rates_are_log2_ratios() {
         let r = rates(&[Some(4.0), Some(1.0), None, Some(0.1)]);
         assert_eq!(r, vec![Some(2.0), None, None]);
+    }
+
+    #[test]
+    fn period_of_the_two_readings() {
+        assert!((period(1e7) - 0.02).abs() < 1e-15);
+        assert!((period(1e8) - 0.02 / 10f64.sqrt()).abs() < 1e-15);
     }
 }
