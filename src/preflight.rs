@@ -358,7 +358,7 @@ fn memory(
     if f.solver.mls {
         let grid = model::Grid::regular(f.grid.h, lo, nx.max(2), ny.max(2));
         let gp = model::gauss::gauss_points(shape, &grid) as f64;
-        mls = 12.0 * n + gp * (16.0 + 8.0 + 2.0 + slots * 28.0 + 8.0 * 11.0);
+        mls = 12.0 * n + gp * (16.0 + 8.0 + 2.0 + slots * 28.0 + 8.0 * 13.0);
     }
     let probes = f.output.probes.len() as f64;
     let constraints = f.constraints.len() as f64;

@@ -129,9 +129,11 @@ impl CpuBackend {
             per += 24.0;
         }
         if model.mls {
-            // Sort order and cells per particle, the Gauss points' share.
+            // Sort order and cells per particle, the Gauss points' share
+            // (position, weight, count, shape slots, and 13 f64 of fits:
+            // coefficients 3, p2g 3, forces 5, remap 2).
             let slots = model.shape.max_nodes() as f64;
-            let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 11.0;
+            let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 13.0;
             per += 12.0
                 + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
         }
