@@ -39,3 +39,10 @@ pub const MAX_SHAPES: usize = 1000;
 /// Most polygon vertices over all bodies (each seeded point is tested
 /// against a polygon's every edge).
 pub const MAX_POLYGON_VERTICES: usize = 10_000;
+
+/// The MLS weight's support half-width (cells, `solver.mls_support`): at
+/// most the paper's 3 (the neighbour search reaches 3 cells), at least 1.5
+/// (with 2 particles per cell or more a Gauss point then still sees at
+/// least 3 particles per direction).
+pub const MLS_SUPPORT_MIN: f64 = 1.5;
+pub const MLS_SUPPORT_MAX: f64 = 3.0;

@@ -254,7 +254,8 @@ fn shared_structs_match_rust_layouts() {
     let params = rust_fields!(Params; n_particles, n_nodes, nx, ny, h, inv_h, cfl_h, mass_eps, t_end_hi, t_end_lo,
         gravity, ramp_period, npc_gamma, p2g_accel, edge_margin, grid_w, grid_hgt, lme_beta, lme_r2, lme_tol,
         lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials, fixed_dt, mms_amp, mms_origin,
-        mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off);
+        mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off,
+        mls_weight_scale);
     assert_eq!(wgsl_struct(&module, "Params"), params);
     let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);

@@ -93,5 +93,6 @@ fn mls_sample(p: u32, qg: vec2<f32>) -> vec3<f32> {
 // `mls_sample` of a particle at position xp (m, grid-relative).
 fn mls_sample_at(xp: vec2<f32>, qg: vec2<f32>) -> vec3<f32> {
     let d = xp * params.inv_h - qg;
-    return vec3<f32>(d, mls_weight(0.5 * abs(d.x)) * mls_weight(0.5 * abs(d.y)));
+    let s = params.mls_weight_scale;
+    return vec3<f32>(d, mls_weight(s * abs(d.x)) * mls_weight(s * abs(d.y)));
 }

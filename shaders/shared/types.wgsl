@@ -75,6 +75,11 @@ struct Params {
     mls_spans_x: u32,
     mls_spans_y: u32,
     mls_break_off: f32,
+    // r per |Δx|/h in the MLS weight: 1.5 / solver.mls_support (the paper's 0.5).
+    mls_weight_scale: f32,
+    _pad_p0: u32,
+    _pad_p1: u32,
+    _pad_p2: u32,
 }
 
 // Run state on the device (storage, read_write), read back at sample times.

@@ -5,7 +5,8 @@
 //! other shapes) holding at least one particle gets 2 × 2 Gauss points g.
 //! At each, particle data f_p are fitted by moving least squares with the
 //! linear basis [1, x, y] and the weight w = w(r_x) w(r_y),
-//! r = (x_g − x_p)/(2h), w the quadratic spline of eq. 17 (support 3h):
+//! r = (x_g − x_p)/(2h), w the quadratic spline of eq. 17 (support 3h;
+//! `solver.mls_support` narrows it: r = 1.5 (x_g − x_p)/(support · h)):
 //!   f_g = Σ_p φ_gp f_p,  φ_gp = w_gp pᵀ(x_g) A⁻¹ p(x_p),  A = Σ_p w_gp p pᵀ,
 //! with the basis centred on x_g and scaled by h, so that φ_gp =
 //! w_gp (c₀ + c₁ Δx + c₂ Δy) with c = A⁻¹ e₀, Δ = (x_p − x_g)/h.
@@ -80,6 +81,8 @@ pub struct Mls {
     /// Per Gauss point: the remap's (ρ^t v^{t+1}) (MUSL, eq. 31).
     pub gp_remap: Vec<[f64; 2]>,
     mv_scatter: Scatter<3>,
+    /// r per Δx/h in the weight: 1.5 / support (the paper's 1/2).
+    weight_scale: f64,
     f_scatter: Scatter<2>,
 }
 
@@ -124,8 +127,16 @@ impl Mls {
             gp_f: vec![[0.0; 5]; n_gp],
             gp_remap: vec![[0.0; 2]; n_gp],
             mv_scatter: Scatter::default(),
+            weight_scale: 1.5 / SUPPORT_CELLS,
             f_scatter: Scatter::default(),
         })
+    }
+
+    /// The weight's support half-width `cells` (`solver.mls_support`,
+    /// 1.5 to 3; the paper's 3 by default): w(1.5 |Δx| / (cells h)).
+    pub fn with_support(mut self, cells: f64) -> Self {
+        self.weight_scale = 1.5 / cells.clamp(crate::limits::MLS_SUPPORT_MIN, SUPPORT_CELLS);
+        self
     }
 
     pub fn n_gauss_points(&self) -> usize {
@@ -226,11 +237,12 @@ impl Mls {
                     (q[1] - gy[0]) * inv_h,
                     (q[1] - gy[1]) * inv_h,
                 ];
+                let sc = self.weight_scale;
                 let w = [
-                    weight(0.5 * d[0].abs()),
-                    weight(0.5 * d[1].abs()),
-                    weight(0.5 * d[2].abs()),
-                    weight(0.5 * d[3].abs()),
+                    weight(sc * d[0].abs()),
+                    weight(sc * d[1].abs()),
+                    weight(sc * d[2].abs()),
+                    weight(sc * d[3].abs()),
                 ];
                 if (w[0] == 0.0 && w[1] == 0.0) || (w[2] == 0.0 && w[3] == 0.0) {
                     continue;

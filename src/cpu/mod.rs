@@ -95,6 +95,7 @@ impl CpuBackend {
             mls: model.mls.then(|| {
                 mls::Mls::new(&model.shape, &model.grid, n)
                     .expect("shape functions are defined at Gauss points inside a regular grid")
+                    .with_support(model.mls_support)
             }),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,

@@ -46,8 +46,12 @@ pub struct Params {
     pub mls_spans_x: u32,
     pub mls_spans_y: u32,
     pub mls_break_off: f32,
+    pub mls_weight_scale: f32,
+    pub _pad_p0: u32,
+    pub _pad_p1: u32,
+    pub _pad_p2: u32,
 }
-const _: () = assert!(std::mem::size_of::<Params>() == 160);
+const _: () = assert!(std::mem::size_of::<Params>() == 176);
 
 /// Run state on the device. Atomic fields of the WGSL struct are plain u32 here.
 #[repr(C)]

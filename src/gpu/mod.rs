@@ -417,6 +417,10 @@ pub fn params(model: &Model) -> Params {
         mls_spans_x: mls_spans[0],
         mls_spans_y: mls_spans[1],
         mls_break_off,
+        mls_weight_scale: (1.5 / model.mls_support) as f32,
+        _pad_p0: 0,
+        _pad_p1: 0,
+        _pad_p2: 0,
     }
 }
 

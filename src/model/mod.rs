@@ -125,6 +125,8 @@ pub struct Model {
     pub fixed_dt: Option<f64>,
     /// MLS reconstruction at Gauss points (`solver.mls`).
     pub mls: bool,
+    /// MLS weight support half-width (cells, `solver.mls_support`).
+    pub mls_support: f64,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
@@ -211,6 +213,7 @@ impl Model {
             t_end: f.solver.t_end,
             fixed_dt: f.solver.dt,
             mls: f.solver.mls,
+            mls_support: f.solver.mls_support,
             probes,
             manufactured,
         })

@@ -346,6 +346,15 @@ pub struct SolverSpec {
     /// grid (uGIMP, LME and perturbed grids are refused). Default false.
     #[serde(default)]
     pub mls: bool,
+    /// Half-width of the MLS weight's support, in cells: the weight of eq.
+    /// 17 is taken at r = 1.5 Δx / (mls_support · h). Default 3, the paper's
+    /// r = Δx/(2h); in [1.5, 3].
+    #[serde(default = "default_mls_support")]
+    pub mls_support: f64,
+}
+
+fn default_mls_support() -> f64 {
+    crate::limits::MLS_SUPPORT_MAX
 }
 
 fn default_shape() -> ShapeKind {

@@ -643,6 +643,18 @@ fn check_solver_options(file: &SceneFile) -> Result<(), SceneError> {
              non-polynomial functions are not integrated exactly",
         ));
     }
+    finite("solver.mls_support", s.mls_support)?;
+    if !(crate::limits::MLS_SUPPORT_MIN..=crate::limits::MLS_SUPPORT_MAX).contains(&s.mls_support) {
+        return Err(SceneError::invalid(
+            "solver.mls_support",
+            format!(
+                "must be in [{}, {}] cells (3 is the paper's weight), got {}",
+                crate::limits::MLS_SUPPORT_MIN,
+                crate::limits::MLS_SUPPORT_MAX,
+                s.mls_support
+            ),
+        ));
+    }
     if s.mls && g.perturb != 0.0 {
         return Err(SceneError::invalid(
             "solver.mls",
