@@ -71,12 +71,12 @@ fn uniform_velocity_passes_the_full_musl_step_exactly() {
         let p = &cpu.model.particles;
         let dt = cpu.dt();
         for i in 0..p.len() {
-            for k in 0..2 {
-                assert!((p.v[i][k] - vel[k]).abs() <= ROUND_OFF * 2.0, "{shape}: v");
+            for (k, vk) in vel.iter().enumerate() {
+                assert!((p.v[i][k] - vk).abs() <= ROUND_OFF * 2.0, "{shape}: v");
                 // The motion V Δt (2e-5 m) is added to a position near 1 m,
                 // whose own rounding (1.1e-16 m) bounds how exactly it shows.
                 let du = p.x[i][k] - p.x0[i][k];
-                assert!((du - vel[k] * dt).abs() <= 4.0 * f64::EPSILON, "{shape}: x");
+                assert!((du - vk * dt).abs() <= 4.0 * f64::EPSILON, "{shape}: x");
             }
             // No strain: the stress stays zero (scale E Δt |v| / h = 0.3 Pa).
             assert!(p.stress[i].iter().all(|s| s.abs() < 1e-9), "{shape}");
