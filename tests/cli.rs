@@ -74,6 +74,18 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
         ),
         ("cfl zero", dyka.clone(), vec!["solver.cfl=0"], "solver.cfl"),
         (
+            "MLS weight support below 1.5 cells",
+            dyka.clone(),
+            vec!["solver.mls_support=1.0"],
+            "solver.mls_support",
+        ),
+        (
+            "unknown integrator",
+            dyka.clone(),
+            vec!["solver.integrator=usl"],
+            "musl",
+        ),
+        (
             "cfl above one",
             dyka.clone(),
             vec!["solver.cfl=1.5"],
