@@ -53,6 +53,7 @@ fn variants() -> Vec<Variant> {
             gamma: 0.5,
             position: NpcPosition::Corrected,
         },
+        Integrator::Musl,
     ];
     let mut out = Vec::new();
     for shape in [
@@ -165,6 +166,10 @@ fn every_pass_validates_in_every_variant() {
                 "{pass:?} {v:?}: a without NPC"
             );
             assert!(
+                !has(Buf::XStart) || v.integrator == Integrator::Musl,
+                "{pass:?} {v:?}: step-start positions without MUSL"
+            );
+            assert!(
                 !has(Buf::Lambda) || v.shape == ShapeKind::Lme,
                 "{pass:?} {v:?}: λ without LME"
             );
@@ -218,6 +223,8 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::G2p
             | Pass::MlsP2g
             | Pass::MlsForces
+            | Pass::Remap
+            | Pass::MlsRemap
     )
 }
 
@@ -304,8 +311,14 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
         .iter()
         .find(|v| v.lme_stored && v.mms && v.perturbed)
         .unwrap();
+    // MUSL's remap passes, with and without MLS.
+    let musl = |mls: bool| {
+        all.iter()
+            .find(|v| v.integrator == Integrator::Musl && v.mls == mls)
+            .unwrap()
+    };
     let mut out = Vec::new();
-    for v in [mls, lme] {
+    for v in [mls, lme, musl(true), musl(false)] {
         let d = v.defines();
         for pass in Pass::ALL {
             if v.uses(pass) {

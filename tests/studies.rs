@@ -192,7 +192,7 @@ fn stability_quick_records_every_failure() {
 #[test]
 fn mms_quick_every_method_converges_or_reports_why_not() {
     let (results, md, _) = run(StudyName::Mms);
-    assert!(md.contains("study-mms-u.png") && md.contains("study-mms-front.png"));
+    assert!(md.contains("study-mms-u-e7.png") && md.contains("study-mms-front.png"));
     assert_eq!(
         results.len(),
         lme_mpm::study::mms::METHODS.len() * lme_mpm::study::mms::CELLS_QUICK.len()
