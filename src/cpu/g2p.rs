@@ -52,7 +52,8 @@ pub fn g2p(
             v[0] += dt * acc[0];
             v[1] += dt * acc[1];
             match prm.integrator {
-                Integrator::Fe => {
+                // `cpu::implicit` steps implicit models; this arm is FE's.
+                Integrator::Fe | Integrator::Implicit(_) => {
                     x[0] += dt * vel[0];
                     x[1] += dt * vel[1];
                 }

@@ -8,6 +8,7 @@ pub mod energy;
 pub mod forces;
 pub mod g2p;
 pub mod grid_update;
+pub mod implicit;
 pub mod mls;
 pub mod p2g;
 pub mod scatter;
@@ -208,6 +209,8 @@ impl CpuBackend {
         match self.model.integrator {
             Integrator::Fe => 0.0,
             Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
+            // Implicit models run on `implicit::ImplicitBackend`, never here.
+            Integrator::Implicit(_) => 0.0,
         }
     }
 
@@ -268,7 +271,7 @@ impl CpuBackend {
         let m = &mut self.model;
         let p = &mut m.particles;
         let gamma = match m.integrator {
-            Integrator::Fe => 1.0,
+            Integrator::Fe | Integrator::Implicit(_) => 1.0,
             Integrator::Npc { gamma, .. } => gamma,
         };
         match stage {
@@ -372,7 +375,7 @@ impl CpuBackend {
 /// with its ramp, plus a manufactured solution's load at the particle's
 /// reference position, plus the particle's share of the tractions and
 /// point loads divided by its mass (the stages multiply by m_p again).
-fn body_force<'a>(
+pub(crate) fn body_force<'a>(
     gravity: Option<crate::model::Gravity>,
     mms: &'a Option<crate::model::AlignedVibration>,
     ext: &'a Option<crate::model::ExternalForces>,
@@ -441,6 +444,7 @@ impl Backend for CpuBackend {
                 .collect(),
             energy: energy::energy(&self.model),
             reactions: self.reactions.clone(),
+            newton: None,
         })
     }
 

@@ -69,6 +69,14 @@ impl GpuBackend {
     }
 
     pub fn with_options(ctx: GpuContext, model: Model, opts: GpuOptions) -> Result<GpuBackend> {
+        if matches!(model.integrator, Integrator::Implicit(_)) {
+            return Err(crate::error::SceneError::invalid(
+                "solver.integrator",
+                "= \"implicit\" runs on the CPU path only (--backend cpu or auto); the GPU \
+                 path steps the explicit integrators",
+            )
+            .into());
+        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
@@ -344,7 +352,8 @@ pub fn params(model: &Model) -> Params {
         .fold(f64::INFINITY, f64::min);
     let (t_end_hi, t_end_lo) = split_f64(model.t_end);
     let (gamma, p2g_accel) = match model.integrator {
-        Integrator::Fe => (1.0, 0.0),
+        // `with_options` refuses implicit models before this is read.
+        Integrator::Fe | Integrator::Implicit(_) => (1.0, 0.0),
         Integrator::Npc { gamma, .. } => (gamma, 1.0 - gamma),
     };
     let gravity = model
@@ -528,6 +537,7 @@ impl Backend for GpuBackend {
                 gravity_work_bound: e[2] as f64,
             },
             reactions: b.pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls),
+            newton: None,
         })
     }
 

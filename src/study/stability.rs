@@ -148,6 +148,7 @@ fn error_figure(r: &JobResult) -> Option<String> {
         Errors::Column(e) => Some(format!("settle {}", sig(e.settlement_rel_error))),
         Errors::Sliding(e) => Some(format!("v {}", sig(e.velocity_rel_error))),
         Errors::Rolling(e) => Some(format!("u_x {}", sig(e.u_x_rel_error))),
+        Errors::Cantilever(e) => Some(format!("tip {}", sig(e.rel_error_timoshenko))),
     }
 }
 
