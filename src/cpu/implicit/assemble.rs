@@ -22,7 +22,8 @@ use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::Material;
 use crate::model::material::increment::{StepState, mul};
 use crate::model::walls::{CONTACT_FRICTION, Wall};
-use faer::sparse::{Argsort, Pair, SymbolicSparseColMat};
+use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::linalg::solvers::SymbolicLu;
 use rayon::prelude::*;
 
 /// Marks a node component that is not an unknown (no mass, or fixed).
@@ -33,12 +34,31 @@ pub const NO_DOF: u32 = u32::MAX;
 /// about 1e-4 of the strain the contact force would cause in the material.
 pub const PENALTY_REL: f64 = 1e4;
 
-/// The unknowns of one step: two per node with mass, less fixed components.
+/// The unknowns of one step: two per node with mass (equations 2·id and
+/// 2·id + 1). Held components (constraints, stick walls) stay in the
+/// system as identity rows with their prescribed Δu, so every node's block
+/// has the same layout.
 #[derive(Debug, Clone, Default)]
 pub struct Dofs {
-    /// Per node: the equation number of its x and y displacement, or `NO_DOF`.
-    pub of: Vec<[u32; 2]>,
-    pub count: usize,
+    /// Per node: its index among the nodes with mass, or `NO_DOF`.
+    pub id: Vec<u32>,
+    /// Per node: held components (`FIX_X | FIX_Y` bits).
+    pub held: Vec<u8>,
+    /// Nodes with mass.
+    pub active: usize,
+}
+
+impl Dofs {
+    /// Component `c` of node `n` is an unknown.
+    #[inline]
+    pub fn free(&self, n: usize, c: usize) -> bool {
+        self.id[n] != NO_DOF && self.held[n] & (1 << c) == 0
+    }
+
+    /// Equations in the system.
+    pub fn count(&self) -> usize {
+        2 * self.active
+    }
 }
 
 /// The Newmark parameters of a step.
@@ -272,7 +292,7 @@ pub fn residual(
     }
     if !inp.walls.is_empty() {
         for (n, &mask) in inp.wall_mask.iter().enumerate() {
-            if mask == 0 || inp.dofs.of[n] == [NO_DOF; 2] {
+            if mask == 0 || inp.dofs.id[n] == NO_DOF {
                 continue;
             }
             for (k, wall) in inp.walls.iter().enumerate() {
@@ -291,14 +311,17 @@ pub fn residual(
 
 /// A wall's penalty force on a node displaced by `du` into it, and the
 /// force's derivative −∂f/∂Δu (2 × 2, row-major). The node is in contact
-/// when Δu·n < 0 (it moves further behind the line): the normal force is
+/// when Δu·n ≤ 0 (it moves further behind the line): the normal force is
 /// −k (Δu·n) n; ``friction` adds Coulomb's law on the tangential
 /// displacement (stick −k Δu_t up to μ |f_n|, then μ |f_n| against the
 /// slip), `slip` nothing. Stick walls are fixed components instead.
 pub fn contact(wall: &Wall, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
     let n = wall.normal;
     let g = du[0] * n[0] + du[1] * n[1];
-    if g >= 0.0 {
+    // g = 0 counts as contact (zero force, full stiffness): a node resting
+    // on the wall starts each step in the active set, so Newton does not
+    // chatter between free fall and the penalty's push-back.
+    if g > 0.0 {
         return ([0.0; 2], [0.0; 4]);
     }
     let fnorm = -k * g;
@@ -336,77 +359,92 @@ pub fn contact(wall: &Wall, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
     (f, kt)
 }
 
-/// The Jacobian's sparsity for one step: every (dof, dof) pair a particle
-/// couples, then each wall node's 2 × 2 block, in the order `values` fills.
+/// The Jacobian's sparsity for one step, in compressed columns: node b's
+/// two columns hold rows 2a, 2a + 1 for every node a a particle couples
+/// with b (`adj`, sorted), so entry (2a + i, 2b + k) sits at
+/// `col_ptr[2b + k] + 2 j + i`, j the position of a in b's list.
 pub struct Pattern {
     pub symbolic: SymbolicSparseColMat<usize>,
-    pub argsort: Argsort<usize>,
-    /// Per particle, the first entry of its block of values.
-    pub offsets: Vec<usize>,
-    /// Wall nodes with unknowns, in the order their blocks follow the particles'.
-    pub wall_nodes: Vec<usize>,
-    pub len: usize,
-}
-
-/// Entries particle `p` contributes, in `values`' order.
-fn particle_pairs(cache: &ShapeCache, dofs: &Dofs, p: usize, mut emit: impl FnMut(usize, usize)) {
-    let (nodes, _) = cache.particle(p);
-    for &a in nodes {
-        for &b in nodes {
-            let (da, db) = (dofs.of[a as usize], dofs.of[b as usize]);
-            for ra in da {
-                for cb in db {
-                    if ra != NO_DOF && cb != NO_DOF {
-                        emit(ra as usize, cb as usize);
-                    }
-                }
-            }
-        }
-    }
+    pub lu: SymbolicLu<usize>,
+    /// Per active node b: its neighbours' ids, `adj[adj_start[b]..adj_start[b + 1]]`.
+    pub adj_start: Vec<usize>,
+    pub adj: Vec<u32>,
+    pub nnz: usize,
 }
 
 impl Pattern {
-    pub fn new(
-        cache: &ShapeCache,
-        dofs: &Dofs,
-        particles: usize,
-        wall_mask: &[u32],
-    ) -> Result<Pattern, faer::sparse::CreationError> {
-        let mut pairs = Vec::new();
-        let mut offsets = Vec::with_capacity(particles + 1);
+    /// Fails only when faer cannot build the structure (out of memory).
+    pub fn new(cache: &ShapeCache, dofs: &Dofs, particles: usize) -> Result<Pattern, Fault> {
+        let fail = |_| Fault {
+            particle: None,
+            kind: FaultKind::NonFinite {
+                field: "Jacobian structure",
+            },
+        };
+        let mut pairs: Vec<u64> = Vec::new();
         for p in 0..particles {
-            offsets.push(pairs.len());
-            particle_pairs(cache, dofs, p, |r, c| pairs.push(Pair::new(r, c)));
-        }
-        offsets.push(pairs.len());
-        let mut wall_nodes = Vec::new();
-        for (n, &mask) in wall_mask.iter().enumerate() {
-            let d = dofs.of[n];
-            if mask != 0 && d != [NO_DOF; 2] {
-                wall_nodes.push(n);
-                for r in d {
-                    for c in d {
-                        if r != NO_DOF && c != NO_DOF {
-                            pairs.push(Pair::new(r as usize, c as usize));
-                        }
+            let (nodes, _) = cache.particle(p);
+            for &b in nodes {
+                let ib = dofs.id[b as usize];
+                for &a in nodes {
+                    let ia = dofs.id[a as usize];
+                    if ia != NO_DOF && ib != NO_DOF {
+                        pairs.push(((ib as u64) << 32) | ia as u64);
                     }
                 }
             }
         }
-        let len = pairs.len();
-        let (symbolic, argsort) =
-            SymbolicSparseColMat::try_new_from_indices(dofs.count, dofs.count, &pairs)?;
+        pairs.par_sort_unstable();
+        pairs.dedup();
+        let n = dofs.active;
+        let mut adj_start = vec![0usize; n + 1];
+        for &pr in &pairs {
+            adj_start[(pr >> 32) as usize + 1] += 1;
+        }
+        for b in 0..n {
+            adj_start[b + 1] += adj_start[b];
+        }
+        let adj: Vec<u32> = pairs.iter().map(|&pr| pr as u32).collect();
+        let mut col_ptr = Vec::with_capacity(2 * n + 1);
+        let mut row_idx = Vec::with_capacity(4 * adj.len());
+        for b in 0..n {
+            let list = &adj[adj_start[b]..adj_start[b + 1]];
+            for _k in 0..2 {
+                col_ptr.push(row_idx.len());
+                for &a in list {
+                    row_idx.push(2 * a as usize);
+                    row_idx.push(2 * a as usize + 1);
+                }
+            }
+        }
+        col_ptr.push(row_idx.len());
+        let nnz = row_idx.len();
+        let symbolic = SymbolicSparseColMat::new_checked(2 * n, 2 * n, col_ptr, None, row_idx);
+        let lu = SymbolicLu::try_new(symbolic.as_ref()).map_err(fail)?;
         Ok(Pattern {
             symbolic,
-            argsort,
-            offsets,
-            wall_nodes,
-            len,
+            lu,
+            adj_start,
+            adj,
+            nnz,
         })
+    }
+
+    /// Index in the values of entry (2a + i, 2b + k), a and b active ids.
+    #[inline]
+    pub fn slot(&self, a: u32, b: u32, i: usize, k: usize) -> usize {
+        let (s, e) = (self.adj_start[b as usize], self.adj_start[b as usize + 1]);
+        let j = self.adj[s..e]
+            .binary_search(&a)
+            .expect("every coupled pair is in the pattern");
+        // Column 2b starts at 4 s; column 2b + 1 after its 2 (e − s) rows.
+        4 * s + k * 2 * (e - s) + 2 * j + i
     }
 }
 
-/// Fills `values` (in `Pattern` order) with the Jacobian at `du`.
+/// Fills `values` (the `Pattern`'s slots) with the Jacobian at `du`:
+/// particles' stiffness and inertia, walls' contact stiffness, and the
+/// identity on held components.
 pub fn jacobian(
     inp: &StepInputs,
     pattern: &Pattern,
@@ -415,81 +453,87 @@ pub fn jacobian(
     values: &mut Vec<f64>,
 ) -> Result<(), Fault> {
     values.clear();
-    values.resize(pattern.len, 0.0);
+    values.resize(pattern.nnz, 0.0);
     let inertia = inp.newmark.accel_slope();
-    let (head, tail) = values.split_at_mut(pattern.offsets[iterates.len()]);
-    // Split the particles' part of `values` by particle, in parallel.
-    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(iterates.len());
-    let mut rest = head;
-    for p in 0..iterates.len() {
-        let (a, b) = rest.split_at_mut(pattern.offsets[p + 1] - pattern.offsets[p]);
-        slices.push(a);
-        rest = b;
-    }
-    let fault = slices
-        .into_par_iter()
+    // A = ∂P/∂ΔF per particle, in parallel; then one ordered scatter.
+    let tangents: Result<Vec<[[f64; 4]; 4]>, Fault> = iterates
+        .par_iter()
         .enumerate()
         .with_min_len(64)
-        .map(|(p, out)| {
-            let it = &iterates[p];
-            let a = match piola_tangent((inp.material)(p), it, &inp.start[p]) {
-                Ok(a) => a,
-                Err(kind) => return Some(Fault::at(p, kind)),
-            };
-            let (nodes, w) = inp.cache.particle(p);
-            let (m, vol) = (inp.mass[p], inp.volume[p]);
-            let mut e = 0;
+        .map(|(p, it)| {
+            piola_tangent((inp.material)(p), it, &inp.start[p]).map_err(|k| Fault::at(p, k))
+        })
+        .collect();
+    let tangents = tangents?;
+    let dofs = inp.dofs;
+    for (p, a) in tangents.iter().enumerate() {
+        let (nodes, w) = inp.cache.particle(p);
+        let (m, vol) = (inp.mass[p], inp.volume[p]);
+        for (&nb, wb) in nodes.iter().zip(w) {
+            let ib = dofs.id[nb as usize];
+            if ib == NO_DOF {
+                continue;
+            }
             for (&na, wa) in nodes.iter().zip(w) {
-                for (&nb, wb) in nodes.iter().zip(w) {
-                    let (da, db) = (inp.dofs.of[na as usize], inp.dofs.of[nb as usize]);
+                let ia = dofs.id[na as usize];
+                if ia == NO_DOF {
+                    continue;
+                }
+                let base = pattern.slot(ia, ib, 0, 0);
+                let col_len = pattern.slot(ia, ib, 0, 1) - base;
+                for k in 0..2 {
                     for i in 0..2 {
-                        for k in 0..2 {
-                            if da[i] == NO_DOF || db[k] == NO_DOF {
-                                continue;
-                            }
-                            let ga = [wa[1], wa[2]];
-                            let gb = [wb[1], wb[2]];
-                            let mut v = 0.0;
-                            for big_j in 0..2 {
-                                for l in 0..2 {
-                                    v += ga[big_j] * a[2 * i + big_j][2 * k + l] * gb[l];
-                                }
-                            }
-                            v *= vol;
-                            if i == k {
-                                v += m * wa[0] * wb[0] * inertia;
-                            }
-                            out[e] = v;
-                            e += 1;
+                        let mut v = 0.0;
+                        for big_j in 0..2 {
+                            let ga = wa[1 + big_j];
+                            v += ga * (a[2 * i + big_j][2 * k] * wb[1] + a[2 * i + big_j][2 * k + 1] * wb[2]);
                         }
+                        v *= vol;
+                        if i == k {
+                            v += m * wa[0] * wb[0] * inertia;
+                        }
+                        values[base + k * col_len + i] += v;
                     }
                 }
             }
-            None
-        })
-        .reduce(|| None, Fault::first);
-    if let Some(f) = fault {
-        return Err(f);
+        }
     }
-    let mut e = 0;
-    for &n in &pattern.wall_nodes {
-        let mut kt = [0.0; 4];
+    for (n, &mask) in inp.wall_mask.iter().enumerate() {
+        let id = dofs.id.get(n).copied().unwrap_or(NO_DOF);
+        if mask == 0 || id == NO_DOF {
+            continue;
+        }
         for (k, wall) in inp.walls.iter().enumerate() {
-            if inp.wall_mask[n] & (1 << k) != 0 {
+            if mask & (1 << k) != 0 {
                 let (_, dk) = contact(wall, du[n], inp.penalty);
-                for (x, y) in kt.iter_mut().zip(dk) {
-                    *x += y;
+                for i in 0..2 {
+                    for c in 0..2 {
+                        values[pattern.slot(id, id, i, c)] += dk[2 * i + c];
+                    }
                 }
             }
         }
-        let d = inp.dofs.of[n];
-        for i in 0..2 {
-            for k in 0..2 {
-                if d[i] != NO_DOF && d[k] != NO_DOF {
-                    tail[e] = kt[2 * i + k];
-                    e += 1;
+    }
+    // Held components: identity rows and columns.
+    for (n, &id) in dofs.id.iter().enumerate() {
+        if id == NO_DOF || dofs.held[n] == 0 {
+            continue;
+        }
+        let s = pattern.adj_start[id as usize];
+        let e = pattern.adj_start[id as usize + 1];
+        for c in 0..2 {
+            if dofs.held[n] & (1 << c) == 0 {
+                continue;
+            }
+            // Column 2 id + c, then row 2 id + c in every neighbour's columns.
+            for jj in s..e {
+                let nb = pattern.adj[jj];
+                for i in 0..2 {
+                    values[pattern.slot(nb, id, i, c)] = 0.0;
+                    values[pattern.slot(id, nb, c, i)] = 0.0;
                 }
             }
+            values[pattern.slot(id, id, c, c)] = 1.0;
         }
     }
     Ok(())

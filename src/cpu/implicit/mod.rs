@@ -35,7 +35,7 @@ use crate::model::{FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles}
 use assemble::{Dofs, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
 use faer::prelude::*;
 use faer::sparse::SparseColMat;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::solvers::Lu;
 use std::sync::atomic::AtomicBool;
 
 /// A residual norm above this many times the step's reference is a
@@ -67,6 +67,9 @@ pub struct ImplicitBackend {
     volume: Vec<f64>,
     body: Vec<[f64; 2]>,
     values: Vec<f64>,
+    /// The step's unknowns and the Jacobian's structure (built once per step).
+    dofs: Dofs,
+    pattern: Option<Pattern>,
     /// Per constraint group then per wall: reaction of the last step (N/m).
     reactions: Vec<[f64; 2]>,
     wall_force: Vec<[f64; 2]>,
@@ -126,6 +129,8 @@ impl ImplicitBackend {
             volume: vec![0.0; n],
             body: vec![[0.0; 2]; n],
             values: Vec::new(),
+            dofs: Dofs::default(),
+            pattern: None,
             reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
             wall_force: vec![[0.0; 2]; model.walls.list.len()],
             mass_eps: crate::model::MASS_EPS_REL * min_mass,
@@ -245,12 +250,15 @@ impl ImplicitBackend {
             };
             self.volume[i] = p.volume(i);
         }
+        let n = p.len();
+        self.dofs = self.build_dofs();
+        self.pattern = Some(Pattern::new(&self.cache, &self.dofs, n)?);
         Ok(())
     }
 
-    /// The unknowns, and Δu on fixed components (prescribed velocity ×
-    /// Δt, trapezoidal in time) written into `du`.
-    fn dofs(&mut self, dt: f64) -> Dofs {
+    /// The step's unknowns: nodes with mass, their held components
+    /// (constraints and stick walls).
+    fn build_dofs(&self) -> Dofs {
         let m = &self.model;
         let nodes = m.grid.n_nodes();
         let stick = |n: usize| {
@@ -262,8 +270,33 @@ impl ImplicitBackend {
                     .any(|(k, w)| mask & (1 << k) != 0 && w.contact == CONTACT_STICK)
             })
         };
+        let mut id = vec![NO_DOF; nodes];
+        let mut held = vec![0u8; nodes];
+        let mut active = 0u32;
+        for n in 0..nodes {
+            if self.node_mass[n] <= self.mass_eps {
+                continue;
+            }
+            id[n] = active;
+            active += 1;
+            held[n] = if stick(n) {
+                FIX_X | FIX_Y
+            } else {
+                m.constraints.fix[n]
+            };
+        }
+        Dofs {
+            id,
+            held,
+            active: active as usize,
+        }
+    }
+
+    /// Δu on held components (a prescribed velocity × Δt, trapezoidal in
+    /// time; zero otherwise), the free ones zero: Newton's start.
+    fn predict(&mut self, dt: f64) {
         self.du.fill([0.0; 2]);
-        for g in m.constraints.groups.iter().filter(|g| g.moves()) {
+        for g in self.model.constraints.groups.iter().filter(|g| g.moves()) {
             let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
             for &n in &g.nodes {
                 for (d, bit) in [(0, FIX_X), (1, FIX_Y)] {
@@ -272,23 +305,6 @@ impl ImplicitBackend {
                     }
                 }
             }
-        }
-        let mut of = vec![[NO_DOF; 2]; nodes];
-        let mut count = 0u32;
-        for (n, slot) in of.iter_mut().enumerate() {
-            if self.node_mass[n] <= self.mass_eps || stick(n) {
-                continue;
-            }
-            for (d, bit) in [(0, FIX_X), (1, FIX_Y)] {
-                if m.constraints.fix[n] & bit == 0 {
-                    slot[d] = count;
-                    count += 1;
-                }
-            }
-        }
-        Dofs {
-            of,
-            count: count as usize,
         }
     }
 
@@ -314,7 +330,7 @@ impl ImplicitBackend {
     /// `du` and `iterates`, and `dt` is the step's.
     fn attempt(&mut self, dt: f64) -> std::result::Result<(), AttemptFail> {
         self.fill_body(dt);
-        let dofs = self.dofs(dt);
+        self.predict(dt);
         let newmark = Newmark {
             beta: self.settings.beta,
             gamma: self.settings.gamma,
@@ -322,6 +338,10 @@ impl ImplicitBackend {
             is_static: self.settings.static_analysis,
         };
         let m = &self.model;
+        let dofs = &self.dofs;
+        let Some(pattern) = self.pattern.as_ref() else {
+            return Err(AttemptFail::Newton(f64::NAN));
+        };
         let material = |p: usize| m.material_of(p);
         let inp = StepInputs {
             cache: &self.cache,
@@ -333,73 +353,53 @@ impl ImplicitBackend {
             v: &self.node_v,
             a: &self.node_a,
             newmark,
-            dofs: &dofs,
+            dofs,
             walls: &m.walls.list,
             wall_mask: &m.walls.mask,
             penalty: self.penalty,
         };
-        let pattern = Pattern::new(&self.cache, &dofs, m.particles.len(), &m.walls.mask)
-            .map_err(|_| AttemptFail::Newton(f64::NAN))?;
-        let symbolic = SymbolicLu::try_new(pattern.symbolic.as_ref())
-            .map_err(|_| AttemptFail::Newton(f64::NAN))?;
-        // The load's own size: f_ext and the start's inertia, per node.
-        let load_norm = {
-            let mut s = 0.0;
-            for i in 0..m.particles.len() {
-                let (nodes, w) = self.cache.particle(i);
-                for (&n, wk) in nodes.iter().zip(w) {
-                    if dofs.of[n as usize] != [NO_DOF; 2] {
-                        let f = [
-                            wk[0] * m.particles.mass[i] * self.body[i][0],
-                            wk[0] * m.particles.mass[i] * self.body[i][1],
-                        ];
-                        s += f[0] * f[0] + f[1] * f[1];
-                    }
+        // The load's own size, |Σ_p N m_p b_p| over the free components.
+        let mut fext = vec![[0.0f64; 2]; self.du.len()];
+        for i in 0..m.particles.len() {
+            let (nodes, w) = self.cache.particle(i);
+            for (&n, wk) in nodes.iter().zip(w) {
+                for c in 0..2 {
+                    fext[n as usize][c] += wk[0] * m.particles.mass[i] * self.body[i][c];
                 }
             }
-            s.sqrt()
-        };
+        }
         let free_norm = |r: &[[f64; 2]]| -> f64 {
             let mut s = 0.0;
-            for (n, d) in dofs.of.iter().enumerate() {
-                for k in 0..2 {
-                    if d[k] != NO_DOF {
-                        s += r[n][k] * r[n][k];
+            for (n, rn) in r.iter().enumerate() {
+                for (c, v) in rn.iter().enumerate() {
+                    if dofs.free(n, c) {
+                        s += v * v;
                     }
                 }
             }
             s.sqrt()
         };
+        let load_norm = free_norm(&fext);
         let mut residuals = Vec::new();
         let mut corrections = Vec::new();
         let mut reference = 0.0;
         let mut last_correction = f64::INFINITY;
         let tol = self.settings.tol;
-        let mut rhs = Mat::<f64>::zeros(dofs.count, 1);
+        let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
         for iter in 0..=self.settings.max_iter {
-            assemble::residual(
-                &inp,
-                &self.du,
-                &mut self.iterates,
-                &mut self.r,
-                &mut self.wall_force,
-            )
-            .map_err(AttemptFail::Particle)?;
+            assemble::residual(&inp, &self.du, &mut self.iterates, &mut self.r, &mut self.wall_force)
+                .map_err(AttemptFail::Particle)?;
             let norm = free_norm(&self.r);
             if iter == 0 {
                 reference = norm.max(load_norm);
             }
-            let ratio = if reference > 0.0 {
-                norm / reference
-            } else {
-                0.0
-            };
+            let ratio = if reference > 0.0 { norm / reference } else { 0.0 };
             residuals.push(ratio);
             if !ratio.is_finite() || ratio > DIVERGED_RATIO {
                 return Err(AttemptFail::Newton(ratio));
             }
-            let converged = ratio <= tol && (iter == 0 || last_correction <= tol);
-            if converged || dofs.count == 0 {
+            let converged = ratio <= tol && (iter == 0 || last_correction <= tol.sqrt());
+            if converged || dofs.active == 0 {
                 self.dt = dt;
                 self.stats.steps += 1;
                 self.stats.iterations += iter as u64;
@@ -412,29 +412,31 @@ impl ImplicitBackend {
             if iter == self.settings.max_iter {
                 return Err(AttemptFail::Newton(ratio));
             }
-            assemble::jacobian(&inp, &pattern, &self.du, &self.iterates, &mut self.values)
+            assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values)
                 .map_err(AttemptFail::Particle)?;
-            let k = SparseColMat::new_from_argsort(
-                pattern.symbolic.clone(),
-                &pattern.argsort,
-                &self.values,
-            )
-            .map_err(|_| AttemptFail::Newton(ratio))?;
-            let lu = Lu::try_new_with_symbolic(symbolic.clone(), k.as_ref())
+            let k = SparseColMat::new(pattern.symbolic.clone(), self.values.clone());
+            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k.as_ref())
                 .map_err(|_| AttemptFail::Newton(ratio))?;
-            for (n, d) in dofs.of.iter().enumerate() {
+            for (n, &id) in dofs.id.iter().enumerate() {
+                if id == NO_DOF {
+                    continue;
+                }
                 for c in 0..2 {
-                    if d[c] != NO_DOF {
-                        rhs[(d[c] as usize, 0)] = self.r[n][c];
-                    }
+                    rhs[(2 * id as usize + c, 0)] = if dofs.free(n, c) { self.r[n][c] } else { 0.0 };
                 }
             }
             lu.solve_in_place(rhs.as_mut());
             let (mut dn, mut un) = (0.0, 0.0);
-            for (n, d) in dofs.of.iter().enumerate() {
+            for (n, &id) in dofs.id.iter().enumerate() {
+                if id == NO_DOF {
+                    continue;
+                }
                 for c in 0..2 {
-                    if d[c] != NO_DOF {
-                        let delta = rhs[(d[c] as usize, 0)];
+                    if dofs.free(n, c) {
+                        let delta = rhs[(2 * id as usize + c, 0)];
+                        if !delta.is_finite() {
+                            return Err(AttemptFail::Newton(ratio));
+                        }
                         self.du[n][c] += delta;
                         dn += delta * delta;
                         un += self.du[n][c] * self.du[n][c];
@@ -442,11 +444,7 @@ impl ImplicitBackend {
                 }
             }
             // A zero increment with a zero correction has converged.
-            last_correction = if un > 0.0 {
-                (dn / un).sqrt()
-            } else {
-                dn.sqrt()
-            };
+            last_correction = if un > 0.0 { (dn / un).sqrt() } else { dn.sqrt() };
             corrections.push(last_correction);
         }
         Err(AttemptFail::Newton(f64::NAN))
