@@ -486,7 +486,9 @@ pub fn jacobian(
                         let mut v = 0.0;
                         for big_j in 0..2 {
                             let ga = wa[1 + big_j];
-                            v += ga * (a[2 * i + big_j][2 * k] * wb[1] + a[2 * i + big_j][2 * k + 1] * wb[2]);
+                            v += ga
+                                * (a[2 * i + big_j][2 * k] * wb[1]
+                                    + a[2 * i + big_j][2 * k + 1] * wb[2]);
                         }
                         v *= vol;
                         if i == k {

@@ -387,13 +387,23 @@ impl ImplicitBackend {
         let tol = self.settings.tol;
         let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
         for iter in 0..=self.settings.max_iter {
-            assemble::residual(&inp, &self.du, &mut self.iterates, &mut self.r, &mut self.wall_force)
-                .map_err(AttemptFail::Particle)?;
+            assemble::residual(
+                &inp,
+                &self.du,
+                &mut self.iterates,
+                &mut self.r,
+                &mut self.wall_force,
+            )
+            .map_err(AttemptFail::Particle)?;
             let norm = free_norm(&self.r);
             if iter == 0 {
                 reference = norm.max(load_norm);
             }
-            let ratio = if reference > 0.0 { norm / reference } else { 0.0 };
+            let ratio = if reference > 0.0 {
+                norm / reference
+            } else {
+                0.0
+            };
             residuals.push(ratio);
             if !ratio.is_finite() || ratio > DIVERGED_RATIO {
                 return Err(AttemptFail::Newton(ratio));
@@ -422,7 +432,8 @@ impl ImplicitBackend {
                     continue;
                 }
                 for c in 0..2 {
-                    rhs[(2 * id as usize + c, 0)] = if dofs.free(n, c) { self.r[n][c] } else { 0.0 };
+                    rhs[(2 * id as usize + c, 0)] =
+                        if dofs.free(n, c) { self.r[n][c] } else { 0.0 };
                 }
             }
             lu.solve_in_place(rhs.as_mut());
@@ -444,10 +455,103 @@ impl ImplicitBackend {
                 }
             }
             // A zero increment with a zero correction has converged.
-            last_correction = if un > 0.0 { (dn / un).sqrt() } else { dn.sqrt() };
+            last_correction = if un > 0.0 {
+                (dn / un).sqrt()
+            } else {
+                dn.sqrt()
+            };
             corrections.push(last_correction);
         }
         Err(AttemptFail::Newton(f64::NAN))
+    }
+
+    /// Checks the assembled Jacobian against a central difference of the
+    /// residual (a test of `assemble`): at a step of `dt` from the current
+    /// state, with Δu set to `du_of(node)` on the free components, returns
+    /// the largest |K_ij − (−∂R_i/∂Δu_j)_FD| over the largest |K_ij|.
+    pub fn jacobian_mismatch(
+        &mut self,
+        dt: f64,
+        du_of: impl Fn(usize) -> [f64; 2],
+        eps: f64,
+    ) -> std::result::Result<f64, Fault> {
+        self.initial_phase()?;
+        self.fill_body(dt);
+        self.predict(dt);
+        for n in 0..self.du.len() {
+            let d = du_of(n);
+            for c in 0..2 {
+                if self.dofs.free(n, c) {
+                    self.du[n][c] = d[c];
+                }
+            }
+        }
+        let newmark = Newmark {
+            beta: self.settings.beta,
+            gamma: self.settings.gamma,
+            dt,
+            is_static: self.settings.static_analysis,
+        };
+        let m = &self.model;
+        let material = |p: usize| m.material_of(p);
+        let pattern = self.pattern.as_ref().expect("initial_phase built it");
+        let inp = StepInputs {
+            cache: &self.cache,
+            mass: &m.particles.mass,
+            volume: &self.volume,
+            body: &self.body,
+            material: &material,
+            start: &self.start,
+            v: &self.node_v,
+            a: &self.node_a,
+            newmark,
+            dofs: &self.dofs,
+            walls: &m.walls.list,
+            wall_mask: &m.walls.mask,
+            penalty: self.penalty,
+        };
+        let mut its = self.iterates.clone();
+        let mut wf = self.wall_force.clone();
+        assemble::residual(&inp, &self.du, &mut its, &mut self.r, &mut wf)?;
+        assemble::jacobian(&inp, pattern, &self.du, &its, &mut self.values)?;
+        let scale = self.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let nodes: Vec<usize> = (0..self.du.len())
+            .filter(|&n| self.dofs.id[n] != NO_DOF)
+            .collect();
+        let (mut rp, mut rm) = (self.r.clone(), self.r.clone());
+        let mut worst = 0.0f64;
+        for &nb in &nodes {
+            for k in 0..2 {
+                if !self.dofs.free(nb, k) {
+                    continue;
+                }
+                let mut du = self.du.clone();
+                du[nb][k] += eps;
+                assemble::residual(&inp, &du, &mut its, &mut rp, &mut wf)?;
+                du[nb][k] -= 2.0 * eps;
+                assemble::residual(&inp, &du, &mut its, &mut rm, &mut wf)?;
+                for &na in &nodes {
+                    for i in 0..2 {
+                        if !self.dofs.free(na, i) {
+                            continue;
+                        }
+                        let fd = -(rp[na][i] - rm[na][i]) / (2.0 * eps);
+                        let (ia, ib) = (self.dofs.id[na], self.dofs.id[nb]);
+                        let coupled = pattern.adj
+                            [pattern.adj_start[ib as usize]..pattern.adj_start[ib as usize + 1]]
+                            .binary_search(&ia)
+                            .is_ok();
+                        let k_ab = if coupled {
+                            self.values[pattern.slot(ia, ib, i, k)]
+                        } else {
+                            0.0
+                        };
+                        worst = worst.max((k_ab - fd).abs() / scale);
+                    }
+                }
+            }
+        }
+        Ok(worst)
     }
 
     /// Particles take the converged grid solution (eqs. 46–49); reactions.
