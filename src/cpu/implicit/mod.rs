@@ -363,9 +363,10 @@ impl ImplicitBackend {
         for i in 0..m.particles.len() {
             let (nodes, w) = self.cache.particle(i);
             for (&n, wk) in nodes.iter().zip(w) {
-                for c in 0..2 {
-                    fext[n as usize][c] += wk[0] * m.particles.mass[i] * self.body[i][c];
-                }
+                let mw = wk[0] * m.particles.mass[i];
+                let f = &mut fext[n as usize];
+                f[0] += mw * self.body[i][0];
+                f[1] += mw * self.body[i][1];
             }
         }
         let free_norm = |r: &[[f64; 2]]| -> f64 {
@@ -479,10 +480,9 @@ impl ImplicitBackend {
         self.fill_body(dt);
         self.predict(dt);
         for n in 0..self.du.len() {
-            let d = du_of(n);
-            for c in 0..2 {
+            for (c, d) in du_of(n).into_iter().enumerate() {
                 if self.dofs.free(n, c) {
-                    self.du[n][c] = d[c];
+                    self.du[n][c] = d;
                 }
             }
         }
