@@ -136,6 +136,20 @@ pub trait Backend {
     }
 }
 
+/// The probes' state now, in `Model::probes` order.
+pub fn probe_states(model: &Model) -> Vec<ProbeState> {
+    let p = &model.particles;
+    model
+        .probes
+        .iter()
+        .map(|pr| ProbeState {
+            x: p.x[pr.particle],
+            v: p.v[pr.particle],
+            stress: p.stress[pr.particle],
+        })
+        .collect()
+}
+
 /// `stop` raised? (Relaxed: the flag is a request, nothing else hangs on it.)
 pub fn stop_requested(stop: &AtomicBool) -> bool {
     stop.load(Ordering::Relaxed)

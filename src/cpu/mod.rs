@@ -15,7 +15,7 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample, State, stop_requested};
+use crate::backend::{Backend, Halt, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
@@ -79,12 +79,7 @@ impl CpuBackend {
     pub fn new(model: Model) -> Self {
         let n = model.particles.len();
         let nodes = model.grid.n_nodes();
-        let min_mass = model
-            .particles
-            .mass
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
+        let min_mass = model.particles.min_mass();
         CpuBackend {
             cache: ShapeCache::new(n, model.shape.max_nodes()),
             mv: vec![[0.0; 3]; nodes],
@@ -429,19 +424,9 @@ impl Backend for CpuBackend {
     }
 
     fn sample(&mut self) -> Result<Sample> {
-        let p = &self.model.particles;
         Ok(Sample {
             t: self.t,
-            probes: self
-                .model
-                .probes
-                .iter()
-                .map(|pr| ProbeState {
-                    x: p.x[pr.particle],
-                    v: p.v[pr.particle],
-                    stress: p.stress[pr.particle],
-                })
-                .collect(),
+            probes: crate::backend::probe_states(&self.model),
             energy: energy::energy(&self.model),
             reactions: self.reactions.clone(),
             newton: None,

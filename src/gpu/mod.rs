@@ -344,12 +344,7 @@ impl GpuBackend {
 /// The scene constants the shaders read.
 pub fn params(model: &Model) -> Params {
     let g = &model.grid;
-    let min_mass = model
-        .particles
-        .mass
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let min_mass = model.particles.min_mass();
     let (t_end_hi, t_end_lo) = split_f64(model.t_end);
     let (gamma, p2g_accel) = match model.integrator {
         // `with_options` refuses implicit models before this is read.

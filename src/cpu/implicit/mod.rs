@@ -23,9 +23,7 @@
 
 pub mod assemble;
 
-use crate::backend::{
-    Backend, Halt, NewtonSample, NewtonStats, ProbeState, Sample, State, stop_requested,
-};
+use crate::backend::{Backend, Halt, NewtonSample, NewtonStats, Sample, State, stop_requested};
 use crate::cpu::{ShapeCache, shape_eval};
 use crate::error::Result;
 use crate::model::fault::{Fault, FaultKind};
@@ -93,12 +91,7 @@ impl ImplicitBackend {
         };
         let n = model.particles.len();
         let nodes = model.grid.n_nodes();
-        let min_mass = model
-            .particles
-            .mass
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
+        let min_mass = model.particles.min_mass();
         let stiffest = model
             .materials
             .iter()
@@ -661,19 +654,9 @@ impl Backend for ImplicitBackend {
     }
 
     fn sample(&mut self) -> Result<Sample> {
-        let p = &self.model.particles;
         Ok(Sample {
             t: self.t,
-            probes: self
-                .model
-                .probes
-                .iter()
-                .map(|pr| ProbeState {
-                    x: p.x[pr.particle],
-                    v: p.v[pr.particle],
-                    stress: p.stress[pr.particle],
-                })
-                .collect(),
+            probes: crate::backend::probe_states(&self.model),
             energy: crate::cpu::energy::energy(&self.model),
             reactions: self.reactions.clone(),
             newton: Some(NewtonSample {
