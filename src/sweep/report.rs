@@ -316,3 +316,47 @@ pub fn stability_chart(
     .save(stem)?;
     Ok(stems(stem))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pareto_front_keeps_what_nothing_beats() {
+        // (cost, error): b is beaten by a (cheaper and more accurate), d by c.
+        let pts = [
+            (1.0, 5.0),
+            (2.0, 6.0),
+            (3.0, 2.0),
+            (4.0, 2.5),
+            (5.0, 1.0),
+            (0.5, f64::NAN),
+        ];
+        assert_eq!(pareto(&pts), vec![0, 2, 4]);
+    }
+
+    #[test]
+    fn the_fitted_order_is_the_slope_in_log_log() {
+        let pts: Vec<(f64, f64)> = [0.1, 0.05, 0.025]
+            .iter()
+            .map(|&h| (h, 3.0 * h * h))
+            .collect();
+        assert!((fitted_order(&pts).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(fitted_order(&pts[..1]), None);
+        assert_eq!(fitted_order(&[(0.1, 1.0), (0.1, 2.0)]), None);
+    }
+
+    #[test]
+    fn csv_quotes_what_needs_it_and_always_the_reason() {
+        let mut r = Record::missing("a", vec![("k".into(), "x,y".into())], "why, \"so\"");
+        r.errors = vec![("rms".into(), 0.5)];
+        let text = csv(&[r]);
+        let row = text.lines().nth(1).unwrap();
+        assert!(
+            row.starts_with("a,\"x,y\",missing,\"why, \"\"so\"\"\","),
+            "{row}"
+        );
+        assert!(row.ends_with(",0.5"), "{row}");
+        assert_eq!(default_metric(&[]), None);
+    }
+}
