@@ -239,18 +239,8 @@ fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Resu
 
 pub use crate::sweep::report::{image, sig, table};
 
-/// Short text for a run that did not complete.
+/// Short text for how a run ended (`unstable at 1.2e-5 s (left_grid)`),
+/// the same words as a sweep's table.
 pub fn failure_text(r: &runner::JobResult) -> String {
-    match &r.outcome {
-        Err(e) => format!("error: {e}"),
-        Ok(d) => match &d.status {
-            crate::solver::RunStatus::Completed => "completed".into(),
-            crate::solver::RunStatus::Unstable { fault, t, .. } => {
-                format!("unstable at {} s ({})", sig(*t), fault.code())
-            }
-            crate::solver::RunStatus::Interrupted { t, .. } => {
-                format!("interrupted at {} s", sig(*t))
-            }
-        },
-    }
+    Record::from_job(r).status_text()
 }
