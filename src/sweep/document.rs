@@ -318,7 +318,7 @@ pub fn write(
                 .iter()
                 .map(|&i| &records[i])
                 .find(|r| r.key(&col_key) == Some(c.as_str()));
-            let fig = r.and_then(|r| value(r)).map(sig);
+            let fig = r.and_then(&value).map(sig);
             let (status, text, md_text) = report::status_cell(r, fig);
             line.push((status, text));
             md_line.push(md_text.replace('|', "/"));

@@ -191,6 +191,9 @@ fn stems(stem: &Path) -> Vec<PathBuf> {
     vec![stem.with_extension("png"), stem.with_extension("svg")]
 }
 
+/// A point on the Pareto front: (curve index, point index in that curve).
+pub type OnFront = (usize, usize);
+
 /// Error against wall time (log-log), one line per curve, and the Pareto
 /// front over all their points as a dashed grey line. Returns the files
 /// written and the front as (curve index, point index), cheapest first.
@@ -199,7 +202,7 @@ pub fn front_chart(
     y_label: &str,
     curves: &[Curve],
     stem: &Path,
-) -> Result<(Vec<PathBuf>, Vec<(usize, usize)>)> {
+) -> Result<(Vec<PathBuf>, Vec<OnFront>)> {
     let mut c = LineChart::new(title, "wall time of the run (s)", y_label).log_log();
     let mut all = Vec::new();
     for (ci, cv) in curves.iter().enumerate() {

@@ -321,7 +321,7 @@ pub fn run_jobs(jobs: Vec<Job>, n_workers: usize, progress: bool) -> Vec<JobResu
         |j| j.label.clone(),
         |j| j.backend != BackendChoice::Cpu,
         None,
-        |j, threads| run_one(j, threads),
+        run_one,
         |_, msg| Err(format!("the run panicked: {msg}")),
     );
     bar.finish_and_clear();
