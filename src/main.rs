@@ -648,6 +648,7 @@ fn sweep(a: SweepArgs) -> ExitCode {
     let opts = SweepOptions {
         jobs,
         progress: !a.quiet && std::io::stderr().is_terminal(),
+        progress_lines: !a.quiet && !std::io::stderr().is_terminal(),
         stop: Some(Arc::clone(&signals.stop)),
         metric: a.metric.clone(),
     };

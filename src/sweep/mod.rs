@@ -37,6 +37,8 @@ pub struct SweepOptions {
     pub jobs: usize,
     /// One progress bar over the runs on stderr.
     pub progress: bool,
+    /// A line on stderr as each run ends (for logs, when stderr is not a terminal).
+    pub progress_lines: bool,
     /// Raised by a signal: running runs stop (interrupted, resumable) and no new one starts.
     pub stop: Option<Arc<AtomicBool>>,
     /// The figure the charts use (`--metric`); default the first error reported.
@@ -118,7 +120,9 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
             .any(|a| !a.is_software()),
     };
     let bar = runner::progress_bar(plan.runs.len(), opts.progress);
+    let opts_lines = opts.progress_lines;
     let split = runner::Split::new(if on_gpu { 1 } else { opts.jobs.max(1) }, plan.runs.len());
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let outcomes = runner::run_parallel(
         &plan.runs,
         split,
@@ -144,9 +148,19 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
                 limits: Default::default(),
                 stop: opts.stop.clone(),
             };
-            crate::run::run(&scene, &opts)
-                .map(|_| ())
-                .map_err(|e| e.to_string())
+            let result = crate::run::run(&scene, &opts);
+            if opts_lines {
+                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                let how = match &result {
+                    Ok(o) => match &o.summary.reason {
+                        Some(why) => format!("{}: {why}", o.summary.status),
+                        None => o.summary.status.to_string(),
+                    },
+                    Err(e) => format!("failed: {e}"),
+                };
+                eprintln!("sweep: {k}/{} runs done; {} {how}", plan.runs.len(), r.id);
+            }
+            result.map(|_| ()).map_err(|e| e.to_string())
         },
         |_, msg| Err(format!("the run panicked: {msg}")),
     );
