@@ -18,6 +18,7 @@
 //! linearisation written in the other configuration.
 
 use crate::cpu::ShapeCache;
+use crate::model::Model;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::Material;
 use crate::model::material::increment::{StepState, mul};
@@ -195,21 +196,18 @@ pub fn piola_tangent(
 /// Inputs of the residual and Jacobian that stay fixed through a step.
 pub struct StepInputs<'a> {
     pub cache: &'a ShapeCache,
-    pub mass: &'a [f64],
+    /// Particles' mass and material, the walls.
+    pub model: &'a Model,
     /// V_p at the step's start (m²).
     pub volume: &'a [f64],
     /// Body force per unit mass at the step's end, load factor applied (m/s²).
     pub body: &'a [[f64; 2]],
-    pub material: &'a (dyn Fn(usize) -> &'a Material + Sync),
     pub start: &'a [StepState],
     /// Nodal velocity and acceleration at the step's start.
     pub v: &'a [[f64; 2]],
     pub a: &'a [[f64; 2]],
     pub newmark: Newmark,
     pub dofs: &'a Dofs,
-    pub walls: &'a [Wall],
-    /// Per node, the walls it is behind (bit k = wall k); empty: none.
-    pub wall_mask: &'a [u32],
     pub penalty: f64,
 }
 
@@ -232,7 +230,7 @@ pub fn residual(
         .with_min_len(256)
         .map(|(p, it)| {
             let df = incremental_gradient(inp.cache, p, du);
-            match particle_iterate((inp.material)(p), df, &inp.start[p]) {
+            match particle_iterate(inp.model.material_of(p), df, &inp.start[p]) {
                 Ok(x) => {
                     *it = x;
                     None
@@ -255,7 +253,7 @@ pub fn residual(
                 for (k, it) in its.iter().enumerate() {
                     let p = c * chunk + k;
                     let (nodes, w) = inp.cache.particle(p);
-                    let (m, vol) = (inp.mass[p], inp.volume[p]);
+                    let (m, vol) = (inp.model.particles.mass[p], inp.volume[p]);
                     // Particle acceleration at the step's end (eq. 47).
                     let mut ap = [0.0; 2];
                     if !nw.is_static {
@@ -290,12 +288,12 @@ pub fn residual(
     for f in wall_force.iter_mut() {
         *f = [0.0; 2];
     }
-    if !inp.walls.is_empty() {
-        for (n, &mask) in inp.wall_mask.iter().enumerate() {
+    if !inp.model.walls.list.is_empty() {
+        for (n, &mask) in inp.model.walls.mask.iter().enumerate() {
             if mask == 0 || inp.dofs.id[n] == NO_DOF {
                 continue;
             }
-            for (k, wall) in inp.walls.iter().enumerate() {
+            for (k, wall) in inp.model.walls.list.iter().enumerate() {
                 if mask & (1 << k) != 0 {
                     let (f, _) = contact(wall, du[n], inp.penalty);
                     r[n][0] += f[0];
@@ -461,14 +459,14 @@ pub fn jacobian(
         .enumerate()
         .with_min_len(64)
         .map(|(p, it)| {
-            piola_tangent((inp.material)(p), it, &inp.start[p]).map_err(|k| Fault::at(p, k))
+            piola_tangent(inp.model.material_of(p), it, &inp.start[p]).map_err(|k| Fault::at(p, k))
         })
         .collect();
     let tangents = tangents?;
     let dofs = inp.dofs;
     for (p, a) in tangents.iter().enumerate() {
         let (nodes, w) = inp.cache.particle(p);
-        let (m, vol) = (inp.mass[p], inp.volume[p]);
+        let (m, vol) = (inp.model.particles.mass[p], inp.volume[p]);
         for (&nb, wb) in nodes.iter().zip(w) {
             let ib = dofs.id[nb as usize];
             if ib == NO_DOF {
@@ -500,12 +498,12 @@ pub fn jacobian(
             }
         }
     }
-    for (n, &mask) in inp.wall_mask.iter().enumerate() {
+    for (n, &mask) in inp.model.walls.mask.iter().enumerate() {
         let id = dofs.id.get(n).copied().unwrap_or(NO_DOF);
         if mask == 0 || id == NO_DOF {
             continue;
         }
-        for (k, wall) in inp.walls.iter().enumerate() {
+        for (k, wall) in inp.model.walls.list.iter().enumerate() {
             if mask & (1 << k) != 0 {
                 let (_, dk) = contact(wall, du[n], inp.penalty);
                 for i in 0..2 {

@@ -32,7 +32,7 @@ use crate::model::walls::CONTACT_STICK;
 use crate::model::{FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
 use assemble::{Dofs, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
 use faer::prelude::*;
-use faer::sparse::SparseColMat;
+use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::solvers::Lu;
 use std::sync::atomic::AtomicBool;
 
@@ -150,6 +150,16 @@ impl ImplicitBackend {
             rem
         } else {
             dt
+        }
+    }
+
+    /// The Newmark parameters of a step of `dt`.
+    fn newmark(&self, dt: f64) -> Newmark {
+        Newmark {
+            beta: self.settings.beta,
+            gamma: self.settings.gamma,
+            dt,
+            is_static: self.settings.static_analysis,
         }
     }
 
@@ -324,31 +334,22 @@ impl ImplicitBackend {
     fn attempt(&mut self, dt: f64) -> std::result::Result<(), AttemptFail> {
         self.fill_body(dt);
         self.predict(dt);
-        let newmark = Newmark {
-            beta: self.settings.beta,
-            gamma: self.settings.gamma,
-            dt,
-            is_static: self.settings.static_analysis,
-        };
+        let newmark = self.newmark(dt);
         let m = &self.model;
         let dofs = &self.dofs;
         let Some(pattern) = self.pattern.as_ref() else {
             return Err(AttemptFail::Newton(f64::NAN));
         };
-        let material = |p: usize| m.material_of(p);
         let inp = StepInputs {
             cache: &self.cache,
-            mass: &m.particles.mass,
+            model: m,
             volume: &self.volume,
             body: &self.body,
-            material: &material,
             start: &self.start,
             v: &self.node_v,
             a: &self.node_a,
             newmark,
             dofs,
-            walls: &m.walls.list,
-            wall_mask: &m.walls.mask,
             penalty: self.penalty,
         };
         // The load's own size, |Σ_p N m_p b_p| over the free components.
@@ -418,8 +419,8 @@ impl ImplicitBackend {
             }
             assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values)
                 .map_err(AttemptFail::Particle)?;
-            let k = SparseColMat::new(pattern.symbolic.clone(), self.values.clone());
-            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k.as_ref())
+            let k = SparseColMatRef::new(pattern.symbolic.as_ref(), &self.values);
+            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k)
                 .map_err(|_| AttemptFail::Newton(ratio))?;
             for (n, &id) in dofs.id.iter().enumerate() {
                 if id == NO_DOF {
@@ -479,28 +480,19 @@ impl ImplicitBackend {
                 }
             }
         }
-        let newmark = Newmark {
-            beta: self.settings.beta,
-            gamma: self.settings.gamma,
-            dt,
-            is_static: self.settings.static_analysis,
-        };
+        let newmark = self.newmark(dt);
         let m = &self.model;
-        let material = |p: usize| m.material_of(p);
         let pattern = self.pattern.as_ref().expect("initial_phase built it");
         let inp = StepInputs {
             cache: &self.cache,
-            mass: &m.particles.mass,
+            model: m,
             volume: &self.volume,
             body: &self.body,
-            material: &material,
             start: &self.start,
             v: &self.node_v,
             a: &self.node_a,
             newmark,
             dofs: &self.dofs,
-            walls: &m.walls.list,
-            wall_mask: &m.walls.mask,
             penalty: self.penalty,
         };
         let mut its = self.iterates.clone();
@@ -549,13 +541,8 @@ impl ImplicitBackend {
 
     /// Particles take the converged grid solution (eqs. 46–49); reactions.
     fn convect(&mut self) {
-        let (beta, gamma, dt) = (self.settings.beta, self.settings.gamma, self.dt);
-        let newmark = Newmark {
-            beta,
-            gamma,
-            dt,
-            is_static: self.settings.static_analysis,
-        };
+        let (gamma, dt) = (self.settings.gamma, self.dt);
+        let newmark = self.newmark(dt);
         let m = &mut self.model;
         let p = &mut m.particles;
         for i in 0..p.len() {
