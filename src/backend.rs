@@ -62,6 +62,45 @@ pub struct Sample {
     pub energy: Energy,
     /// Per constraint group, reaction of the last step (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
+    /// The implicit integrator's last step (None for the explicit ones,
+    /// and for samples read back from a checkpoint).
+    pub newton: Option<NewtonSample>,
+}
+
+/// The implicit integrator's last step, as a sample reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonSample {
+    /// Newton iterations the step took.
+    pub iterations: u32,
+    /// Its final residual norm over the step's reference norm.
+    pub residual: f64,
+    /// Its Δt after any cuts (s).
+    pub dt: f64,
+}
+
+/// Newton statistics of an implicit run, for `summary.json`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NewtonStats {
+    /// Converged steps and the Newton iterations they took in all.
+    pub steps: u64,
+    pub iterations: u64,
+    /// Most iterations one step took.
+    pub max_iterations: u32,
+    /// Iterations of the last step.
+    pub last_iterations: u32,
+    /// Relative residual norms of the last step's iterates, first to last.
+    pub last_residuals: Vec<f64>,
+    /// Relative correction norms |δ| / |Δu| of the last step's iterations.
+    pub last_corrections: Vec<f64>,
+    /// Halvings of Δt over the run.
+    pub cuts: u64,
+}
+
+impl NewtonStats {
+    /// Mean Newton iterations per converged step.
+    pub fn mean_iterations(&self) -> f64 {
+        self.iterations as f64 / self.steps.max(1) as f64
+    }
 }
 
 pub trait Backend {
@@ -91,6 +130,24 @@ pub trait Backend {
     /// Replaces the run state with `state` after `steps` steps (resuming
     /// from a checkpoint): particles, time, Δt of the last step.
     fn restore(&mut self, state: &State, steps: u64) -> Result<()>;
+    /// Newton statistics (the implicit integrator only).
+    fn newton(&self) -> Option<&NewtonStats> {
+        None
+    }
+}
+
+/// The probes' state now, in `Model::probes` order.
+pub fn probe_states(model: &Model) -> Vec<ProbeState> {
+    let p = &model.particles;
+    model
+        .probes
+        .iter()
+        .map(|pr| ProbeState {
+            x: p.x[pr.particle],
+            v: p.v[pr.particle],
+            stress: p.stress[pr.particle],
+        })
+        .collect()
 }
 
 /// `stop` raised? (Relaxed: the flag is a request, nothing else hangs on it.)

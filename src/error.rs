@@ -79,6 +79,11 @@ pub enum SceneError {
     /// A `--set dotted.key=value` argument could not be applied.
     #[error("--set {arg}: {message}")]
     Override { arg: String, message: String },
+
+    /// A `lme-mpm sweep` argument (`--vary KEY=V1,V2`, `--resolution`, a
+    /// run of the product) cannot be used; `arg` names it with its value.
+    #[error("{arg}: {message}")]
+    Sweep { arg: String, message: String },
 }
 
 impl SceneError {

@@ -36,5 +36,6 @@ pub mod scene;
 pub mod simulation;
 pub mod solver;
 pub mod study;
+pub mod sweep;
 
 pub use error::{Error, Result, SceneError};

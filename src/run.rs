@@ -206,6 +206,9 @@ fn finish(
         writer.samples.push(s);
     }
     let bytes_per_particle = backend.bytes_per_particle();
+    let newton = backend
+        .newton()
+        .map(crate::output::summary::NewtonSummary::from_stats);
     let backend_name = backend.name();
     let final_sample = writer.samples.last().cloned();
     // The particles are read once (a GPU download) and used in place.
@@ -299,6 +302,7 @@ fn finish(
         version: env!("CARGO_PKG_VERSION"),
         memory_estimate_bytes: plan.estimate.memory_bytes.round() as u64,
         peak_rss_bytes: crate::preflight::peak_rss(),
+        newton,
     };
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     writer.write("summary.json", json.as_bytes())?;
@@ -589,6 +593,17 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         crate::model::Integrator::Musl => "musl (B-spline paper eqs. 28-37)".to_string(),
         crate::model::Integrator::Npc { gamma, position } => {
             format!("npc (gamma = {gamma}, position: {position:?})")
+        }
+        crate::model::Integrator::Implicit(s) => {
+            let mode = if s.static_analysis {
+                format!("static, {} load steps", s.load_steps)
+            } else {
+                format!("Newmark beta = {}, gamma = {}", s.beta, s.gamma)
+            };
+            format!(
+                "implicit ({mode}; Newton tol = {:e}, at most {} iterations, {} cuts)",
+                s.tol, s.max_iter, s.max_cuts
+            )
         }
     };
     format!(

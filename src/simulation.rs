@@ -13,6 +13,7 @@
 
 use crate::backend::Backend;
 use crate::cpu::CpuBackend;
+use crate::cpu::implicit::ImplicitBackend;
 use crate::error::{Error, Result};
 use crate::exact::{self, Errors};
 use crate::gpu::{self, GpuBackend};
@@ -71,6 +72,25 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
         allow_software,
         force_cas: std::env::var_os("LME_MPM_FORCE_CAS").is_some(),
     };
+    if matches!(model.integrator, crate::model::Integrator::Implicit(_)) {
+        return match spec.choice() {
+            BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
+                "solver.integrator",
+                "= \"implicit\" runs on the CPU path only: use --backend cpu or auto",
+            )
+            .into()),
+            BackendChoice::Cpu | BackendChoice::Auto => {
+                let b = ImplicitBackend::new(model)?;
+                if spec.verbose && spec.choice() == BackendChoice::Auto {
+                    eprintln!(
+                        "backend: {} (auto: the implicit integrator runs on the CPU only)",
+                        b.name()
+                    );
+                }
+                Ok(Box::new(b))
+            }
+        };
+    }
     match spec.choice() {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
         BackendChoice::Gpu => {

@@ -53,8 +53,9 @@ pub fn g2p(
             v[0] += dt * acc[0];
             v[1] += dt * acc[1];
             match prm.integrator {
-                // MUSL moves as FE does (B-spline paper eqs. 29–30).
-                Integrator::Fe | Integrator::Musl => {
+                // MUSL moves as FE does (B-spline paper eqs. 29–30);
+                // `cpu::implicit` steps implicit models, so that arm is unused.
+                Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => {
                     x[0] += dt * vel[0];
                     x[1] += dt * vel[1];
                 }

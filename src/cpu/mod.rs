@@ -8,6 +8,7 @@ pub mod energy;
 pub mod forces;
 pub mod g2p;
 pub mod grid_update;
+pub mod implicit;
 pub mod mls;
 pub mod p2g;
 pub mod remap;
@@ -15,7 +16,7 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stress;
 
-use crate::backend::{Backend, Halt, ProbeState, Sample, State, stop_requested};
+use crate::backend::{Backend, Halt, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
@@ -79,12 +80,7 @@ impl CpuBackend {
     pub fn new(model: Model) -> Self {
         let n = model.particles.len();
         let nodes = model.grid.n_nodes();
-        let min_mass = model
-            .particles
-            .mass
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
+        let min_mass = model.particles.min_mass();
         CpuBackend {
             cache: ShapeCache::new(n, model.shape.max_nodes()),
             mv: vec![[0.0; 3]; nodes],
@@ -214,6 +210,8 @@ impl CpuBackend {
         match self.model.integrator {
             Integrator::Fe | Integrator::Musl => 0.0,
             Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
+            // Implicit models run on `implicit::ImplicitBackend`, never here.
+            Integrator::Implicit(_) => 0.0,
         }
     }
 
@@ -274,7 +272,7 @@ impl CpuBackend {
         let m = &mut self.model;
         let p = &mut m.particles;
         let gamma = match m.integrator {
-            Integrator::Fe | Integrator::Musl => 1.0,
+            Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => 1.0,
             Integrator::Npc { gamma, .. } => gamma,
         };
         // The forces' loads: at the step's end where the stress already is
@@ -405,7 +403,7 @@ impl CpuBackend {
 /// with its ramp, plus a manufactured solution's load at the particle's
 /// reference position, plus the particle's share of the tractions and
 /// point loads divided by its mass (the stages multiply by m_p again).
-fn body_force<'a>(
+pub(crate) fn body_force<'a>(
     gravity: Option<crate::model::Gravity>,
     mms: &'a Option<crate::model::AlignedVibration>,
     ext: &'a Option<crate::model::ExternalForces>,
@@ -459,21 +457,12 @@ impl Backend for CpuBackend {
     }
 
     fn sample(&mut self) -> Result<Sample> {
-        let p = &self.model.particles;
         Ok(Sample {
             t: self.t,
-            probes: self
-                .model
-                .probes
-                .iter()
-                .map(|pr| ProbeState {
-                    x: p.x[pr.particle],
-                    v: p.v[pr.particle],
-                    stress: p.stress[pr.particle],
-                })
-                .collect(),
+            probes: crate::backend::probe_states(&self.model),
             energy: energy::energy(&self.model),
             reactions: self.reactions.clone(),
+            newton: None,
         })
     }
 

@@ -1,6 +1,7 @@
 //! Exact solutions the benchmarks are scored against, built from the scene
 //! (geometry, material, loads) so a changed scene is scored correctly.
 
+pub mod cantilever;
 pub mod column;
 pub mod dyka;
 pub mod mms;
@@ -20,6 +21,7 @@ pub enum Errors {
     Mms(mms::MmsErrors),
     Sliding(sliding::SlidingErrors),
     Rolling(rolling::RollingErrors),
+    Cantilever(cantilever::CantileverErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact solution.
@@ -45,6 +47,9 @@ pub fn score(
         )),
         ExactKind::RollingDisk => {
             Errors::Rolling(rolling::RollingDisk::from_scene(scene).score(particles, t))
+        }
+        ExactKind::Cantilever => {
+            Errors::Cantilever(cantilever::Cantilever::from_scene(scene).score(particles))
         }
     }
 }

@@ -69,6 +69,14 @@ impl GpuBackend {
     }
 
     pub fn with_options(ctx: GpuContext, model: Model, opts: GpuOptions) -> Result<GpuBackend> {
+        if matches!(model.integrator, Integrator::Implicit(_)) {
+            return Err(crate::error::SceneError::invalid(
+                "solver.integrator",
+                "= \"implicit\" runs on the CPU path only (--backend cpu or auto); the GPU \
+                 path steps the explicit integrators",
+            )
+            .into());
+        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
@@ -336,15 +344,11 @@ impl GpuBackend {
 /// The scene constants the shaders read.
 pub fn params(model: &Model) -> Params {
     let g = &model.grid;
-    let min_mass = model
-        .particles
-        .mass
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let min_mass = model.particles.min_mass();
     let (t_end_hi, t_end_lo) = split_f64(model.t_end);
     let (gamma, p2g_accel) = match model.integrator {
-        Integrator::Fe | Integrator::Musl => (1.0, 0.0),
+        // `with_options` refuses implicit models before this is read.
+        Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => (1.0, 0.0),
         Integrator::Npc { gamma, .. } => (gamma, 1.0 - gamma),
     };
     let gravity = model
@@ -532,6 +536,7 @@ impl Backend for GpuBackend {
                 gravity_work_bound: e[2] as f64,
             },
             reactions: b.pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls),
+            newton: None,
         })
     }
 

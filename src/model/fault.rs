@@ -17,6 +17,10 @@ pub enum FaultKind {
     /// MLS: the moment matrix at a Gauss point (m) is singular, fewer than
     /// three non-collinear particles within its 3h support.
     MlsSingular { at: [f64; 2] },
+    /// Implicit: Newton did not converge within `solver.newton_max_iter`
+    /// iterations even after `cuts` halvings of Δt; `ratio` is the last
+    /// residual norm over the step's reference norm.
+    NewtonDiverged { cuts: u32, ratio: f64 },
 }
 
 /// The first problem a step found.
@@ -54,6 +58,7 @@ impl Fault {
             FaultKind::NonPositiveDensity => "non_positive_density",
             FaultKind::EnergyRunaway { .. } => "energy_runaway",
             FaultKind::MlsSingular { .. } => "mls_singular",
+            FaultKind::NewtonDiverged { .. } => "newton_diverged",
         }
     }
 }
@@ -74,6 +79,12 @@ impl std::fmt::Display for Fault {
                 f,
                 "MLS reconstruction singular at the Gauss point ({:.4}, {:.4}) m: fewer than 3 non-collinear particles within 3h",
                 at[0], at[1]
+            )?,
+            FaultKind::NewtonDiverged { cuts, ratio } => write!(
+                f,
+                "Newton did not converge (residual {ratio:.3e} of the step's reference) after {cuts} \
+                 halvings of the time step: lower solver.cfl / solver.dt, raise solver.load_steps or \
+                 solver.newton_max_iter"
             )?,
         }
         if let Some(p) = self.particle {

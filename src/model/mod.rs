@@ -78,6 +78,24 @@ pub enum Integrator {
     },
     /// Modified update stress last (B-spline paper eqs. 28–37).
     Musl,
+    /// Implicit Newmark with Newton–Raphson (`cpu::implicit`).
+    Implicit(ImplicitSettings),
+}
+
+/// The implicit integrator's settings (`solver.*` keys of the same names).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImplicitSettings {
+    /// Newmark β and γ.
+    pub beta: f64,
+    pub gamma: f64,
+    /// No inertia; loads scaled by t / t_end over `load_steps` steps.
+    pub static_analysis: bool,
+    pub load_steps: u32,
+    /// Relative residual and correction norms that end Newton.
+    pub tol: f64,
+    pub max_iter: u32,
+    /// Halvings of Δt allowed for a step before the run is unstable.
+    pub max_cuts: u32,
 }
 
 impl Integrator {
@@ -86,6 +104,7 @@ impl Integrator {
             Integrator::Fe => IntegratorKind::Fe,
             Integrator::Npc { .. } => IntegratorKind::Npc,
             Integrator::Musl => IntegratorKind::Musl,
+            Integrator::Implicit(_) => IntegratorKind::Implicit,
         }
     }
 }
@@ -168,12 +187,21 @@ impl Model {
                 position: f.solver.npc_position,
             },
             IntegratorKind::Musl => Integrator::Musl,
+            IntegratorKind::Implicit => Integrator::Implicit(ImplicitSettings {
+                beta: f.solver.newmark_beta,
+                gamma: f.solver.newmark_gamma,
+                static_analysis: f.solver.static_analysis,
+                load_steps: f.solver.load_steps,
+                tol: f.solver.newton_tol,
+                max_iter: f.solver.newton_max_iter,
+                max_cuts: f.solver.newton_max_cuts,
+            }),
         };
         let particles = Particles::from_seeds(
             &seeds,
             |b| materials[body_material[b as usize] as usize].density(),
             |b| velocities[b as usize],
-            matches!(integrator, Integrator::Npc { .. }),
+            matches!(integrator, Integrator::Npc { .. } | Integrator::Implicit(_)),
             matches!(shape, Shape::Lme(_)),
             materials.iter().any(Material::needs_deformation_gradient),
             materials.iter().any(Material::needs_plastic_state),

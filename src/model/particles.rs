@@ -93,6 +93,12 @@ impl Particles {
             .unwrap_or(0)
     }
 
+    /// The lightest particle's mass (kg per unit thickness; ∞ when empty):
+    /// what both backends scale `MASS_EPS_REL` by.
+    pub fn min_mass(&self) -> f64 {
+        self.mass.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
     /// Volume of particle `p` (m² per unit thickness).
     #[inline]
     pub fn volume(&self, p: usize) -> f64 {

@@ -157,6 +157,7 @@ impl Checkpoint {
                 })?,
                 energy: d.energy()?,
                 reactions: d.pairs()?,
+                newton: None,
             })
         })?;
         let snapshots = d.list(|d| Ok((d.f64()?, d.str()?)))?;
@@ -346,6 +347,7 @@ mod tests {
                 }],
                 energy: Energy::default(),
                 reactions: vec![[1.0, -1.0]],
+                newton: None,
             }],
             snapshots: vec![(0.0, "vtk/particles_00000.vtu".into())],
         }

@@ -6,13 +6,21 @@ use crate::backend::Sample;
 use crate::model::Particles;
 use std::fmt::Write;
 
-/// `t,probe,x,y,vx,vy,sxx,syy,sxy` (s, m, m/s, Pa).
+/// `t,probe,x,y,vx,vy,sxx,syy,sxy` (s, m, m/s, Pa), and for the implicit
+/// integrator `newton_iterations,newton_residual,dt` of the step before
+/// the sample (empty for samples read back from a checkpoint).
 /// `names` in `Model::probes` order.
 pub fn probes(names: &[String], samples: &[Sample]) -> String {
-    let mut s = String::from("t,probe,x,y,vx,vy,sxx,syy,sxy\n");
+    let implicit = samples.iter().any(|s| s.newton.is_some());
+    let mut s = String::from("t,probe,x,y,vx,vy,sxx,syy,sxy");
+    s.push_str(if implicit {
+        ",newton_iterations,newton_residual,dt\n"
+    } else {
+        "\n"
+    });
     for smp in samples {
         for (name, st) in names.iter().zip(&smp.probes) {
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "{},{},{},{},{},{},{},{},{}",
                 smp.t,
@@ -25,6 +33,14 @@ pub fn probes(names: &[String], samples: &[Sample]) -> String {
                 st.stress[1],
                 st.stress[2]
             );
+            match (implicit, smp.newton) {
+                (false, _) => {}
+                (true, Some(n)) => {
+                    let _ = write!(s, ",{},{},{}", n.iterations, n.residual, n.dt);
+                }
+                (true, None) => s.push_str(",,,"),
+            }
+            s.push('\n');
         }
     }
     s

@@ -63,4 +63,36 @@ pub struct Summary {
     /// Peak resident memory of the process when the summary was written
     /// (VmHWM, bytes); null where the OS does not report it.
     pub peak_rss_bytes: Option<u64>,
+    /// The implicit integrator's Newton iterations (null for the explicit ones).
+    pub newton: Option<NewtonSummary>,
+}
+
+/// Newton iterations of an implicit run.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct NewtonSummary {
+    /// Converged steps (since a resume, if resumed).
+    pub steps: u64,
+    /// Iterations per step: mean and most.
+    pub iterations_mean: f64,
+    pub iterations_max: u32,
+    /// Halvings of Δt (steps retried after Newton failed).
+    pub cuts: u64,
+    /// The last step's residual norms over its reference, one per iterate
+    /// (the first is the predictor's): quadratic convergence squares them.
+    pub last_step_residuals: Vec<f64>,
+    /// The last step's correction norms |δ| / |Δu|, one per iteration.
+    pub last_step_corrections: Vec<f64>,
+}
+
+impl NewtonSummary {
+    pub fn from_stats(s: &crate::backend::NewtonStats) -> Self {
+        NewtonSummary {
+            steps: s.steps,
+            iterations_mean: s.mean_iterations(),
+            iterations_max: s.max_iterations,
+            cuts: s.cuts,
+            last_step_residuals: s.last_residuals.clone(),
+            last_step_corrections: s.last_corrections.clone(),
+        }
+    }
 }

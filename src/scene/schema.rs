@@ -296,6 +296,9 @@ pub enum IntegratorKind {
     /// the nodes (by MLS with `solver.mls`), velocity gradient from the
     /// remapped nodal velocity, then F, density and stress.
     Musl,
+    /// Implicit Newmark with Newton–Raphson on the grid's displacement
+    /// increment, updated Lagrangian (implicit-MPM paper §3–4). CPU only.
+    Implicit,
 }
 
 /// Which nodal velocity moves the particles in the NPC particle update.
@@ -332,9 +335,37 @@ pub struct SolverSpec {
     /// Default `newmark` (docs/methods.md gives the test that chose it).
     #[serde(default = "default_npc_position")]
     pub npc_position: NpcPosition,
-    /// Courant number in (0, 1]: Δt = cfl · h / max(|v_p|, c_p). Default 0.1.
+    /// Courant number: Δt = cfl · h / max(|v_p|, c_p). In (0, 1] for the
+    /// explicit integrators; the implicit one accepts up to 100. Default 0.1.
     #[serde(default = "default_cfl")]
     pub cfl: f64,
+    /// Implicit: Newmark β, in (0, 0.5]. Default 0.25 (trapezoidal rule).
+    #[serde(default = "default_newmark_beta")]
+    pub newmark_beta: f64,
+    /// Implicit: Newmark γ, in [0.5, 1]. Default 0.5.
+    #[serde(default = "default_newmark_gamma")]
+    pub newmark_gamma: f64,
+    /// Implicit: a static analysis (no inertia): loads grow linearly to
+    /// their full value over `load_steps` equal steps of pseudo-time up to
+    /// `t_end`. Default false.
+    #[serde(default, rename = "static")]
+    pub static_analysis: bool,
+    /// Implicit static: number of load increments. Default 1 (a step
+    /// whose Newton fails is halved automatically, `newton_max_cuts`).
+    #[serde(default = "default_load_steps")]
+    pub load_steps: u32,
+    /// Implicit: Newton converges when the residual norm relative to the
+    /// step's first (or to the load's, if larger) and the correction norm
+    /// relative to the displacement increment are both below this. Default 1e-8.
+    #[serde(default = "default_newton_tol")]
+    pub newton_tol: f64,
+    /// Implicit: Newton iterations per attempt of a step. Default 25.
+    #[serde(default = "default_newton_max_iter")]
+    pub newton_max_iter: u32,
+    /// Implicit: times a step that does not converge is retried with half
+    /// the Δt before the run stops as unstable (`newton_diverged`). Default 6.
+    #[serde(default = "default_newton_max_cuts")]
+    pub newton_max_cuts: u32,
     /// End time (s). Required.
     pub t_end: f64,
     /// Fixed time step (s), in place of the CFL condition (the manufactured
@@ -377,6 +408,24 @@ fn default_npc_position() -> NpcPosition {
 }
 fn default_cfl() -> f64 {
     0.1
+}
+fn default_newmark_beta() -> f64 {
+    0.25
+}
+fn default_newmark_gamma() -> f64 {
+    0.5
+}
+fn default_load_steps() -> u32 {
+    1
+}
+fn default_newton_tol() -> f64 {
+    1e-8
+}
+fn default_newton_max_iter() -> u32 {
+    25
+}
+fn default_newton_max_cuts() -> u32 {
+    6
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -434,6 +483,9 @@ pub enum ExactKind {
     /// A disk rolling without slip down a wall under constant gravity
     /// (implicit-MPM paper §5.2): a = (2/3) g_t.
     RollingDisk,
+    /// Cantilever under self-weight, static (implicit-MPM paper §5.1): the
+    /// free end's mid-height deflection against 0.67433 m.
+    Cantilever,
 }
 
 /// Manufactured solutions known to the code.

@@ -103,12 +103,26 @@ fn check_solver(file: &SceneFile) -> Result<(), SceneError> {
     let s = &file.solver;
     positive("solver.t_end", s.t_end)?;
     finite("solver.cfl", s.cfl)?;
-    if !(s.cfl > 0.0 && s.cfl <= 1.0) {
+    let implicit = s.integrator == IntegratorKind::Implicit;
+    // Explicit steps are stable only below the Courant limit; the implicit
+    // Newmark step (β = 1/4) is unconditionally stable, and 100 keeps Δt a
+    // time step rather than a typo.
+    let cfl_max = if implicit { 100.0 } else { 1.0 };
+    if !(s.cfl > 0.0 && s.cfl <= cfl_max) {
         return Err(SceneError::invalid(
             "solver.cfl",
-            format!("must be in (0, 1], got {}", s.cfl),
+            format!(
+                "must be in (0, {cfl_max}] with integrator = \"{}\", got {}",
+                if implicit {
+                    "implicit"
+                } else {
+                    "npc\" or \"fe"
+                },
+                s.cfl
+            ),
         ));
     }
+    check_implicit(s)?;
     finite("solver.npc_gamma", s.npc_gamma)?;
     if !(s.npc_gamma > 0.0 && s.npc_gamma <= 1.0) {
         return Err(SceneError::invalid(
@@ -121,6 +135,70 @@ fn check_solver(file: &SceneFile) -> Result<(), SceneError> {
         return Err(SceneError::invalid(
             "solver.lme_tol",
             format!("must be in (0, 1e-2], got {}", s.lme_tol),
+        ));
+    }
+    Ok(())
+}
+
+/// The implicit integrator's keys (checked whatever the integrator, so a
+/// typo is caught before it matters).
+fn check_implicit(s: &SolverSpec) -> Result<(), SceneError> {
+    finite("solver.newmark_beta", s.newmark_beta)?;
+    if !(s.newmark_beta > 0.0 && s.newmark_beta <= 0.5) {
+        return Err(SceneError::invalid(
+            "solver.newmark_beta",
+            format!("must be in (0, 0.5], got {}", s.newmark_beta),
+        ));
+    }
+    finite("solver.newmark_gamma", s.newmark_gamma)?;
+    if !(s.newmark_gamma >= 0.5 && s.newmark_gamma <= 1.0) {
+        return Err(SceneError::invalid(
+            "solver.newmark_gamma",
+            format!(
+                "must be in [0.5, 1] (below 0.5 Newmark amplifies), got {}",
+                s.newmark_gamma
+            ),
+        ));
+    }
+    finite("solver.newton_tol", s.newton_tol)?;
+    if !(s.newton_tol >= 1e-14 && s.newton_tol <= 1e-2) {
+        return Err(SceneError::invalid(
+            "solver.newton_tol",
+            format!("must be in [1e-14, 1e-2], got {}", s.newton_tol),
+        ));
+    }
+    if s.newton_max_iter == 0 || s.newton_max_iter > 1000 {
+        return Err(SceneError::invalid(
+            "solver.newton_max_iter",
+            format!("must be in [1, 1000], got {}", s.newton_max_iter),
+        ));
+    }
+    if s.newton_max_cuts > 30 {
+        return Err(SceneError::invalid(
+            "solver.newton_max_cuts",
+            format!(
+                "must be at most 30 (2^-30 of the step), got {}",
+                s.newton_max_cuts
+            ),
+        ));
+    }
+    if s.load_steps == 0 || s.load_steps > 1_000_000 {
+        return Err(SceneError::invalid(
+            "solver.load_steps",
+            format!("must be in [1, 1e6], got {}", s.load_steps),
+        ));
+    }
+    let implicit = s.integrator == IntegratorKind::Implicit;
+    if s.static_analysis && !implicit {
+        return Err(SceneError::invalid(
+            "solver.static",
+            "needs integrator = \"implicit\" (an explicit step has no static form)",
+        ));
+    }
+    if implicit && s.mls {
+        return Err(SceneError::invalid(
+            "solver.mls",
+            "is not available with integrator = \"implicit\" (the implicit step integrates at the particles)",
         ));
     }
     Ok(())
@@ -752,6 +830,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ExactKind::AlignedVibration => return Ok(()),
         ExactKind::SlidingBlock => return check_sliding_block(file),
         ExactKind::RollingDisk => return check_rolling_disk(file),
+        ExactKind::Cantilever => "cantilever",
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -767,7 +846,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         return Err(SceneError::invalid(
             "exact",
             format!(
-                "= \"{what}\" is a 1D solution and needs nu = 0 (plane strain then has no lateral coupling), got nu = {}",
+                "= \"{what}\" is scored by a 1D (bar or beam) solution and needs nu = 0 (plane strain then has no lateral coupling), got nu = {}",
                 m.nu
             ),
         ));
@@ -795,6 +874,18 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
                 return Err(SceneError::invalid(
                     "exact",
                     "= \"dyka_bar\" needs horizontal initial velocities",
+                ));
+            }
+        }
+        ExactKind::Cantilever => {
+            let ok = file
+                .gravity
+                .as_ref()
+                .is_some_and(|g| g.g[0] == 0.0 && g.g[1] < 0.0);
+            if !ok {
+                return Err(SceneError::invalid(
+                    "exact",
+                    "= \"cantilever\" needs gravity along -y (gravity.g = [0, -g])",
                 ));
             }
         }

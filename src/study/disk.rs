@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::exact::rolling::RollingDisk;
 use crate::scene::Scene;
 use crate::simulation::BackendChoice;
+use crate::sweep::report::{self, Curve};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -177,24 +178,28 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     let mut md = String::new();
 
     // --- error against wall time -------------------------------------------
-    let mut c = LineChart::new(
-        format!("Rolling disk ({main}): eq. 67 error against wall time, Δt1 = 2Δt2 = 4Δt3"),
-        "wall time (s)",
+    let curves: Vec<Curve> = methods
+        .iter()
+        .enumerate()
+        .map(|(k, m)| Curve {
+            label: m.to_string(),
+            points: (0..dts.len())
+                .filter_map(|i| {
+                    let r = get(m, i)?;
+                    Some((r.data()?.wall_seconds, error_percent(&exact, r)?))
+                })
+                .collect(),
+            color: k,
+            dashed: false,
+        })
+        .collect();
+    let (files, _) = report::front_chart(
+        &format!("Rolling disk ({main}): eq. 67 error against wall time, Δt1 = 2Δt2 = 4Δt3"),
         "error (%)",
-    )
-    .log_log();
-    for (k, m) in methods.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = (0..dts.len())
-            .filter_map(|i| {
-                let r = get(m, i)?;
-                Some((r.data()?.wall_seconds, error_percent(&exact, r)?))
-            })
-            .collect();
-        c.series.push(Series::line(*m, pts, k).markers());
-    }
-    c.size = (800, 480);
-    c.save(&dir.join("study-disk-error-time"))?;
-    charts.extend(["study-disk-error-time.png", "study-disk-error-time.svg"].map(|f| dir.join(f)));
+        &curves,
+        &dir.join("study-disk-error-time"),
+    )?;
+    charts.extend(files);
 
     // --- displacement history at the smallest step ---------------------------
     let last = dts.len() - 1;

@@ -13,6 +13,7 @@ use crate::exact::Errors;
 use crate::exact::dyka::DykaBar;
 use crate::scene::Scene;
 use crate::simulation::BackendChoice;
+use crate::sweep::report::{self, Curve};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -177,79 +178,72 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
 }
 
 impl Report<'_> {
-    /// Error against cell size, one series per method and integrator.
+    /// Error against cell size, one series per method and integrator, each
+    /// with its fitted order (the shared convergence chart).
     fn convergence_chart(&self) -> Result<Vec<PathBuf>> {
         let (results, hs, main, dir) = (self.results, self.hs, self.main, self.dir);
-        let mut charts = Vec::new();
-        // --- error against cell size --------------------------------------
-        let mut conv = LineChart::new(
+        let mut curves = Vec::new();
+        for (m, (label, _, _)) in METHODS.iter().enumerate() {
+            for integ in INTEGRATORS {
+                curves.push(Curve {
+                    label: format!("{label} {integ}"),
+                    points: hs
+                        .iter()
+                        .filter_map(|&h| {
+                            find(results, main, label, integ, h)
+                                .and_then(rms_of)
+                                .map(|e| (h * 1e3, e))
+                        })
+                        .collect(),
+                    color: m,
+                    dashed: integ == "fe",
+                });
+            }
+        }
+        let (files, _) = report::convergence_chart(
             "Dyka's bar: RMS velocity error at t_end (solid NPC, dashed FE)",
             "cell size h (mm)",
             "RMS velocity error (m/s)",
-        )
-        .log_log();
-        for (m, (label, _, _)) in METHODS.iter().enumerate() {
-            for integ in INTEGRATORS {
-                let pts: Vec<(f64, f64)> = hs
-                    .iter()
-                    .filter_map(|&h| {
-                        find(results, main, label, integ, h)
-                            .and_then(rms_of)
-                            .map(|e| (h * 1e3, e))
-                    })
-                    .collect();
-                let s = Series::line(format!("{label} {integ}"), pts, m).markers();
-                conv.series.push(if integ == "fe" { s.dashed() } else { s });
-            }
-        }
-        conv.size = (900, 560);
-        conv.legend = plotters::chart::SeriesLabelPosition::LowerRight;
-        conv.save(&dir.join("study-dyka-convergence"))?;
-        charts.extend(
-            ["study-dyka-convergence.png", "study-dyka-convergence.svg"].map(|f| dir.join(f)),
-        );
-        Ok(charts)
+            &curves,
+            &dir.join("study-dyka-convergence"),
+        )?;
+        Ok(files)
     }
 
-    /// Error against wall time, per backend, method and integrator.
+    /// Error against wall time, per backend, method and integrator, with
+    /// the Pareto front (the shared front chart).
     fn front_chart(&self, backends: &[&str]) -> Result<Vec<PathBuf>> {
         let (results, hs, dir) = (self.results, self.hs, self.dir);
-        let mut charts = Vec::new();
-        // --- error against wall time -----------------------------------------
-        let mut front = LineChart::new(
-            "Dyka's bar: accuracy against cost (each point one cell size)",
-            "wall time of the run (s)",
-            "RMS velocity error (m/s)",
-        )
-        .log_log();
+        let mut curves = Vec::new();
         for b in backends {
             for (m, (label, _, _)) in METHODS.iter().enumerate() {
                 for integ in INTEGRATORS {
-                    let mut pts: Vec<(f64, f64)> = hs
-                        .iter()
-                        .filter_map(|&h| {
-                            let r = find(results, b, label, integ, h)?;
-                            Some((r.data()?.wall_seconds, rms_of(r)?))
-                        })
-                        .collect();
-                    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                    let name = if backends.len() > 1 {
-                        format!("{b} {label} {integ}")
-                    } else {
-                        format!("{label} {integ}")
-                    };
-                    let s = Series::line(name, pts, m).markers();
-                    front
-                        .series
-                        .push(if integ == "fe" { s.dashed() } else { s });
+                    curves.push(Curve {
+                        label: if backends.len() > 1 {
+                            format!("{b} {label} {integ}")
+                        } else {
+                            format!("{label} {integ}")
+                        },
+                        points: hs
+                            .iter()
+                            .filter_map(|&h| {
+                                let r = find(results, b, label, integ, h)?;
+                                Some((r.data()?.wall_seconds, rms_of(r)?))
+                            })
+                            .collect(),
+                        color: m,
+                        dashed: integ == "fe",
+                    });
                 }
             }
         }
-        front.size = (900, 560);
-        front.legend = plotters::chart::SeriesLabelPosition::LowerLeft;
-        front.save(&dir.join("study-dyka-front"))?;
-        charts.extend(["study-dyka-front.png", "study-dyka-front.svg"].map(|f| dir.join(f)));
-        Ok(charts)
+        let (files, _) = report::front_chart(
+            "Dyka's bar: accuracy against cost (each point one cell size)",
+            "RMS velocity error (m/s)",
+            &curves,
+            &dir.join("study-dyka-front"),
+        )?;
+        Ok(files)
     }
 
     /// Free-end velocity histories at 1 mm: the stems of the charts drawn
@@ -451,7 +445,7 @@ impl Report<'_> {
             "study-dyka-front.png",
         ));
         // The front: completed runs no other run beats on both time and error.
-        let mut pts: Vec<(f64, f64, String)> = results
+        let runs: Vec<(f64, f64, String)> = results
             .iter()
             .filter_map(|r| {
                 let d = r.data()?;
@@ -459,15 +453,14 @@ impl Report<'_> {
                 Some((d.wall_seconds, e, r.job.label.clone()))
             })
             .collect();
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut front_runs = Vec::new();
-        let mut best = f64::INFINITY;
-        for (w, e, l) in &pts {
-            if *e < best {
-                best = *e;
-                front_runs.push(format!("{l} ({} s, {} m/s)", sig(*w), sig(*e)));
-            }
-        }
+        let pts: Vec<(f64, f64)> = runs.iter().map(|(w, e, _)| (*w, *e)).collect();
+        let front_runs: Vec<String> = report::pareto(&pts)
+            .into_iter()
+            .map(|i| {
+                let (w, e, l) = &runs[i];
+                format!("{l} ({} s, {} m/s)", sig(*w), sig(*e))
+            })
+            .collect();
         let _ = writeln!(
             md,
             "\n**Accuracy against cost.** Each point is one run ({} thread(s) per run); further down and left is \

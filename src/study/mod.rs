@@ -14,7 +14,7 @@ pub mod stability;
 
 use crate::error::{Error, Result};
 use crate::simulation::BackendChoice;
-use std::fmt::Write;
+use crate::sweep::record::Record;
 use std::path::{Path, PathBuf};
 
 /// Which study.
@@ -192,9 +192,10 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             eprintln!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
         let results = runner::run_jobs(jobs, opts.jobs, opts.progress);
+        let records: Vec<Record> = results.iter().map(Record::from_job).collect();
         crate::output::write_atomic(
             &dir.join("results.csv"),
-            runner::results_csv(&results).as_bytes(),
+            crate::sweep::report::csv(&records).as_bytes(),
         )?;
         let (markdown, charts) = match n {
             StudyName::Dyka => dyka::report(&results, &dir, opts.quick)?,
@@ -237,48 +238,10 @@ fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Resu
     crate::docgen::replace_section(doc, &format!("study-{}", n.slug()), &(stamp + markdown))
 }
 
-/// Markdown image line for a chart written as `<dir>/<file>`.
-pub fn image(alt: &str, file: &str) -> String {
-    format!("![{alt}](charts/{file})\n")
-}
+pub use crate::sweep::report::{image, sig, table};
 
-/// Three significant digits.
-pub fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32;
-    if (-3..4).contains(&e) {
-        let decimals = (2 - e).max(0) as usize;
-        format!("{v:.decimals$}")
-    } else {
-        format!("{v:.2e}")
-    }
-}
-
-/// A markdown table.
-pub fn table(header: &[String], rows: &[Vec<String>]) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "| {} |", header.join(" | "));
-    let _ = writeln!(s, "|{}", "---|".repeat(header.len()));
-    for r in rows {
-        let _ = writeln!(s, "| {} |", r.join(" | "));
-    }
-    s
-}
-
-/// Short text for a run that did not complete.
+/// Short text for how a run ended (`unstable at 1.2e-5 s (left_grid)`),
+/// the same words as a sweep's table.
 pub fn failure_text(r: &runner::JobResult) -> String {
-    match &r.outcome {
-        Err(e) => format!("error: {e}"),
-        Ok(d) => match &d.status {
-            crate::solver::RunStatus::Completed => "completed".into(),
-            crate::solver::RunStatus::Unstable { fault, t, .. } => {
-                format!("unstable at {} s ({})", sig(*t), fault.code())
-            }
-            crate::solver::RunStatus::Interrupted { t, .. } => {
-                format!("interrupted at {} s", sig(*t))
-            }
-        },
-    }
+    Record::from_job(r).status_text()
 }

@@ -6,11 +6,11 @@
 use super::runner::{Job, JobResult};
 use super::{backend_slug, image, sig, table};
 use crate::cases::{COLUMN_COLLAPSE, DYKA_BAR, DYKA_L, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK};
-use crate::chart::{Status, StatusGrid};
 use crate::error::Result;
 use crate::exact::Errors;
 use crate::simulation::BackendChoice;
-use crate::solver::RunStatus;
+use crate::sweep::record::Record;
+use crate::sweep::report;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -148,6 +148,7 @@ fn error_figure(r: &JobResult) -> Option<String> {
         Errors::Column(e) => Some(format!("settle {}", sig(e.settlement_rel_error))),
         Errors::Sliding(e) => Some(format!("v {}", sig(e.velocity_rel_error))),
         Errors::Rolling(e) => Some(format!("u_x {}", sig(e.u_x_rel_error))),
+        Errors::Cantilever(e) => Some(format!("tip {}", sig(e.rel_error_timoshenko))),
     }
 }
 
@@ -161,58 +162,29 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                 && r.job.tag_value("column") == Some(ci.to_string().as_str())
         })
     };
+    // The cells as every sweep draws them (`sweep::report::status_cell`).
     let mut grid_cells = Vec::new();
     let mut rows_md = Vec::new();
     for (ri, (label, ..)) in METHODS.iter().enumerate() {
         let mut g = Vec::new();
         let mut m = vec![label.to_string()];
         for ci in 0..cols.len() {
-            let (status, text, md) = match cell(ri, ci) {
-                None => (Status::Missing, "-".to_string(), "-".to_string()),
-                Some(r) => match &r.outcome {
-                    Err(e) => (Status::Error, "error".into(), format!("error: {e}")),
-                    Ok(d) => match &d.status {
-                        RunStatus::Completed => {
-                            let e = error_figure(r);
-                            (
-                                Status::Ok,
-                                format!(
-                                    "ok{}",
-                                    e.as_ref().map_or(String::new(), |e| format!("\n{e}"))
-                                ),
-                                format!("ok{}", e.map_or(String::new(), |e| format!(" ({e})"))),
-                            )
-                        }
-                        RunStatus::Unstable { fault, t, .. } => (
-                            Status::Failed,
-                            format!("t = {} s\n{}", sig(*t), fault.code()),
-                            format!("**unstable** at {} s: {}", sig(*t), fault),
-                        ),
-                        RunStatus::Interrupted { t, .. } => (
-                            Status::Error,
-                            format!("t = {} s\ninterrupted", sig(*t)),
-                            format!("interrupted at {} s", sig(*t)),
-                        ),
-                    },
-                },
-            };
+            let r = cell(ri, ci);
+            let record = r.map(Record::from_job);
+            let (status, text, md) = report::status_cell(record.as_ref(), r.and_then(error_figure));
             g.push((status, text));
             m.push(md);
         }
         grid_cells.push(g);
         rows_md.push(m);
     }
-    StatusGrid {
-        title: format!("Stability map ({main}): completed or unstable, when and why"),
-        rows: METHODS.iter().map(|m| m.0.to_string()).collect(),
-        cols: cols.iter().map(Column::label).collect(),
-        cells: grid_cells,
-    }
-    .save(&dir.join("study-stability"))?;
-    let charts = vec![
-        dir.join("study-stability.png"),
-        dir.join("study-stability.svg"),
-    ];
+    let charts = report::stability_chart(
+        &format!("Stability map ({main}): completed or unstable, when and why"),
+        METHODS.iter().map(|m| m.0.to_string()).collect(),
+        cols.iter().map(Column::label).collect(),
+        grid_cells,
+        &dir.join("study-stability"),
+    )?;
 
     let mut md = String::new();
     let n = results.len();

@@ -5,6 +5,7 @@
 //! Drucker–Prager: σzz and the plastic strains, `plastic::PlasticState`).
 
 pub mod drucker_prager;
+pub mod increment;
 pub mod linear_elastic;
 pub mod mohr_coulomb;
 pub mod neo_hookean;
@@ -26,10 +27,6 @@ pub enum Material {
     MohrCoulomb(MohrCoulomb),
     DruckerPrager(DruckerPrager),
 }
-
-/// The tangent a later implicit solver asks of a material: dσ/dε in Voigt
-/// form [xx, yy, xy] (engineering shear), plane strain (Pa).
-pub type Tangent = [[f64; 3]; 3];
 
 impl Material {
     pub fn new(spec: &MaterialSpec) -> Material {
@@ -183,23 +180,6 @@ impl Material {
             Material::NeoHookean(m) => m.energy_density(f),
             Material::MohrCoulomb(m) => m.elastic.energy(s4),
             Material::DruckerPrager(m) => m.elastic.energy(s4),
-        }
-    }
-
-    /// Hook for the implicit solver (a later issue): the tangent dσ/dε of
-    /// the last `update` at this particle's state. Linear elastic gives its
-    /// plane-strain D; the others return `None` until their consistent
-    /// (algorithmic) tangents are written: for the plastic models it
-    /// follows from the return recorded in `q[plastic::RETURN]` (the active
-    /// surfaces) and de Souza Neto et al. box 8.4 (MC) / §8.3.3 (DP);
-    /// Neo-Hookean's from ∂σ/∂F at `f`.
-    pub fn tangent(&self, _stress: &[f64; 3], _f: &DefGrad, _q: &PlasticState) -> Option<Tangent> {
-        match self {
-            Material::LinearElastic(m) => {
-                let (l, g) = (m.lame, m.shear);
-                Some([[l + 2.0 * g, l, 0.0], [l, l + 2.0 * g, 0.0], [0.0, 0.0, g]])
-            }
-            _ => None,
         }
     }
 }

@@ -1,0 +1,686 @@
+//! The implicit integrator on the CPU (`solver.integrator = "implicit"`):
+//! updated-Lagrangian Newmark with Newton–Raphson on the nodal displacement
+//! increment (implicit-MPM paper §3–4, Algorithm 1). One step:
+//!
+//! 1. Initial phase: N, ∇N at the particles on the undeformed grid; nodal
+//!    mass, velocity and acceleration from the particles (eqs. 38–41);
+//!    Newmark predictor Δu = 0 (eqs. 42–44).
+//! 2. UL-FEM phase: Newton on R(Δu) = 0 (`assemble`), the grid moving with
+//!    the iterate, the sparse Jacobian factorised by faer's sparse LU;
+//!    converged when the residual norm over the step's reference and the
+//!    correction norm over Δu are both below `solver.newton_tol`.
+//! 3. Convective phase: particles take the converged grid solution
+//!    (eqs. 46–49): x += Σ N Δu, a = Σ N a_I, v += Δt((1 − γ) a_n + γ a);
+//!    stress, F and plastic state are those of the converged iterate; the
+//!    grid is reset.
+//!
+//! A step whose Newton fails (no convergence in `newton_max_iter`, a
+//! residual that blows up, a particle inverted, a singular Jacobian) is
+//! retried with half the Δt, up to `newton_max_cuts` times; then the run
+//! stops as unstable with reason `newton_diverged`. A static analysis
+//! (`solver.static`) drops the inertia and scales every load by t / t_end
+//! over `load_steps` steps of pseudo-time.
+
+pub mod assemble;
+
+use crate::backend::{Backend, Halt, NewtonSample, NewtonStats, Sample, State, stop_requested};
+use crate::cpu::{ShapeCache, shape_eval};
+use crate::error::Result;
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::material::increment::StepState;
+use crate::model::walls::CONTACT_STICK;
+use crate::model::{FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
+use assemble::{Dofs, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
+use faer::prelude::*;
+use faer::sparse::SparseColMatRef;
+use faer::sparse::linalg::solvers::Lu;
+use std::sync::atomic::AtomicBool;
+
+/// A residual norm above this many times the step's reference is a
+/// diverging Newton: the step is cut at once rather than iterated further.
+const DIVERGED_RATIO: f64 = 1e8;
+
+/// Why one attempt at a step failed.
+enum AttemptFail {
+    /// A particle faulted at an iterate (inverted, non-finite).
+    Particle(Fault),
+    /// No convergence; the last relative residual.
+    Newton(f64),
+}
+
+/// Runs an implicit `Model` on the CPU.
+pub struct ImplicitBackend {
+    pub model: Model,
+    pub settings: ImplicitSettings,
+    cache: ShapeCache,
+    /// Per node at the step's start: mass, velocity, acceleration.
+    node_mass: Vec<f64>,
+    node_v: Vec<[f64; 2]>,
+    node_a: Vec<[f64; 2]>,
+    /// The iterate Δu and the residual, per node.
+    du: Vec<[f64; 2]>,
+    r: Vec<[f64; 2]>,
+    iterates: Vec<ParticleIterate>,
+    start: Vec<StepState>,
+    volume: Vec<f64>,
+    body: Vec<[f64; 2]>,
+    values: Vec<f64>,
+    /// The step's unknowns and the Jacobian's structure (built once per step).
+    dofs: Dofs,
+    pattern: Option<Pattern>,
+    /// Per constraint group then per wall: reaction of the last step (N/m).
+    reactions: Vec<[f64; 2]>,
+    wall_force: Vec<[f64; 2]>,
+    mass_eps: f64,
+    penalty: f64,
+    pub stats: NewtonStats,
+    t: f64,
+    steps: u64,
+    dt: f64,
+}
+
+impl ImplicitBackend {
+    /// Fails unless `model` has the implicit integrator.
+    pub fn new(model: Model) -> Result<ImplicitBackend> {
+        let Integrator::Implicit(settings) = model.integrator else {
+            return Err(crate::error::SceneError::invalid(
+                "solver.integrator",
+                "must be \"implicit\" for the implicit backend",
+            )
+            .into());
+        };
+        let n = model.particles.len();
+        let nodes = model.grid.n_nodes();
+        let min_mass = model.particles.min_mass();
+        let stiffest = model
+            .materials
+            .iter()
+            .map(|m| {
+                let (l, g) = m.lame_shear();
+                l + 2.0 * g
+            })
+            .fold(0.0, f64::max);
+        let blank = ParticleIterate {
+            df: [1.0, 0.0, 0.0, 1.0],
+            state: StepState {
+                stress: [0.0; 3],
+                f: [1.0, 0.0, 0.0, 1.0],
+                q: [0.0; 4],
+            },
+            p: [0.0; 4],
+            j: 1.0,
+        };
+        Ok(ImplicitBackend {
+            cache: ShapeCache::new(n, model.shape.max_nodes()),
+            node_mass: vec![0.0; nodes],
+            node_v: vec![[0.0; 2]; nodes],
+            node_a: vec![[0.0; 2]; nodes],
+            du: vec![[0.0; 2]; nodes],
+            r: vec![[0.0; 2]; nodes],
+            iterates: vec![blank; n],
+            start: vec![blank.state; n],
+            volume: vec![0.0; n],
+            body: vec![[0.0; 2]; n],
+            values: Vec::new(),
+            dofs: Dofs::default(),
+            pattern: None,
+            reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
+            wall_force: vec![[0.0; 2]; model.walls.list.len()],
+            mass_eps: crate::model::MASS_EPS_REL * min_mass,
+            penalty: assemble::PENALTY_REL * stiffest,
+            stats: NewtonStats::default(),
+            t: 0.0,
+            steps: 0,
+            dt: 0.0,
+            settings,
+            model,
+        })
+    }
+
+    /// Δt of the next step before any cut (s): t_end / load_steps when
+    /// static, else `solver.dt` or the Courant rule (which may exceed 1).
+    pub fn planned_dt(&self) -> f64 {
+        let rem = self.model.t_end - self.t;
+        let dt = if self.settings.static_analysis {
+            self.model.t_end / self.settings.load_steps as f64
+        } else {
+            crate::model::time_step::time_step(&self.model, self.t).0
+        };
+        if dt >= rem * (1.0 - crate::model::time_step::LAST_STEP_REL) {
+            rem
+        } else {
+            dt
+        }
+    }
+
+    /// The Newmark parameters of a step of `dt`.
+    fn newmark(&self, dt: f64) -> Newmark {
+        Newmark {
+            beta: self.settings.beta,
+            gamma: self.settings.gamma,
+            dt,
+            is_static: self.settings.static_analysis,
+        }
+    }
+
+    /// Δt of the last step taken (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// One step, cutting Δt on failure. The time advances only on success.
+    pub fn step(&mut self) -> std::result::Result<(), Fault> {
+        self.initial_phase()?;
+        let mut dt = self.planned_dt();
+        let mut cuts = 0;
+        loop {
+            match self.attempt(dt) {
+                Ok(()) => break,
+                Err(fail) => {
+                    if cuts >= self.settings.max_cuts {
+                        return Err(match fail {
+                            AttemptFail::Particle(f) if self.settings.max_cuts == 0 => f,
+                            AttemptFail::Particle(_) => Fault {
+                                particle: None,
+                                kind: FaultKind::NewtonDiverged {
+                                    cuts,
+                                    ratio: f64::NAN,
+                                },
+                            },
+                            AttemptFail::Newton(ratio) => Fault {
+                                particle: None,
+                                kind: FaultKind::NewtonDiverged { cuts, ratio },
+                            },
+                        });
+                    }
+                    cuts += 1;
+                    self.stats.cuts += 1;
+                    dt *= 0.5;
+                }
+            }
+        }
+        self.convect();
+        self.t = if self.model.t_end - (self.t + self.dt)
+            <= crate::model::time_step::LAST_STEP_REL * self.dt
+        {
+            self.model.t_end
+        } else {
+            self.t + self.dt
+        };
+        self.steps += 1;
+        Ok(())
+    }
+
+    /// Shape functions at the particles and the nodal mass, velocity and
+    /// acceleration they map to the grid (lumped, eqs. 38–41).
+    fn initial_phase(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
+        self.node_mass.fill(0.0);
+        self.node_v.fill([0.0; 2]);
+        self.node_a.fill([0.0; 2]);
+        for i in 0..p.len() {
+            let (nodes, w) = self.cache.particle(i);
+            let mass = p.mass[i];
+            for (&n, wk) in nodes.iter().zip(w) {
+                let n = n as usize;
+                let mw = mass * wk[0];
+                self.node_mass[n] += mw;
+                for d in 0..2 {
+                    self.node_v[n][d] += mw * p.v[i][d];
+                    self.node_a[n][d] += mw * p.a[i][d];
+                }
+            }
+        }
+        for n in 0..self.node_mass.len() {
+            let mass = self.node_mass[n];
+            if mass > self.mass_eps {
+                for d in 0..2 {
+                    self.node_v[n][d] /= mass;
+                    self.node_a[n][d] /= mass;
+                }
+            } else {
+                self.node_v[n] = [0.0; 2];
+                self.node_a[n] = [0.0; 2];
+            }
+        }
+        for i in 0..p.len() {
+            self.start[i] = StepState {
+                stress: p.stress[i],
+                f: p.f.get(i).copied().unwrap_or([1.0, 0.0, 0.0, 1.0]),
+                q: p.plastic.get(i).copied().unwrap_or([0.0; 4]),
+            };
+            self.volume[i] = p.volume(i);
+        }
+        let n = p.len();
+        self.dofs = self.build_dofs();
+        self.pattern = Some(Pattern::new(&self.cache, &self.dofs, n)?);
+        Ok(())
+    }
+
+    /// The step's unknowns: nodes with mass, their held components
+    /// (constraints and stick walls).
+    fn build_dofs(&self) -> Dofs {
+        let m = &self.model;
+        let nodes = m.grid.n_nodes();
+        let stick = |n: usize| {
+            m.walls.mask.get(n).is_some_and(|&mask| {
+                m.walls
+                    .list
+                    .iter()
+                    .enumerate()
+                    .any(|(k, w)| mask & (1 << k) != 0 && w.contact == CONTACT_STICK)
+            })
+        };
+        let mut id = vec![NO_DOF; nodes];
+        let mut held = vec![0u8; nodes];
+        let mut active = 0u32;
+        for n in 0..nodes {
+            if self.node_mass[n] <= self.mass_eps {
+                continue;
+            }
+            id[n] = active;
+            active += 1;
+            held[n] = if stick(n) {
+                FIX_X | FIX_Y
+            } else {
+                m.constraints.fix[n]
+            };
+        }
+        Dofs {
+            id,
+            held,
+            active: active as usize,
+        }
+    }
+
+    /// Δu on held components (a prescribed velocity × Δt, trapezoidal in
+    /// time; zero otherwise), the free ones zero: Newton's start.
+    fn predict(&mut self, dt: f64) {
+        self.du.fill([0.0; 2]);
+        for g in self.model.constraints.groups.iter().filter(|g| g.moves()) {
+            let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
+            for &n in &g.nodes {
+                for (d, bit) in [(0, FIX_X), (1, FIX_Y)] {
+                    if g.fix & bit != 0 {
+                        self.du[n as usize][d] = 0.5 * dt * (v0[d] + v1[d]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Body force per unit mass at the step's end (m/s²), times the load
+    /// factor when static.
+    fn fill_body(&mut self, dt: f64) {
+        let m = &self.model;
+        let p = &m.particles;
+        let (t, factor) = if self.settings.static_analysis {
+            (m.t_end, (self.t + dt) / m.t_end)
+        } else {
+            (self.t + dt, 1.0)
+        };
+        let body =
+            crate::cpu::body_force(m.gravity, &m.manufactured, &m.external, &p.x0, &p.mass, t);
+        for (i, b) in self.body.iter_mut().enumerate() {
+            let v = body(i);
+            *b = [factor * v[0], factor * v[1]];
+        }
+    }
+
+    /// Newton on one step of `dt`; on success the converged iterate is in
+    /// `du` and `iterates`, and `dt` is the step's.
+    fn attempt(&mut self, dt: f64) -> std::result::Result<(), AttemptFail> {
+        self.fill_body(dt);
+        self.predict(dt);
+        let newmark = self.newmark(dt);
+        let m = &self.model;
+        let dofs = &self.dofs;
+        let Some(pattern) = self.pattern.as_ref() else {
+            return Err(AttemptFail::Newton(f64::NAN));
+        };
+        let inp = StepInputs {
+            cache: &self.cache,
+            model: m,
+            volume: &self.volume,
+            body: &self.body,
+            start: &self.start,
+            v: &self.node_v,
+            a: &self.node_a,
+            newmark,
+            dofs,
+            penalty: self.penalty,
+        };
+        // The load's own size, |Σ_p N m_p b_p| over the free components.
+        let mut fext = vec![[0.0f64; 2]; self.du.len()];
+        for i in 0..m.particles.len() {
+            let (nodes, w) = self.cache.particle(i);
+            for (&n, wk) in nodes.iter().zip(w) {
+                let mw = wk[0] * m.particles.mass[i];
+                let f = &mut fext[n as usize];
+                f[0] += mw * self.body[i][0];
+                f[1] += mw * self.body[i][1];
+            }
+        }
+        let free_norm = |r: &[[f64; 2]]| -> f64 {
+            let mut s = 0.0;
+            for (n, rn) in r.iter().enumerate() {
+                for (c, v) in rn.iter().enumerate() {
+                    if dofs.free(n, c) {
+                        s += v * v;
+                    }
+                }
+            }
+            s.sqrt()
+        };
+        let load_norm = free_norm(&fext);
+        let mut residuals = Vec::new();
+        let mut corrections = Vec::new();
+        let mut reference = 0.0;
+        let mut last_correction = f64::INFINITY;
+        let tol = self.settings.tol;
+        let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
+        for iter in 0..=self.settings.max_iter {
+            assemble::residual(
+                &inp,
+                &self.du,
+                &mut self.iterates,
+                &mut self.r,
+                &mut self.wall_force,
+            )
+            .map_err(AttemptFail::Particle)?;
+            let norm = free_norm(&self.r);
+            if iter == 0 {
+                reference = norm.max(load_norm);
+            }
+            let ratio = if reference > 0.0 {
+                norm / reference
+            } else {
+                0.0
+            };
+            residuals.push(ratio);
+            if !ratio.is_finite() || ratio > DIVERGED_RATIO {
+                return Err(AttemptFail::Newton(ratio));
+            }
+            let converged = ratio <= tol && (iter == 0 || last_correction <= tol.sqrt());
+            if converged || dofs.active == 0 {
+                self.dt = dt;
+                self.stats.steps += 1;
+                self.stats.iterations += iter as u64;
+                self.stats.max_iterations = self.stats.max_iterations.max(iter);
+                self.stats.last_iterations = iter;
+                self.stats.last_residuals = residuals;
+                self.stats.last_corrections = corrections;
+                return Ok(());
+            }
+            if iter == self.settings.max_iter {
+                return Err(AttemptFail::Newton(ratio));
+            }
+            assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values)
+                .map_err(AttemptFail::Particle)?;
+            let k = SparseColMatRef::new(pattern.symbolic.as_ref(), &self.values);
+            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k)
+                .map_err(|_| AttemptFail::Newton(ratio))?;
+            for (n, &id) in dofs.id.iter().enumerate() {
+                if id == NO_DOF {
+                    continue;
+                }
+                for c in 0..2 {
+                    rhs[(2 * id as usize + c, 0)] =
+                        if dofs.free(n, c) { self.r[n][c] } else { 0.0 };
+                }
+            }
+            lu.solve_in_place(rhs.as_mut());
+            let (mut dn, mut un) = (0.0, 0.0);
+            for (n, &id) in dofs.id.iter().enumerate() {
+                if id == NO_DOF {
+                    continue;
+                }
+                for c in 0..2 {
+                    if dofs.free(n, c) {
+                        let delta = rhs[(2 * id as usize + c, 0)];
+                        if !delta.is_finite() {
+                            return Err(AttemptFail::Newton(ratio));
+                        }
+                        self.du[n][c] += delta;
+                        dn += delta * delta;
+                        un += self.du[n][c] * self.du[n][c];
+                    }
+                }
+            }
+            // A zero increment with a zero correction has converged.
+            last_correction = if un > 0.0 {
+                (dn / un).sqrt()
+            } else {
+                dn.sqrt()
+            };
+            corrections.push(last_correction);
+        }
+        Err(AttemptFail::Newton(f64::NAN))
+    }
+
+    /// Checks the assembled Jacobian against a central difference of the
+    /// residual (a test of `assemble`): at a step of `dt` from the current
+    /// state, with Δu set to `du_of(node)` on the free components, returns
+    /// the largest |K_ij − (−∂R_i/∂Δu_j)_FD| over the largest |K_ij|.
+    pub fn jacobian_mismatch(
+        &mut self,
+        dt: f64,
+        du_of: impl Fn(usize) -> [f64; 2],
+        eps: f64,
+    ) -> std::result::Result<f64, Fault> {
+        self.initial_phase()?;
+        self.fill_body(dt);
+        self.predict(dt);
+        for n in 0..self.du.len() {
+            for (c, d) in du_of(n).into_iter().enumerate() {
+                if self.dofs.free(n, c) {
+                    self.du[n][c] = d;
+                }
+            }
+        }
+        let newmark = self.newmark(dt);
+        let m = &self.model;
+        let pattern = self.pattern.as_ref().expect("initial_phase built it");
+        let inp = StepInputs {
+            cache: &self.cache,
+            model: m,
+            volume: &self.volume,
+            body: &self.body,
+            start: &self.start,
+            v: &self.node_v,
+            a: &self.node_a,
+            newmark,
+            dofs: &self.dofs,
+            penalty: self.penalty,
+        };
+        let mut its = self.iterates.clone();
+        let mut wf = self.wall_force.clone();
+        assemble::residual(&inp, &self.du, &mut its, &mut self.r, &mut wf)?;
+        assemble::jacobian(&inp, pattern, &self.du, &its, &mut self.values)?;
+        let scale = self.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let nodes: Vec<usize> = (0..self.du.len())
+            .filter(|&n| self.dofs.id[n] != NO_DOF)
+            .collect();
+        let (mut rp, mut rm) = (self.r.clone(), self.r.clone());
+        let mut worst = 0.0f64;
+        for &nb in &nodes {
+            for k in 0..2 {
+                if !self.dofs.free(nb, k) {
+                    continue;
+                }
+                let mut du = self.du.clone();
+                du[nb][k] += eps;
+                assemble::residual(&inp, &du, &mut its, &mut rp, &mut wf)?;
+                du[nb][k] -= 2.0 * eps;
+                assemble::residual(&inp, &du, &mut its, &mut rm, &mut wf)?;
+                for &na in &nodes {
+                    for i in 0..2 {
+                        if !self.dofs.free(na, i) {
+                            continue;
+                        }
+                        let fd = -(rp[na][i] - rm[na][i]) / (2.0 * eps);
+                        let (ia, ib) = (self.dofs.id[na], self.dofs.id[nb]);
+                        let coupled = pattern.adj
+                            [pattern.adj_start[ib as usize]..pattern.adj_start[ib as usize + 1]]
+                            .binary_search(&ia)
+                            .is_ok();
+                        let k_ab = if coupled {
+                            self.values[pattern.slot(ia, ib, i, k)]
+                        } else {
+                            0.0
+                        };
+                        worst = worst.max((k_ab - fd).abs() / scale);
+                    }
+                }
+            }
+        }
+        Ok(worst)
+    }
+
+    /// Particles take the converged grid solution (eqs. 46–49); reactions.
+    fn convect(&mut self) {
+        let (gamma, dt) = (self.settings.gamma, self.dt);
+        let newmark = self.newmark(dt);
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        for i in 0..p.len() {
+            let (nodes, w) = self.cache.particle(i);
+            let (mut u, mut a) = ([0.0; 2], [0.0; 2]);
+            for (&n, wk) in nodes.iter().zip(w) {
+                let n = n as usize;
+                let an = newmark.accel(self.du[n], self.node_v[n], self.node_a[n]);
+                for d in 0..2 {
+                    u[d] += wk[0] * self.du[n][d];
+                    a[d] += wk[0] * an[d];
+                }
+            }
+            let it = &self.iterates[i];
+            for d in 0..2 {
+                p.x[i][d] += u[d];
+                if newmark.is_static {
+                    p.v[i][d] = 0.0;
+                    p.a[i][d] = 0.0;
+                } else {
+                    p.v[i][d] += dt * ((1.0 - gamma) * p.a[i][d] + gamma * a[d]);
+                    p.a[i][d] = a[d];
+                }
+            }
+            p.stress[i] = it.state.stress;
+            p.rho[i] /= it.j;
+            if let Some(f) = p.f.get_mut(i) {
+                *f = it.state.f;
+            }
+            if let Some(q) = p.plastic.get_mut(i) {
+                *q = it.state.q;
+            }
+        }
+        // The support's reaction is minus the residual on its components.
+        let groups = m.constraints.groups.len();
+        for (g, r) in m.constraints.groups.iter().zip(self.reactions.iter_mut()) {
+            *r = [0.0; 2];
+            for &n in &g.nodes {
+                let n = n as usize;
+                if g.fix & FIX_X != 0 {
+                    r[0] -= self.r[n][0];
+                }
+                if g.fix & FIX_Y != 0 {
+                    r[1] -= self.r[n][1];
+                }
+            }
+        }
+        for (k, w) in m.walls.list.iter().enumerate() {
+            self.reactions[groups + k] = if w.contact == CONTACT_STICK {
+                // Stick wall nodes are fixed: minus the residual there.
+                let mut r = [0.0; 2];
+                for &n in &w.nodes {
+                    r[0] -= self.r[n as usize][0];
+                    r[1] -= self.r[n as usize][1];
+                }
+                r
+            } else {
+                // The force on the wall: minus its force on the material.
+                [-self.wall_force[k][0], -self.wall_force[k][1]]
+            };
+        }
+    }
+}
+
+impl Backend for ImplicitBackend {
+    fn name(&self) -> String {
+        format!(
+            "cpu implicit (f64, {} threads, faer sparse LU)",
+            rayon::current_num_threads()
+        )
+    }
+
+    fn time(&self) -> f64 {
+        self.t
+    }
+
+    fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt> {
+        while self.t < t_stop && self.t < self.model.t_end && !stop_requested(stop) {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt> {
+        for _ in 0..n {
+            if self.t >= self.model.t_end {
+                break;
+            }
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self) -> Result<Sample> {
+        Ok(Sample {
+            t: self.t,
+            probes: crate::backend::probe_states(&self.model),
+            energy: crate::cpu::energy::energy(&self.model),
+            reactions: self.reactions.clone(),
+            newton: Some(NewtonSample {
+                iterations: self.stats.last_iterations,
+                residual: self.stats.last_residuals.last().copied().unwrap_or(0.0),
+                dt: self.dt,
+            }),
+        })
+    }
+
+    fn particles(&mut self) -> Result<&Particles> {
+        Ok(&self.model.particles)
+    }
+
+    fn model(&self) -> &Model {
+        &self.model
+    }
+
+    fn bytes_per_particle(&self) -> f64 {
+        // The explicit path's particle and cache share, plus the step's
+        // per-particle iterate and start state (~16 f64), plus the
+        // Jacobian: about (2 nodes' worth of dofs per particle)² entries of
+        // 8 bytes and a sparse LU a few times that (measured by
+        // `bench`, not counted here).
+        crate::cpu::CpuBackend::bytes_per_particle_of(&self.model) + 16.0 * 8.0
+    }
+
+    fn newton(&self) -> Option<&NewtonStats> {
+        Some(&self.stats)
+    }
+
+    fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
+        crate::backend::check_state(&self.model, state)?;
+        self.model.particles = state.particles.clone();
+        self.t = state.t;
+        self.dt = state.dt;
+        self.steps = steps;
+        Ok(())
+    }
+}
