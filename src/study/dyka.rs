@@ -99,13 +99,11 @@ fn find<'a>(
     integrator: &str,
     h: f64,
 ) -> Option<&'a JobResult> {
-    let hs = sig(h * 1e3);
-    results.iter().find(|r| {
-        r.job.tag_value("backend") == Some(backend)
-            && r.job.tag_value("method") == Some(method)
-            && r.job.tag_value("integrator") == Some(integrator)
-            && r.job.tag_value("h_mm") == Some(hs.as_str())
-    })
+    let h_mm = sig(h * 1e3);
+    super::find_tagged(
+        results,
+        &[("backend", backend), ("method", method), ("integrator", integrator), ("h_mm", &h_mm)],
+    )
 }
 
 /// (t, value) points of a chart line.

@@ -15,12 +15,12 @@
 use super::runner::{Job, JobResult};
 use super::{backend_slug, backends_of, image, sig, table};
 use crate::cases::ALIGNED_VIBRATION;
-use crate::chart::{LineChart, Series};
 use crate::error::{Error, Result};
 use crate::exact::Errors;
 use crate::exact::mms::{AlignedVibration, MmsErrors};
 use crate::scene::{Override, Scene};
 use crate::simulation::BackendChoice;
+use crate::sweep::report::{self, Curve};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -138,12 +138,10 @@ fn find<'a>(
     cells: usize,
 ) -> Option<&'a JobResult> {
     let n = cells.to_string();
-    results.iter().find(|r| {
-        r.job.tag_value("backend") == Some(backend)
-            && r.job.tag_value("E") == Some(e)
-            && r.job.tag_value("method") == Some(method)
-            && r.job.tag_value("cells") == Some(n.as_str())
-    })
+    super::find_tagged(
+        results,
+        &[("backend", backend), ("E", e), ("method", method), ("cells", &n)],
+    )
 }
 
 /// Errors at T of a completed run.
@@ -272,40 +270,30 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         );
         // --- convergence charts, one per quantity -------------------------
         for (name, unit, stem, pick) in QUANTITIES {
-            let mut c = LineChart::new(
-                format!("Aligned vibration, E = {e_label} Pa: RMS {name} error at {t_label}"),
-                "cell size h (m)",
-                format!("RMS {name} error ({unit})"),
-            )
-            .log_log();
-            for (m, (label, _, mls)) in METHODS.iter().enumerate() {
-                let pts: Vec<(f64, f64)> = cells
-                    .iter()
-                    .filter_map(|&n| {
-                        let e = final_errors(find(results, main, e_label, label, n)?)?;
-                        Some((1.0 / n as f64, pick(e)))
-                    })
-                    .collect();
-                let s = Series::line(*label, pts, color(m)).markers();
-                c.series.push(if *mls { s.dashed() } else { s });
-            }
-            if let Some(&(h, e)) = c
-                .series
+            let curves: Vec<Curve> = METHODS
                 .iter()
-                .find(|s| s.label == "bspline2-mls")
-                .and_then(|s| s.points.last())
-                .or_else(|| c.series.iter().find_map(|s| s.points.last()))
-            {
-                let h0 = 1.0 / cells[0] as f64;
-                c.series.push(
-                    Series::line("slope 2", vec![(h0, e * (h0 / h).powi(2)), (h, e)], 7).dashed(),
-                );
-            }
-            c.size = (900, 560);
-            c.legend = plotters::chart::SeriesLabelPosition::LowerRight;
-            let stem = format!("study-mms-{stem}-e{}", &e_label[2..]);
-            c.save(&dir.join(&stem))?;
-            charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
+                .enumerate()
+                .map(|(m, &(label, _, mls))| Curve {
+                    label: label.to_string(),
+                    points: cells
+                        .iter()
+                        .filter_map(|&n| {
+                            let e = final_errors(find(results, main, e_label, label, n)?)?;
+                            Some((1.0 / n as f64, pick(e)))
+                        })
+                        .collect(),
+                    color: color(m),
+                    dashed: mls,
+                })
+                .collect();
+            let (files, _) = report::convergence_chart(
+                &format!("Aligned vibration, E = {e_label} Pa: RMS {name} error at {t_label}"),
+                "cell size h (m)",
+                &format!("RMS {name} error ({unit})"),
+                &curves,
+                &dir.join(format!("study-mms-{stem}-e{}", &e_label[2..])),
+            )?;
+            charts.extend(files);
         }
 
         // --- tables ----------------------------------------------------------
@@ -464,39 +452,40 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     }
 
     // --- error against wall time -----------------------------------------------
-    let mut front = LineChart::new(
-        format!("Aligned vibration: displacement error at {t_label} against cost"),
-        "wall time of the run (s)",
-        "RMS displacement error (m)",
-    )
-    .log_log();
+    let mut curves = Vec::new();
     for b in &backends {
         for &(e_label, _) in readings(quick) {
-            for (m, (label, _, mls)) in METHODS.iter().enumerate() {
-                let mut pts: Vec<(f64, f64)> = cells
+            for (m, &(label, _, mls)) in METHODS.iter().enumerate() {
+                let points: Vec<(f64, f64)> = cells
                     .iter()
                     .filter_map(|&n| {
                         let r = find(results, b, e_label, label, n)?;
                         Some((r.data()?.wall_seconds, final_errors(r)?.rms_displacement))
                     })
                     .collect();
-                if pts.is_empty() {
+                if points.is_empty() {
                     continue;
                 }
-                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
                 let mut name = format!("E {e_label} {label}");
                 if backends.len() > 1 {
                     name = format!("{b} {name}");
                 }
-                let s = Series::line(name, pts, color(m)).markers();
-                front.series.push(if *mls { s.dashed() } else { s });
+                curves.push(Curve {
+                    label: name,
+                    points,
+                    color: color(m),
+                    dashed: mls,
+                });
             }
         }
     }
-    front.size = (900, 560);
-    front.legend = plotters::chart::SeriesLabelPosition::UpperRight;
-    front.save(&dir.join("study-mms-front"))?;
-    charts.extend(["study-mms-front.png", "study-mms-front.svg"].map(|f| dir.join(f)));
+    let (files, _) = report::front_chart(
+        &format!("Aligned vibration: displacement error at {t_label} against cost"),
+        "RMS displacement error (m)",
+        &curves,
+        &dir.join("study-mms-front"),
+    )?;
+    charts.extend(files);
     md.push_str(&image("MMS error against wall time", "study-mms-front.png"));
     Ok((md, charts))
 }

@@ -148,6 +148,16 @@ pub fn main_backend(results: &[runner::JobResult]) -> String {
         .to_string()
 }
 
+/// The first result whose job carries every one of these (tag, value) pairs.
+pub fn find_tagged<'a>(
+    results: &'a [runner::JobResult],
+    tags: &[(&str, &str)],
+) -> Option<&'a runner::JobResult> {
+    results
+        .iter()
+        .find(|r| tags.iter().all(|&(k, v)| r.job.tag_value(k) == Some(v)))
+}
+
 /// The results of the jobs run on `backend`, in job order.
 pub fn on_backend<'a>(
     results: &'a [runner::JobResult],

@@ -75,12 +75,10 @@ fn find<'a>(
     integrator: &str,
     grid: &str,
 ) -> Option<&'a JobResult> {
-    results.iter().find(|r| {
-        r.job.tag_value("backend") == Some(backend)
-            && r.job.tag_value("shape") == Some(shape)
-            && r.job.tag_value("integrator") == Some(integrator)
-            && r.job.tag_value("grid") == Some(grid)
-    })
+    super::find_tagged(
+        results,
+        &[("backend", backend), ("shape", shape), ("integrator", integrator), ("grid", grid)],
+    )
 }
 
 /// Particles coloured by speed, each a square of the seeding spacing (2 × 2 per cell).
