@@ -121,57 +121,7 @@ enum Command {
     /// one `lme-mpm run` shell line per run for a scheduler instead (Slurm,
     /// GNU parallel), then build the results with --collect <out>.
     /// See docs/sweeps.md.
-    Sweep {
-        /// Scene file (TOML), e.g. cases/dyka_bar.toml. Not with --collect.
-        #[arg(required_unless_present = "collect")]
-        scene: Option<PathBuf>,
-        /// A key and its values, e.g. --vary grid.h=0.01,0.005,0.0025 --vary
-        /// solver.shape=linear,lme (repeatable; any key --set accepts; commas
-        /// inside [..] belong to a value). Every combination is one run.
-        #[arg(
-            long = "vary",
-            value_name = "KEY=V1,V2,...",
-            required_unless_present = "collect"
-        )]
-        vary: Vec<String>,
-        /// Override a scene key in every run (repeatable), as in `run`.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// The varied key that sets the resolution (smaller is finer): the x of
-        /// the convergence chart, and without an exact solution the finest
-        /// run of each series is its reference. Default: grid.h, solver.dt or
-        /// solver.cfl, the first of them varied.
-        #[arg(long, value_name = "KEY")]
-        resolution: Option<String>,
-        /// The error figure the charts use, e.g. rms_velocity_relative.
-        /// Default: the first error the runs' summary.json reports (without
-        /// an exact solution: ref_probe_u_rms, against the finest run).
-        #[arg(long, value_name = "NAME")]
-        metric: Option<String>,
-        /// Where each run runs: auto = GPU when a hardware adapter exists, else CPU.
-        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
-        backend: BackendChoice,
-        /// Runs at once (default: one per core; each run gets cores / jobs threads).
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// Sweep folder. Default: out/sweep/<scene name>.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Write one self-contained shell line per run to FILE (and the plan
-        /// to <out>/sweep-plan.json) and run nothing.
-        #[arg(long, value_name = "FILE")]
-        emit_jobs: Option<PathBuf>,
-        /// The command the emitted lines start with. Default: this executable's absolute path.
-        #[arg(long, value_name = "CMD", requires = "emit_jobs")]
-        exe: Option<String>,
-        /// Build sweep.csv, the charts and sweep.md of the sweep in DIR from
-        /// its finished run folders (missing or interrupted runs listed as such).
-        #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "vary", "set", "resolution", "emit_jobs", "jobs", "out"])]
-        collect: Option<PathBuf>,
-        /// No progress bar and no closing lines.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Sweep(SweepArgs),
     /// Measure particle-steps per second of whole steps on a synthetic scene,
     /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
     Bench {
@@ -361,33 +311,7 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
-        Command::Sweep {
-            scene,
-            vary,
-            set,
-            resolution,
-            metric,
-            backend,
-            jobs,
-            out,
-            emit_jobs,
-            exe,
-            collect,
-            quiet,
-        } => sweep(SweepArgs {
-            scene,
-            vary,
-            set,
-            resolution,
-            metric,
-            backend,
-            jobs,
-            out,
-            emit_jobs,
-            exe,
-            collect,
-            quiet,
-        }),
+        Command::Sweep(args) => sweep(args),
         Command::Bench {
             backend,
             adapter,
@@ -522,19 +446,57 @@ fn report(
     }
 }
 
-/// The arguments of `lme-mpm sweep`.
+// The arguments of `lme-mpm sweep` (its help is the variant's doc comment).
+#[derive(clap::Args)]
 struct SweepArgs {
+    /// Scene file (TOML), e.g. cases/dyka_bar.toml. Not with --collect.
+    #[arg(required_unless_present = "collect")]
     scene: Option<PathBuf>,
+    /// A key and its values, e.g. --vary grid.h=0.01,0.005,0.0025 --vary
+    /// solver.shape=linear,lme (repeatable; any key --set accepts; commas
+    /// inside [..] belong to a value). Every combination is one run.
+    #[arg(
+        long = "vary",
+        value_name = "KEY=V1,V2,...",
+        required_unless_present = "collect"
+    )]
     vary: Vec<String>,
+    /// Override a scene key in every run (repeatable), as in `run`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
+    /// The varied key that sets the resolution (smaller is finer): the x of
+    /// the convergence chart, and without an exact solution the finest
+    /// run of each series is its reference. Default: grid.h, solver.dt or
+    /// solver.cfl, the first of them varied.
+    #[arg(long, value_name = "KEY")]
     resolution: Option<String>,
+    /// The error figure the charts use, e.g. rms_velocity_relative.
+    /// Default: the first error the runs' summary.json reports (without
+    /// an exact solution: ref_probe_u_rms, against the finest run).
+    #[arg(long, value_name = "NAME")]
     metric: Option<String>,
+    /// Where each run runs: auto = GPU when a hardware adapter exists, else CPU.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
+    /// Runs at once (default: one per core; each run gets cores / jobs threads).
+    #[arg(long)]
     jobs: Option<usize>,
+    /// Sweep folder. Default: out/sweep/<scene name>.
+    #[arg(long)]
     out: Option<PathBuf>,
+    /// Write one self-contained shell line per run to FILE (and the plan
+    /// to <out>/sweep-plan.json) and run nothing.
+    #[arg(long, value_name = "FILE")]
     emit_jobs: Option<PathBuf>,
+    /// The command the emitted lines start with. Default: this executable's absolute path.
+    #[arg(long, value_name = "CMD", requires = "emit_jobs")]
     exe: Option<String>,
+    /// Build sweep.csv, the charts and sweep.md of the sweep in DIR from
+    /// its finished run folders (missing or interrupted runs listed as such).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "vary", "set", "resolution", "emit_jobs", "jobs", "out"])]
     collect: Option<PathBuf>,
+    /// No progress bar and no closing lines.
+    #[arg(long, short)]
     quiet: bool,
 }
 

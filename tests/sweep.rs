@@ -25,6 +25,17 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// `lme-mpm sweep --collect DIR`, which must succeed.
+fn collect(dir: &Path) {
+    let o = bin()
+        .arg("sweep")
+        .arg("--collect")
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// Dyka's bar without its exact solution: the sweep must fall back on
 /// comparing runs with the finest of their series.
 fn bar_without_exact(dir: &Path) -> PathBuf {
@@ -150,13 +161,7 @@ fn emitted_lines_run_by_sh_collect_to_the_local_table() {
             stderr(&o)
         );
     }
-    let o = bin()
-        .arg("sweep")
-        .arg("--collect")
-        .arg(&remote)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    collect(&remote);
 
     let (a, b) = (table(&local), table(&remote));
     assert_eq!(a.len(), 8);
@@ -228,13 +233,7 @@ fn emitted_lines_run_by_sh_collect_to_the_local_table() {
     )
     .unwrap();
     std::fs::remove_dir_all(&runs[1]).unwrap();
-    let o = bin()
-        .arg("sweep")
-        .arg("--collect")
-        .arg(&remote)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    collect(&remote);
     let b = table(&remote);
     assert_eq!(b.len(), 8);
     assert_eq!(b[0]["status"], "running");

@@ -102,7 +102,12 @@ fn find<'a>(
     let h_mm = sig(h * 1e3);
     super::find_tagged(
         results,
-        &[("backend", backend), ("method", method), ("integrator", integrator), ("h_mm", &h_mm)],
+        &[
+            ("backend", backend),
+            ("method", method),
+            ("integrator", integrator),
+            ("h_mm", &h_mm),
+        ],
     )
 }
 

@@ -140,7 +140,12 @@ fn find<'a>(
     let n = cells.to_string();
     super::find_tagged(
         results,
-        &[("backend", backend), ("E", e), ("method", method), ("cells", &n)],
+        &[
+            ("backend", backend),
+            ("E", e),
+            ("method", method),
+            ("cells", &n),
+        ],
     )
 }
 

@@ -77,7 +77,12 @@ fn find<'a>(
 ) -> Option<&'a JobResult> {
     super::find_tagged(
         results,
-        &[("backend", backend), ("shape", shape), ("integrator", integrator), ("grid", grid)],
+        &[
+            ("backend", backend),
+            ("shape", shape),
+            ("integrator", integrator),
+            ("grid", grid),
+        ],
     )
 }
 

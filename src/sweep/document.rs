@@ -192,30 +192,29 @@ pub fn write(
 
     // --- error against wall time ------------------------------------------------
     if let Some(m) = &metric {
-        let curves: Vec<Curve> = series
-            .iter()
-            .enumerate()
-            .map(|(k, g)| Curve {
-                label: g.label.clone(),
-                points: g
-                    .members
-                    .iter()
-                    .filter_map(|&i| Some((records[i].wall_seconds?, value(&records[i])?)))
-                    .collect(),
-                color: k,
-                dashed: false,
-            })
-            .collect();
-        let index: Vec<Vec<usize>> = series
-            .iter()
-            .map(|g| {
-                g.members
-                    .iter()
-                    .copied()
-                    .filter(|&i| records[i].wall_seconds.is_some() && value(&records[i]).is_some())
-                    .collect()
-            })
-            .collect();
+        // One curve per series of (x, metric) over its runs that have both,
+        // and which run each point is.
+        let curves_of = |x: &dyn Fn(&Record) -> Option<f64>| -> (Vec<Curve>, Vec<Vec<usize>>) {
+            series
+                .iter()
+                .enumerate()
+                .map(|(k, g)| {
+                    let (points, runs): (Vec<(f64, f64)>, Vec<usize>) = g
+                        .members
+                        .iter()
+                        .filter_map(|&i| Some(((x(&records[i])?, value(&records[i])?), i)))
+                        .unzip();
+                    let curve = Curve {
+                        label: g.label.clone(),
+                        points,
+                        color: k,
+                        dashed: false,
+                    };
+                    (curve, runs)
+                })
+                .unzip()
+        };
+        let (curves, index) = curves_of(&|r| r.wall_seconds);
         if curves.iter().any(|c| !c.points.is_empty()) {
             let (f, front) = report::front_chart(
                 &format!("{}: {m} against wall time", plan.scene_name),
@@ -246,22 +245,7 @@ pub fn write(
         }
         // --- error against resolution -----------------------------------------------
         if let Some(res) = &plan.resolution {
-            let curves: Vec<Curve> = series
-                .iter()
-                .enumerate()
-                .map(|(k, g)| Curve {
-                    label: g.label.clone(),
-                    points: g
-                        .members
-                        .iter()
-                        .filter_map(|&i| {
-                            Some((resolution_of(plan, &records[i])?, value(&records[i])?))
-                        })
-                        .collect(),
-                    color: k,
-                    dashed: false,
-                })
-                .collect();
+            let (curves, _) = curves_of(&|r| resolution_of(plan, r));
             if curves.iter().any(|c| !c.points.is_empty()) {
                 let (f, orders) = report::convergence_chart(
                     &format!("{}: {m} against {res}", plan.scene_name),
