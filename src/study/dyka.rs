@@ -56,6 +56,11 @@ pub fn job(backend: BackendChoice, h: f64, method: usize, integrator: &str) -> J
         "bodies.bar.rects=[[{}, 0.0, {DYKA_L}, {h}]]",
         DYKA_L / 4.0
     ))
+    // The probes on the bar's axis at every cell size (the case file puts
+    // them at y = 0.5 mm, for h = 1 mm): the paper's point A, the
+    // impactor's free end, and the middle.
+    .set(format!("output.probes.free_end=[0.0, {}]", h / 2.0))
+    .set(format!("output.probes.middle=[{}, {}]", DYKA_L / 2.0, h / 2.0))
     .set(format!("solver.shape={shape}"))
     .set(format!("solver.integrator={integrator}"))
     .tag("backend", backend_slug(backend))
@@ -435,7 +440,11 @@ impl Report<'_> {
                 md,
                 "At {} mm the free end travels several cells (grid crossing), and NPC errors are: {}.\n",
                 sig(finest * 1e3),
-                crossing.join(", ")
+                if crossing.is_empty() {
+                    "none (no NPC run completed at that size)".to_string()
+                } else {
+                    crossing.join(", ")
+                }
             );
         }
     }
@@ -469,8 +478,8 @@ impl Report<'_> {
             "\n**Accuracy against cost.** Each point is one run ({} thread(s) per run); further down and left is \
              better. The runs on the front, from cheapest to most accurate: {}.\n",
             results
-                .first()
-                .and_then(|r| r.data())
+                .iter()
+                .find_map(|r| r.data())
                 .map_or(0, |d| d.threads),
             front_runs.join(", ")
         );
