@@ -256,6 +256,27 @@ impl Mls {
         }
     }
 
+    /// The fit f_g = Σ_p φ_gp f_p, with this step's coefficients, of the
+    /// first `F` packed fields at every Gauss point (4 per integration
+    /// cell; zero in cells without particles).
+    fn fit<const F: usize>(&self, grid: &Grid, out: &mut [[f64; F]]) {
+        out.par_chunks_mut(4).enumerate().for_each(|(ic, val)| {
+            val.fill([0.0; F]);
+            if !self.occupied[ic] {
+                return;
+            }
+            let c = &self.coef[4 * ic..4 * ic + 4];
+            self.neighbours(grid, ic, |q, d, w| {
+                for k in 0..4 {
+                    let phi = w[k] * (c[k][0] + c[k][1] * d[k][0] + c[k][2] * d[k][1]);
+                    for f in 0..F {
+                        val[k][f] += phi * q[2 + f];
+                    }
+                }
+            });
+        });
+    }
+
     /// MLS p2g: bins the particles, solves each Gauss point's moment matrix,
     /// fits ρ and ρv* (v* = v + a_factor a), and adds their quadratures to
     /// `mv` (zeroed by `clear_grid`).
@@ -371,22 +392,7 @@ impl Mls {
             [s[0], s[1], s[2], rho[p] * b[0], rho[p] * b[1], 0.0]
         });
         let mut vals = std::mem::take(&mut self.gp_f);
-        let this = &*self;
-        vals.par_chunks_mut(4).enumerate().for_each(|(ic, val)| {
-            val.fill([0.0; 5]);
-            if !this.occupied[ic] {
-                return;
-            }
-            let c = &this.coef[4 * ic..4 * ic + 4];
-            this.neighbours(grid, ic, |q, d, w| {
-                for k in 0..4 {
-                    let phi = w[k] * (c[k][0] + c[k][1] * d[k][0] + c[k][2] * d[k][1]);
-                    for f in 0..5 {
-                        val[k][f] += phi * q[2 + f];
-                    }
-                }
-            });
-        });
+        self.fit(grid, &mut vals);
         self.gp_f = vals;
         let (shape, gw, gf) = (&self.gp_shape, &self.gp_w, &self.gp_f);
         let coef = &self.coef;
@@ -424,21 +430,7 @@ impl Mls {
                 out[3] = rho[p] * v[p][1];
             });
         let mut vals = std::mem::take(&mut self.gp_remap);
-        let this = &*self;
-        vals.par_chunks_mut(4).enumerate().for_each(|(ic, val)| {
-            val.fill([0.0; 2]);
-            if !this.occupied[ic] {
-                return;
-            }
-            let c = &this.coef[4 * ic..4 * ic + 4];
-            this.neighbours(grid, ic, |q, d, w| {
-                for k in 0..4 {
-                    let phi = w[k] * (c[k][0] + c[k][1] * d[k][0] + c[k][2] * d[k][1]);
-                    val[k][0] += phi * q[2];
-                    val[k][1] += phi * q[3];
-                }
-            });
-        });
+        self.fit(grid, &mut vals);
         self.gp_remap = vals;
         super::remap::clear_momentum(mv);
         let (shape, gw, gv) = (&self.gp_shape, &self.gp_w, &self.gp_remap);
