@@ -9,7 +9,6 @@ mod common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;
-use lme_mpm::gpu::pipelines::Pass;
 use lme_mpm::gpu::{GpuBackend, GpuOptions};
 use lme_mpm::model::Model;
 use lme_mpm::rng::SplitMix64;
