@@ -15,8 +15,8 @@
 @group(0) @binding({{B_A}}) var<storage, read> a: array<vec2<f32>>;
 #endif
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
-@group(0) @binding({{B_MLS_START}}) var<storage, read> mls_start: array<u32>;
-@group(0) @binding({{B_MLS_ORDER}}) var<storage, read> mls_order: array<u32>;
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
 @group(0) @binding({{B_MLS_OCC}}) var<storage, read> mls_occ: array<u32>;
 @group(0) @binding({{B_MLS_COEF}}) var<storage, read_write> mls_coef: array<f32>;
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
@@ -50,10 +50,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var m_qy = vec3<f32>(0.0);
     for (var j = r.lo.y; j <= r.hi.y; j++) {
         let row = j * (params.nx - 1u);
-        let s = mls_start[row + r.lo.x];
-        let e = mls_start[row + r.hi.x + 1u];
+        let s = cell_start[row + r.lo.x];
+        let e = cell_start[row + r.hi.x + 1u];
         for (var idx = s; idx < e; idx++) {
-            let p = mls_order[idx];
+            let p = cell_order[idx];
             let dw = mls_sample(p, qg);
             let d = dw.xy;
             let w = dw.z;

@@ -1,7 +1,7 @@
 // Stage `remap` of MUSL with MLS (B-spline paper eqs. 31–32), one
 // invocation per Gauss point g: fit ρ_p^t v_p^{t+1} with the coefficients of
 // this step's mls_p2g and the particles' positions at the step's start
-// (`x_start`, written by mls_bin: g2p has moved them since), and add
+// (`x_start`, written by bin_count: g2p has moved them since), and add
 // N_I(x_g) (ρv)_g ω_g to the nodal momentum, which `remap.wgsl` (CLEAR)
 // zeroed; the masses stay m_I^t. CPU twin: `Mls::remap` (src/cpu/mls.rs).
 #include "shared/common.wgsl"
@@ -14,8 +14,8 @@
 @group(0) @binding({{B_X_START}}) var<storage, read> x_start: array<vec2<f32>>;
 @group(0) @binding({{B_V}}) var<storage, read> v: array<vec2<f32>>;
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
-@group(0) @binding({{B_MLS_START}}) var<storage, read> mls_start: array<u32>;
-@group(0) @binding({{B_MLS_ORDER}}) var<storage, read> mls_order: array<u32>;
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
 @group(0) @binding({{B_MLS_COEF}}) var<storage, read> mls_coef: array<f32>;
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
 
@@ -37,10 +37,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var q = vec2<f32>(0.0);
     for (var j = r.lo.y; j <= r.hi.y; j++) {
         let row = j * (params.nx - 1u);
-        let s = mls_start[row + r.lo.x];
-        let e = mls_start[row + r.hi.x + 1u];
+        let s = cell_start[row + r.lo.x];
+        let e = cell_start[row + r.hi.x + 1u];
         for (var idx = s; idx < e; idx++) {
-            let p = mls_order[idx];
+            let p = cell_order[idx];
             let dw = mls_sample_at(x_start[p], qg);
             let d = dw.xy;
             let w = dw.z;

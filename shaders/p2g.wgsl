@@ -1,7 +1,11 @@
-// Stage `p2g`: scatter mass and (predicted) momentum with atomics.
+// Stage `p2g`: mass and (predicted) momentum to the nodes.
 // NPC: q_I += N m_p (v_p + (1 − γ) Δt a_p); FE and MUSL: q_I += N m_p v_p
 // (MUSL also keeps the positions at the step's start in `x_start`).
-// CPU twin: src/cpu/p2g.rs.
+// Scatter (one invocation per particle, float atomics) or, built with
+// GATHER, node-centred: one invocation per node sums over the particles
+// binned near it (shared/bins.wgsl, binned in `shape_eval`) and writes its
+// sums once, without atomics. The sums are the same, in another order.
+// CPU twin: src/cpu/p2g.rs (a scatter into private grids).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -16,6 +20,53 @@
 #if MUSL
 @group(0) @binding({{B_X_START}}) var<storage, read_write> x_start: array<vec2<f32>>;
 #endif
+
+// The velocity a particle carries to the nodes.
+fn p2g_velocity(p: u32) -> vec2<f32> {
+#if NPC
+    return v[p] + params.p2g_accel * sim.dt * a[p];
+#else
+    return v[p];
+#endif
+}
+
+#if GATHER
+#include "shared/bins.wgsl"
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
+
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = linear_index(gid, nwg);
+    if sim.running == 0u || n >= params.n_nodes {
+        return;
+    }
+    let i = n % params.nx;
+    let j = n / params.nx;
+    let cells = cells_reaching(i, j);
+    // (mass, momentum x, momentum y)
+    var sum = vec3<f32>(0.0);
+    for (var cj = cells.lo.y; cj <= cells.hi.y; cj++) {
+        let row = cj * (params.nx - 1u);
+        let end = cell_start[row + cells.hi.x + 1u];
+        for (var idx = cell_start[row + cells.lo.x]; idx < end; idx++) {
+            let p = cell_order[idx];
+            let w = shape_at(shape_ctx(p, x0[p] + u[p]), i, j);
+            if !w.ok {
+                continue;
+            }
+            let nm = w.n * mass[p];
+            let vel = p2g_velocity(p);
+            sum += vec3<f32>(nm, nm * vel.x, nm * vel.y);
+        }
+    }
+    let base = n * NODE_STRIDE;
+    node_acc[base] = sum.x;
+    node_acc[base + 1u] = sum.y;
+    node_acc[base + 2u] = sum.z;
+}
+#else
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
 
 #include "shared/atomics.wgsl" ARR=node_acc FN=node_add
@@ -27,10 +78,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let m = mass[p];
-    var vel = v[p];
-#if NPC
-    vel += params.p2g_accel * sim.dt * a[p];
-#endif
+    let vel = p2g_velocity(p);
 #if MUSL
     // The step's start positions, for the remap and the stress after g2p.
     x_start[p] = x0[p] + u[p];
@@ -52,3 +100,4 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         node_add(base + 2u, nm * vel.y);
     }
 }
+#endif

@@ -3,7 +3,7 @@
 // step's start, q_I = Σ N_I(x_p^t) m_p v_p^{t+1}, into the momentum slots
 // (the masses stay m_I^t); the pass `grid_update` (predict) then divides by
 // the mass and applies the walls and Dirichlet conditions. Positions at the
-// step's start come from `x_start` (written by p2g or mls_bin), since g2p
+// step's start come from `x_start` (written by p2g or bin_count), since g2p
 // has moved the particles. Built with CLEAR: one invocation per node zeroes
 // its momentum first (also before `mls_remap`).
 // CPU twin: src/cpu/remap.rs (with MLS: `Mls::remap` in src/cpu/mls.rs).

@@ -45,12 +45,27 @@ pub fn standard_cases() -> Vec<Case> {
 
 /// Extra cases: LME with weights stored per slot on the GPU (the
 /// alternative to recomputing them from λ in each pass), elastoplastic LME
-/// (Mohr–Coulomb), and the B-splines with and without MLS reconstruction.
+/// (Mohr–Coulomb), the B-splines with and without MLS reconstruction, and
+/// `*-scatter` and `*-gather`: p2g and forces on the GPU as particle-centred
+/// scatters with float atomics or node-centred gathers, whichever the case
+/// does not run by default (`GpuOptions::gather`).
 pub fn extra_cases() -> Vec<Case> {
     let mut stored = Case::new("lme-g3-stored", &["solver.shape=lme", "solver.lme_gamma=3"]);
     stored.gpu.lme_stored = true;
+    let p2g = |label: &str, sets: &[&str], gather: bool| {
+        let mut c = Case::new(label, sets);
+        c.gpu.gather = Some(gather);
+        c
+    };
     vec![
         stored,
+        p2g("linear-scatter", &["solver.shape=linear"], false),
+        p2g("bspline2-gather", &["solver.shape=bspline2"], true),
+        p2g(
+            "lme-g3-gather",
+            &["solver.shape=lme", "solver.lme_gamma=3"],
+            true,
+        ),
         // Elastoplastic LME: the square's impact stresses (about 50 kPa)
         // exceed this Mohr–Coulomb strength, so the return mapping runs.
         Case::new(
@@ -407,9 +422,6 @@ pub fn profile_gpu(
     use crate::gpu::pipelines::Pass;
     let model = Model::new(&scene(particles, case)?)?;
     let n = model.particles.len() as f64;
-    let lme = !model.particles.lambda.is_empty();
-    let mls = model.mls;
-    let musl = model.integrator == crate::model::Integrator::Musl;
     let ctx = crate::gpu::context::open(&crate::gpu::context::AdapterRequest {
         name: adapter.map(str::to_string),
         allow_software: true,
@@ -417,7 +429,7 @@ pub fn profile_gpu(
     })?;
     let mut gpu = GpuBackend::with_options(ctx, model, case.gpu)?;
     gpu.advance_steps(1).map_err(halted)?;
-    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(lme, mls, musl).collect();
+    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(gpu.plan()).collect();
     // Cost of a submission and wait alone.
     let start = Instant::now();
     for _ in 0..20 {

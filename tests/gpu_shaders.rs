@@ -128,6 +128,11 @@ fn variants() -> Vec<Variant> {
                                         // integrator, with one atomic mode.
                                         walls: atomics == AtomicMode::CompareExchange && !mls,
                                         ext_force: atomics == AtomicMode::CompareExchange && !mls,
+                                        // Gather where it can, except with several
+                                        // materials and float atomics (the scatter).
+                                        gather: !mls
+                                            && integrator != Integrator::Musl
+                                            && !(multi_material && atomics == AtomicMode::Float),
                                     });
                                 }
                             }
@@ -158,7 +163,7 @@ fn every_pass_validates_in_every_variant() {
             let has = |b: Buf| binds.iter().any(|x| x.buf == b);
             assert_eq!(
                 has(Buf::NodePos),
-                v.perturbed && pass_uses_shape(pass),
+                v.perturbed && (pass_uses_shape(pass) || (pass == Pass::BinCount && v.gather)),
                 "{pass:?} {v:?}: node_pos"
             );
             assert!(
@@ -189,8 +194,12 @@ fn every_pass_validates_in_every_variant() {
                 );
             }
             assert!(
-                !(has(Buf::MlsCount) || has(Buf::MlsOrder) || has(Buf::MlsCoef)) || v.mls,
+                !has(Buf::MlsCoef) || v.mls,
                 "{pass:?} {v:?}: MLS buffers without MLS"
+            );
+            assert!(
+                !(has(Buf::CellCount) || has(Buf::CellOrder)) || v.mls || v.gather,
+                "{pass:?} {v:?}: cell bins without MLS or gather"
             );
             assert!(
                 !(has(Buf::Walls) || has(Buf::WallMask)) || v.walls,
@@ -203,7 +212,7 @@ fn every_pass_validates_in_every_variant() {
             if v.walls && matches!(pass, Pass::GridPredict | Pass::GridCorrect) {
                 assert!(has(Buf::WallMask), "{pass:?} {v:?}: walls unread");
             }
-            if v.ext_force && matches!(pass, Pass::Forces) {
+            if v.ext_force && matches!(pass, Pass::Forces | Pass::ForcesGather) {
                 assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");
             }
             checked += 1;
@@ -218,8 +227,10 @@ fn pass_uses_shape(pass: Pass) -> bool {
         pass,
         Pass::LmeNewton
             | Pass::P2g
+            | Pass::P2gGather
             | Pass::Stress
             | Pass::Forces
+            | Pass::ForcesGather
             | Pass::G2p
             | Pass::MlsP2g
             | Pass::MlsForces

@@ -9,7 +9,6 @@ mod common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;
-use lme_mpm::gpu::pipelines::Pass;
 use lme_mpm::gpu::{GpuBackend, GpuOptions};
 use lme_mpm::model::Model;
 use lme_mpm::rng::SplitMix64;
@@ -439,15 +438,18 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
         // positions: they read the LME cache made there, not a new one.
         let musl_late = cpu.model.integrator == lme_mpm::model::Integrator::Musl
             && matches!(stage, Stage::Remap | Stage::Stress);
-        let needs_cache =
-            lme && !musl_late && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
-        if needs_cache {
-            // GPU LME passes read (λ, log Z, J⁻¹) from lme_newton, warm-started from the CPU's λ.
-            gpu.run_pass(Pass::LmeNewton);
+        let needs_shapes =
+            !musl_late && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
+        if needs_shapes {
+            // GPU LME passes read (λ, log Z, J⁻¹) from lme_newton, warm-started
+            // from the CPU's λ; gather passes read the particles' cell bins.
+            for pass in gpu.stage_passes(Stage::ShapeEval) {
+                gpu.run_pass(*pass);
+            }
         }
         cpu.run_stage(stage)
             .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
-        for pass in Pass::for_stage(stage, lme, cpu.model.mls) {
+        for pass in gpu.stage_passes(stage) {
             gpu.run_pass(*pass);
         }
         let sim = gpu.read_sim().unwrap();
@@ -675,7 +677,10 @@ fn stages_match_lme() {
         &["solver.shape=lme", "solver.npc_position=corrected"],
         false,
     );
-    let stored = GpuOptions { lme_stored: true };
+    let stored = GpuOptions {
+        lme_stored: true,
+        ..GpuOptions::default()
+    };
     parity_with(
         "lme npc, weights stored per slot",
         &["solver.shape=lme"],
@@ -694,13 +699,77 @@ fn stages_match_lme() {
     );
 }
 
+/// p2g and forces as node-centred gathers over binned particles
+/// (`GpuOptions::gather`; by default only linear shapes on a regular grid
+/// gather), so every shape's `shape_anchor` and `shape_slot` stay tested.
+const GATHER: GpuOptions = GpuOptions {
+    lme_stored: false,
+    gather: Some(true),
+};
+/// The scatters with float atomics, for linear shapes (which gather by default).
+const SCATTER: GpuOptions = GpuOptions {
+    lme_stored: false,
+    gather: Some(false),
+};
+
 #[test]
 fn stages_match_with_compare_exchange_atomics() {
     parity("lme npc, CAS atomics", &["solver.shape=lme"], true);
-    parity(
+    parity_with(
         "linear fe, CAS atomics",
         &["solver.shape=linear", "solver.integrator=fe"],
         true,
+        SCATTER,
+    );
+    // The gather passes use no float atomics; the binning's are integer.
+    parity(
+        "linear npc gather, CAS atomics",
+        &["solver.shape=linear"],
+        true,
+    );
+}
+
+#[test]
+fn stages_match_gather_and_scatter() {
+    parity_with(
+        "linear npc, scatter",
+        &["solver.shape=linear"],
+        false,
+        SCATTER,
+    );
+    parity_with(
+        "linear npc perturbed, gather",
+        &["solver.shape=linear", "grid.perturb=0.2"],
+        false,
+        GATHER,
+    );
+    parity_with(
+        "ugimp npc perturbed, gather",
+        &["solver.shape=ugimp", "grid.perturb=0.2"],
+        false,
+        GATHER,
+    );
+    parity_with(
+        "bspline2 fe, gather",
+        &["solver.shape=bspline2", "solver.integrator=fe"],
+        false,
+        GATHER,
+    );
+    parity_with(
+        "bspline3 npc, gather",
+        &["solver.shape=bspline3"],
+        false,
+        GATHER,
+    );
+    parity_with("lme npc, gather", &["solver.shape=lme"], false, GATHER);
+    parity_with(
+        "lme npc perturbed, weights stored per slot, gather",
+        &["solver.shape=lme", "grid.perturb=0.2"],
+        false,
+        GpuOptions {
+            lme_stored: true,
+            gather: Some(true),
+        },
     );
 }
 

@@ -59,19 +59,26 @@ fn body_force(p: u32, t: f32) -> vec2<f32> {
     return b;
 }
 
-// Stage `forces`: particle p (shape context c, volume vol, stress
-// s = (xx, yy, xy), body force m_p b) adds −V_p σ_p ∇N + N m_p b to each
-// node of its stencil. Shared by forces.wgsl and the fused stress.wgsl
-// (FORCES); CPU twin: `add_particle_forces` in src/cpu/forces.rs.
+// Stage `forces`: the force −V_p σ_p ∇N + N m_p b one particle (volume
+// vol, stress s = (xx, yy, xy), body force m_p b) puts on one node (weight w).
+// CPU twin: `add_particle_forces` in src/cpu/forces.rs.
+fn node_force(w: NodeW, vol: f32, s: vec3<f32>, mb: vec2<f32>) -> vec2<f32> {
+    return -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * mb;
+}
+
+#if !GATHER
+// The scatter: particle p (shape context c) adds `node_force` to each node
+// of its stencil. Shared by forces.wgsl and the fused stress.wgsl (FORCES).
 fn add_particle_forces(c: ShapeCtx, vol: f32, s: vec3<f32>, mb: vec2<f32>) {
     for (var k = 0u; k < STENCIL; k++) {
         let w = shape_node(c, k);
         if !w.ok {
             continue;
         }
-        let f = -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * mb;
+        let f = node_force(w, vol, s, mb);
         let base = w.node * NODE_STRIDE;
         node_add(base + 3u, f.x);
         node_add(base + 4u, f.y);
     }
 }
+#endif

@@ -35,13 +35,6 @@ fn mls_span_of(u: f32, spans: u32) -> u32 {
     return u32(clamp(floor(u - params.mls_break_off), 0.0, f32(spans - 1u)));
 }
 
-// Grid cell (binning) of lattice point q.
-fn mls_grid_cell(q: vec2<f32>) -> u32 {
-    let i = u32(clamp(floor(q.x), 0.0, f32(params.nx - 2u)));
-    let j = u32(clamp(floor(q.y), 0.0, f32(params.ny - 2u)));
-    return j * (params.nx - 1u) + i;
-}
-
 fn mls_n_gauss() -> u32 {
     return 4u * params.mls_spans_x * params.mls_spans_y;
 }

@@ -5,6 +5,7 @@
 //       if !w.ok { continue; }
 //       ... w.node, w.n, w.dn ...
 //   }
+// and, for node-centred passes, `shape_at(c, i, j)` (below).
 // Exactly one of shape_linear / shape_ugimp / shape_lme / shape_bspline is compiled in.
 // Positions are relative to the grid's lower-left node (m).
 
@@ -125,3 +126,17 @@ fn locate(x: vec2<f32>) -> CellPoint {
 #elif SHAPE_BSPLINE
 #include "shared/shape_bspline.wgsl"
 #endif
+
+// For node-centred (gather) passes: node (i, j) as seen from a particle.
+// Every stencil is a SHAPE_WIDTH × SHAPE_WIDTH box of nodes from
+// `shape_anchor(c)` (some of them outside the support: `ok` false), and
+// `shape_slot` numbers the box as `shape_node` does.
+fn shape_at(c: ShapeCtx, i: u32, j: u32) -> NodeW {
+    let a = vec2<i32>(i32(i), i32(j)) - shape_anchor(c);
+    if any(a < vec2<i32>(0)) || any(a >= vec2<i32>(i32(SHAPE_WIDTH))) {
+        var w: NodeW;
+        w.ok = false;
+        return w;
+    }
+    return shape_node(c, shape_slot(vec2<u32>(a)));
+}

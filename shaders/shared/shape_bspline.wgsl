@@ -5,6 +5,7 @@
 
 const BSPLINE_P: i32 = {{BSPLINE_DEGREE}};
 const STENCIL: u32 = u32((BSPLINE_P + 1) * (BSPLINE_P + 1));
+const SHAPE_WIDTH: u32 = u32(BSPLINE_P + 1);
 
 fn bs_knot(k: i32, n: u32) -> f32 {
     if k <= BSPLINE_P {
@@ -132,3 +133,13 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.dn = vec2<f32>(c.bx.dn[a] * c.by.n[b], c.bx.n[a] * c.by.dn[b]) * params.inv_h;
     return w;
 }
+
+// Lowest node of the stencil.
+fn shape_anchor(c: ShapeCtx) -> vec2<i32> {
+    return vec2<i32>(i32(c.bx.first), i32(c.by.first));
+}
+
+fn shape_slot(a: vec2<u32>) -> u32 {
+    return a.y * SHAPE_WIDTH + a.x;
+}
+

@@ -1,6 +1,7 @@
 // Bilinear Q4 (isoparametric on perturbed grids). CPU twin: src/shape/linear.rs.
 
 const STENCIL: u32 = 4u;
+const SHAPE_WIDTH: u32 = 2u;
 
 struct ShapeCtx {
     cp: CellPoint,
@@ -30,4 +31,14 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.dn = to_physical(c.cp.map, vec2<f32>(ds * nt, ns * dt));
     w.ok = c.cp.ok;
     return w;
+}
+
+// Lowest node of the stencil: the cell's (0, 0) corner.
+fn shape_anchor(c: ShapeCtx) -> vec2<i32> {
+    return vec2<i32>(i32(c.cp.i), i32(c.cp.j));
+}
+
+// Slot of the node at offset a from the anchor (corners counter-clockwise).
+fn shape_slot(a: vec2<u32>) -> u32 {
+    return select(a.x, 3u - a.x, a.y == 1u);
 }

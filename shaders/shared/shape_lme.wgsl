@@ -6,7 +6,8 @@
 // the passes read them. docs/performance.md compares the two.
 // CPU twin: src/shape/lme.rs.
 
-const STENCIL: u32 = {{LME_SIDE}}u * {{LME_SIDE}}u;
+const SHAPE_WIDTH: u32 = {{LME_SIDE}}u;
+const STENCIL: u32 = SHAPE_WIDTH * SHAPE_WIDTH;
 const LME_EMPTY: u32 = 0xffffffffu;
 
 // First node of the search box around x.
@@ -24,8 +25,9 @@ struct LmeNode {
 
 fn lme_node(x: vec2<f32>, i0: u32, j0: u32, k: u32) -> LmeNode {
     var r: LmeNode;
-    let i = i0 + k % params.lme_side;
-    let j = j0 + k / params.lme_side;
+    // The side as a constant (= params.lme_side): no integer division.
+    let i = i0 + k % SHAPE_WIDTH;
+    let j = j0 + k / SHAPE_WIDTH;
     r.ok = i < params.nx && j < params.ny;
     if r.ok {
         r.d = x - node_xy(i, j);
@@ -38,11 +40,15 @@ fn lme_node(x: vec2<f32>, i0: u32, j0: u32, k: u32) -> LmeNode {
 #if LME_STORED
 struct ShapeCtx {
     base: u32,
+    // First node of the search box (gather passes).
+    i0: u32,
+    j0: u32,
     ok: bool,
 }
 
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
-    return ShapeCtx(p * STENCIL, inside_grid(x, 0.0));
+    let b = lme_box(x);
+    return ShapeCtx(p * STENCIL, b.x, b.y, inside_grid(x, 0.0));
 }
 
 fn shape_valid(c: ShapeCtx) -> bool {
@@ -97,3 +103,12 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     return w;
 }
 #endif
+
+// Lowest node of the search box.
+fn shape_anchor(c: ShapeCtx) -> vec2<i32> {
+    return vec2<i32>(i32(c.i0), i32(c.j0));
+}
+
+fn shape_slot(a: vec2<u32>) -> u32 {
+    return a.y * SHAPE_WIDTH + a.x;
+}

@@ -4,6 +4,7 @@
 // src/shape/ugimp.rs, the CPU twin, for why that loses linear reproduction).
 
 const STENCIL: u32 = 9u;
+const SHAPE_WIDTH: u32 = 3u;
 
 struct ShapeCtx {
     base: vec2<i32>,
@@ -71,4 +72,13 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.n = c.wx[kx] * c.wy[ky];
     w.dn = to_physical(c.map, vec2<f32>(c.dwx[kx] * c.wy[ky], c.wx[kx] * c.dwy[ky]));
     return w;
+}
+
+// Lowest node of the stencil (may lie outside the grid, by one).
+fn shape_anchor(c: ShapeCtx) -> vec2<i32> {
+    return c.base;
+}
+
+fn shape_slot(a: vec2<u32>) -> u32 {
+    return a.y * 3u + a.x;
 }

@@ -44,10 +44,13 @@ pub enum Buf {
     ProbeIdx,
     ProbeOut,
     EnergyOut,
-    MlsCount,
-    MlsStart,
-    MlsOrder,
-    MlsCell,
+    /// Particles binned by cell (shared/bins.wgsl), for MLS and the gather
+    /// passes: count per cell, start per cell, the particles in cell order,
+    /// each particle's cell.
+    CellCount,
+    CellStart,
+    CellOrder,
+    CellOf,
     MlsOcc,
     MlsCoef,
     Walls,
@@ -85,10 +88,10 @@ impl Buf {
         Buf::ProbeIdx,
         Buf::ProbeOut,
         Buf::EnergyOut,
-        Buf::MlsCount,
-        Buf::MlsStart,
-        Buf::MlsOrder,
-        Buf::MlsCell,
+        Buf::CellCount,
+        Buf::CellStart,
+        Buf::CellOrder,
+        Buf::CellOf,
         Buf::MlsOcc,
         Buf::MlsCoef,
         Buf::Walls,
@@ -128,7 +131,8 @@ pub struct Buffers {
     pub n_groups: usize,
     /// Walls (their reactions follow the groups' in `Buf::Reactions`).
     pub n_walls: usize,
-    /// MLS: grid cells and Gauss points (0 without MLS).
+    /// Grid cells where particles are binned (MLS or gather; else 0), and
+    /// MLS Gauss points (0 without MLS).
     pub n_cells: usize,
     pub n_gauss: usize,
 }
@@ -169,7 +173,8 @@ impl Buffers {
             ),
         ];
         particle_data(model, params, opts, &mut data);
-        grid_and_output_data(model, params, &mut data);
+        let bins = model.mls || opts.gathers(model);
+        grid_and_output_data(model, params, bins, &mut data);
         let map = upload(ctx, data, model)?;
         let g = &model.grid;
         let groups = model.constraints.groups.len();
@@ -181,11 +186,7 @@ impl Buffers {
             n_probes: model.probes.len(),
             n_groups: groups,
             n_walls: model.walls.list.len(),
-            n_cells: if model.mls {
-                (g.nx - 1) * (g.ny - 1)
-            } else {
-                0
-            },
+            n_cells: if bins { (g.nx - 1) * (g.ny - 1) } else { 0 },
             n_gauss: if model.mls {
                 4 * (params.mls_spans_x * params.mls_spans_y) as usize
             } else {
@@ -317,8 +318,14 @@ fn particle_data(
     }
 }
 
-/// Initial contents of the nodal, constraint, probe, energy and MLS buffers.
-fn grid_and_output_data(model: &Model, params: &Params, data: &mut Vec<(Buf, Vec<u8>)>) {
+/// Initial contents of the nodal, constraint, probe, energy, cell-bin
+/// (`bins`: MLS or gather) and MLS buffers.
+fn grid_and_output_data(
+    model: &Model,
+    params: &Params,
+    bins: bool,
+    data: &mut Vec<(Buf, Vec<u8>)>,
+) {
     let n = model.particles.len();
     let g = &model.grid;
     let origin = g.min;
@@ -368,13 +375,15 @@ fn grid_and_output_data(model: &Model, params: &Params, data: &mut Vec<(Buf, Vec
         vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
     ));
     data.push((Buf::EnergyOut, vec![0u8; 16]));
-    if model.mls {
+    if bins {
         let cells = (g.nx - 1) * (g.ny - 1);
+        data.push((Buf::CellCount, vec![0u8; 4 * cells]));
+        data.push((Buf::CellStart, vec![0u8; 4 * (cells + 1)]));
+        data.push((Buf::CellOrder, vec![0u8; 4 * n]));
+        data.push((Buf::CellOf, vec![0u8; 4 * n]));
+    }
+    if model.mls {
         let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
-        data.push((Buf::MlsCount, vec![0u8; 4 * cells]));
-        data.push((Buf::MlsStart, vec![0u8; 4 * (cells + 1)]));
-        data.push((Buf::MlsOrder, vec![0u8; 4 * n]));
-        data.push((Buf::MlsCell, vec![0u8; 4 * n]));
         data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
         data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
     }

@@ -42,6 +42,22 @@ pub struct GpuOptions {
     /// instead of recomputing them from (λ, log Z, J⁻¹) in each pass. Off by
     /// default: docs/performance.md has the measurement that decided it.
     pub lme_stored: bool,
+    /// `p2g` and `forces` as node-centred gathers over particles binned by
+    /// cell (`Some(true)`) or as particle-centred scatters with float
+    /// atomics (`Some(false)`); `None` picks what measured faster
+    /// (docs/performance.md): the gather for linear shapes on a regular
+    /// grid, the scatter for the rest, whose wider stencils make each
+    /// node visit more particles and evaluate each one's shape anew.
+    /// MUSL and MLS always scatter.
+    pub gather: Option<bool>,
+}
+
+impl GpuOptions {
+    /// Whether `p2g` and `forces` gather (`pipelines::Variant::gather`).
+    pub fn gathers(&self, model: &Model) -> bool {
+        let auto = matches!(model.shape, Shape::Linear) && !model.grid.is_perturbed();
+        self.gather.unwrap_or(auto) && !model.mls && model.integrator != Integrator::Musl
+    }
 }
 
 /// Runs a `Model` on a GPU adapter.
@@ -113,6 +129,16 @@ impl GpuBackend {
             }
         }
         self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// How this scene's stages map onto passes.
+    pub fn plan(&self) -> pipelines::StepPlan {
+        self.pipelines.plan
+    }
+
+    /// The passes of one stage (`Pass::for_stage` for this scene).
+    pub fn stage_passes(&self, stage: crate::solver::Stage) -> &'static [Pass] {
+        Pass::for_stage(stage, self.pipelines.plan)
     }
 
     /// Runs one pass on its own (per-stage parity tests).

@@ -20,11 +20,16 @@ pub enum Pass {
     StepBegin,
     ClearGrid,
     LmeNewton,
+    /// Particles binned by cell (shared/bins.wgsl): for MLS in `p2g`, for
+    /// the gather passes in `shape_eval`.
+    BinClear,
+    BinCount,
+    BinScan,
+    BinFill,
+    /// p2g.wgsl as a scatter with float atomics, or built with GATHER as
+    /// one invocation per node over the binned particles (no atomics).
     P2g,
-    MlsClear,
-    MlsBin,
-    MlsScan,
-    MlsFill,
+    P2gGather,
     MlsP2g,
     GridPredict,
     Stress,
@@ -32,7 +37,9 @@ pub enum Pass {
     /// what a whole step runs without MLS. Not in `ALL`, which lists the
     /// passes of the stages one by one.
     StressForces,
+    /// forces.wgsl as a scatter, or built with GATHER as `P2gGather` is.
     Forces,
+    ForcesGather,
     MlsForces,
     GridCorrect,
     G2p,
@@ -62,20 +69,22 @@ enum Domain {
 }
 
 impl Pass {
-    pub const ALL: [Pass; 22] = [
+    pub const ALL: [Pass; 24] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
         Pass::LmeNewton,
+        Pass::BinClear,
+        Pass::BinCount,
+        Pass::BinScan,
+        Pass::BinFill,
         Pass::P2g,
-        Pass::MlsClear,
-        Pass::MlsBin,
-        Pass::MlsScan,
-        Pass::MlsFill,
+        Pass::P2gGather,
         Pass::MlsP2g,
         Pass::GridPredict,
         Pass::Stress,
         Pass::Forces,
+        Pass::ForcesGather,
         Pass::MlsForces,
         Pass::GridCorrect,
         Pass::G2p,
@@ -94,18 +103,18 @@ impl Pass {
             Pass::StepBegin => "step_begin.wgsl",
             Pass::ClearGrid => "clear_grid.wgsl",
             Pass::LmeNewton => "lme_newton.wgsl",
-            Pass::P2g => "p2g.wgsl",
+            Pass::P2g | Pass::P2gGather => "p2g.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
             Pass::Stress | Pass::StressForces => "stress.wgsl",
-            Pass::Forces => "forces.wgsl",
+            Pass::Forces | Pass::ForcesGather => "forces.wgsl",
             Pass::G2p => "g2p.wgsl",
             Pass::StepEnd => "step_end.wgsl",
             Pass::Probes => "probes.wgsl",
             Pass::Energy => "energy.wgsl",
-            Pass::MlsClear => "mls_clear.wgsl",
-            Pass::MlsBin => "mls_bin.wgsl",
-            Pass::MlsScan => "mls_scan.wgsl",
-            Pass::MlsFill => "mls_fill.wgsl",
+            Pass::BinClear => "bin_clear.wgsl",
+            Pass::BinCount => "bin_count.wgsl",
+            Pass::BinScan => "bin_scan.wgsl",
+            Pass::BinFill => "bin_fill.wgsl",
             Pass::MlsP2g => "mls_p2g.wgsl",
             Pass::MlsForces => "mls_forces.wgsl",
             Pass::RemapClear | Pass::Remap => "remap.wgsl",
@@ -115,45 +124,61 @@ impl Pass {
 
     fn domain(self) -> Domain {
         match self {
-            Pass::StepBegin | Pass::StepEnd | Pass::MlsScan => Domain::One,
-            Pass::MlsClear => Domain::Cells,
+            Pass::StepBegin | Pass::StepEnd | Pass::BinScan => Domain::One,
+            Pass::BinClear => Domain::Cells,
             Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
-            Pass::ClearGrid | Pass::GridPredict | Pass::GridCorrect | Pass::RemapClear => {
-                Domain::Nodes
-            }
+            Pass::ClearGrid
+            | Pass::GridPredict
+            | Pass::GridCorrect
+            | Pass::RemapClear
+            | Pass::P2gGather
+            | Pass::ForcesGather => Domain::Nodes,
             Pass::Probes => Domain::Probes,
             _ => Domain::Particles,
         }
     }
 
     /// The GPU passes that do a solver stage. `Cfl` is the reduction plus
-    /// the one-invocation Δt/stop pass; shape evaluation is a pass of its
-    /// own only for LME (the others are evaluated inline where used).
-    /// With MLS, `p2g` and `forces` work at Gauss points.
-    pub fn for_stage(stage: Stage, lme: bool, mls: bool) -> &'static [Pass] {
+    /// the one-invocation Δt/stop pass; shape evaluation is LME's Newton
+    /// solve and, for the gather passes, the binning (the weights
+    /// themselves are evaluated inline where used). With MLS, `p2g` and
+    /// `forces` work at Gauss points.
+    pub fn for_stage(stage: Stage, plan: StepPlan) -> &'static [Pass] {
+        const BINS: [Pass; 4] = [Pass::BinClear, Pass::BinCount, Pass::BinScan, Pass::BinFill];
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
-            Stage::ShapeEval if lme => &[Pass::LmeNewton],
+            Stage::ShapeEval if plan.gather && plan.lme => {
+                &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
+            }
+            Stage::ShapeEval if plan.gather => &BINS,
+            Stage::ShapeEval if plan.lme => &[Pass::LmeNewton],
             Stage::ShapeEval => &[],
-            Stage::P2g if mls => &[
-                Pass::MlsClear,
-                Pass::MlsBin,
-                Pass::MlsScan,
-                Pass::MlsFill,
-                Pass::MlsP2g,
-            ],
+            Stage::P2g if plan.mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
+            Stage::P2g if plan.gather => &[Pass::P2gGather],
             Stage::P2g => &[Pass::P2g],
-            Stage::Forces if mls => &[Pass::MlsForces],
+            Stage::Forces if plan.mls => &[Pass::MlsForces],
+            Stage::Forces if plan.gather => &[Pass::ForcesGather],
             Stage::GridPredict => &[Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect => &[Pass::GridCorrect],
             Stage::G2p => &[Pass::G2p],
-            Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
+            Stage::Remap if plan.mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
             Stage::Remap => &[Pass::RemapClear, Pass::Remap, Pass::GridPredict],
         }
     }
+}
+
+/// How a scene's stages map onto passes (`Pass::for_stage`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepPlan {
+    pub lme: bool,
+    pub mls: bool,
+    pub musl: bool,
+    /// `p2g` and `forces` gather at nodes over particles binned in
+    /// `shape_eval` (`Variant::gather`).
+    pub gather: bool,
 }
 
 /// Everything that selects a shader variant.
@@ -189,6 +214,11 @@ pub struct Variant {
     pub walls: bool,
     /// Tractions or point loads (the `ExtForce` buffer).
     pub ext_force: bool,
+    /// `p2g` and `forces` as node-centred gathers over particles binned by
+    /// cell, without atomics (GATHER): FE and NPC without MLS, unless
+    /// `GpuOptions::scatter`. MUSL (whose remap scatters from the step's
+    /// start positions) and MLS scatter.
+    pub gather: bool,
 }
 
 impl Variant {
@@ -224,6 +254,16 @@ impl Variant {
             mls: model.mls,
             walls: !model.walls.is_empty(),
             ext_force: model.external.is_some(),
+            gather: opts.gathers(model),
+        }
+    }
+
+    pub fn plan(&self) -> StepPlan {
+        StepPlan {
+            lme: self.shape == crate::scene::ShapeKind::Lme,
+            mls: self.mls,
+            musl: self.integrator == Integrator::Musl,
+            gather: self.gather,
         }
     }
 
@@ -255,6 +295,7 @@ impl Variant {
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
             .flag("EXT_FORCE", self.ext_force)
+            .flag("GATHER", self.gather)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
@@ -284,15 +325,14 @@ impl Variant {
     pub fn uses(&self, pass: Pass) -> bool {
         match pass {
             Pass::LmeNewton => self.shape == crate::scene::ShapeKind::Lme,
-            Pass::MlsClear
-            | Pass::MlsBin
-            | Pass::MlsScan
-            | Pass::MlsFill
-            | Pass::MlsP2g
-            | Pass::MlsForces => self.mls,
-            Pass::P2g | Pass::Forces => !self.mls,
+            Pass::BinClear | Pass::BinCount | Pass::BinScan | Pass::BinFill => {
+                self.mls || self.gather
+            }
+            Pass::MlsP2g | Pass::MlsForces => self.mls,
+            Pass::P2g | Pass::Forces => !self.mls && !self.gather,
+            Pass::P2gGather | Pass::ForcesGather => self.gather,
             // MUSL runs the stress last, apart from the forces.
-            Pass::StressForces => !self.mls && self.integrator != Integrator::Musl,
+            Pass::StressForces => !self.mls && !self.gather && self.integrator != Integrator::Musl,
             Pass::RemapClear => self.integrator == Integrator::Musl,
             Pass::Remap => self.integrator == Integrator::Musl && !self.mls,
             Pass::MlsRemap => self.integrator == Integrator::Musl && self.mls,
@@ -310,9 +350,14 @@ pub fn lme_side(model: &Model) -> u32 {
     }
 }
 
-/// Expands a pass's WGSL for `d`, adding the pass's own flag.
+/// Expands a pass's WGSL for `d`, adding the pass's own flag. (GATHER is
+/// the variant's: it also changes `bin_count`; a scatter pass expands
+/// without it.)
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
+    if matches!(pass, Pass::P2g | Pass::Forces | Pass::StressForces) {
+        d.flag("GATHER", false);
+    }
     d.flag("CORRECT", pass == Pass::GridCorrect)
         .flag("FORCES", pass == Pass::StressForces)
         .flag("CLEAR", pass == Pass::RemapClear);
@@ -392,9 +437,7 @@ pub struct Pipelines {
     n_cells: u32,
     n_gauss: u32,
     max_groups: u32,
-    pub lme: bool,
-    pub mls: bool,
-    pub musl: bool,
+    pub plan: StepPlan,
 }
 
 impl Pipelines {
@@ -406,7 +449,6 @@ impl Pipelines {
     ) -> Result<Pipelines> {
         let variant = Variant::of(model, ctx.atomics, opts);
         let d = variant.defines();
-        let lme = matches!(model.shape, Shape::Lme(_));
         let mut built = Vec::new();
         for pass in Pass::ALL.into_iter().chain([Pass::StressForces]) {
             if !variant.uses(pass) {
@@ -504,9 +546,7 @@ impl Pipelines {
             n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
             n_gauss: buffers.n_gauss as u32,
             max_groups: ctx.limits.max_compute_workgroups_per_dimension,
-            lme,
-            mls: model.mls,
-            musl: model.integrator == Integrator::Musl,
+            plan: variant.plan(),
         })
     }
 
@@ -529,17 +569,18 @@ impl Pipelines {
     }
 
     /// The passes of one whole step, in the order of the integrator's
-    /// stage list (`solver::stages`); without MLS, and where `forces`
-    /// follows `stress` (not MUSL), the two run fused as `StressForces`.
-    pub fn step_passes(lme: bool, mls: bool, musl: bool) -> impl Iterator<Item = Pass> {
-        let fuse = !mls && !musl;
-        let list = if musl {
+    /// stage list (`solver::stages`); scattering without MLS, and where
+    /// `forces` follows `stress` (not MUSL), the two run fused as
+    /// `StressForces`.
+    pub fn step_passes(plan: StepPlan) -> impl Iterator<Item = Pass> {
+        let fuse = !plan.mls && !plan.musl && !plan.gather;
+        let list = if plan.musl {
             crate::solver::STEP_MUSL
         } else {
             crate::solver::STEP
         };
         list.iter()
-            .flat_map(move |stage| Pass::for_stage(*stage, lme, mls).iter().copied())
+            .flat_map(move |stage| Pass::for_stage(*stage, plan).iter().copied())
             .filter_map(move |pass| match pass {
                 Pass::Stress if fuse => Some(Pass::StressForces),
                 Pass::Forces if fuse => None,
@@ -550,7 +591,7 @@ impl Pipelines {
 
     /// Records the passes of one whole step.
     pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
-        for pass in Pipelines::step_passes(self.lme, self.mls, self.musl) {
+        for pass in Pipelines::step_passes(self.plan) {
             self.dispatch(cpass, pass);
         }
     }
@@ -614,6 +655,7 @@ mod tests {
                                 mls: false,
                                 walls: mms,
                                 ext_force: mms,
+                                gather: false,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)

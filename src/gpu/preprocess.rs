@@ -70,12 +70,19 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/mls.wgsl"),
     ),
     (
-        "mls_clear.wgsl",
-        include_str!("../../shaders/mls_clear.wgsl"),
+        "shared/bins.wgsl",
+        include_str!("../../shaders/shared/bins.wgsl"),
     ),
-    ("mls_bin.wgsl", include_str!("../../shaders/mls_bin.wgsl")),
-    ("mls_scan.wgsl", include_str!("../../shaders/mls_scan.wgsl")),
-    ("mls_fill.wgsl", include_str!("../../shaders/mls_fill.wgsl")),
+    (
+        "bin_clear.wgsl",
+        include_str!("../../shaders/bin_clear.wgsl"),
+    ),
+    (
+        "bin_count.wgsl",
+        include_str!("../../shaders/bin_count.wgsl"),
+    ),
+    ("bin_scan.wgsl", include_str!("../../shaders/bin_scan.wgsl")),
+    ("bin_fill.wgsl", include_str!("../../shaders/bin_fill.wgsl")),
     ("mls_p2g.wgsl", include_str!("../../shaders/mls_p2g.wgsl")),
     (
         "mls_forces.wgsl",

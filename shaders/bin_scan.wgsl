@@ -1,11 +1,11 @@
-// Stage `p2g` with MLS, pass 3 of 5 (one workgroup): exclusive prefix sum of
+// Binning (shared/bins.wgsl), pass 3 of 4 (one workgroup): exclusive prefix sum of
 // the per-cell counts into cell starts, resetting the counts to serve as
 // fill cursors. Each of the 256 invocations sums a contiguous run of cells.
 // CPU twin: `Mls::bin`.
 #include "shared/common.wgsl"
 
-@group(0) @binding({{B_MLS_COUNT}}) var<storage, read_write> mls_count: array<u32>;
-@group(0) @binding({{B_MLS_START}}) var<storage, read_write> mls_start: array<u32>;
+@group(0) @binding({{B_CELL_COUNT}}) var<storage, read_write> cell_count: array<u32>;
+@group(0) @binding({{B_CELL_START}}) var<storage, read_write> cell_start: array<u32>;
 
 var<workgroup> partial: array<u32, 256>;
 
@@ -19,7 +19,7 @@ fn main(@builtin(local_invocation_index) lid: u32) {
     let hi = min(lo + chunk, n);
     var sum = 0u;
     for (var i = lo; i < hi; i++) {
-        sum += mls_count[i];
+        sum += cell_count[i];
     }
     partial[lid] = sum;
     workgroupBarrier();
@@ -30,13 +30,13 @@ fn main(@builtin(local_invocation_index) lid: u32) {
             partial[k] = acc;
             acc += s;
         }
-        mls_start[n] = acc;
+        cell_start[n] = acc;
     }
     workgroupBarrier();
     var acc = partial[lid];
     for (var i = lo; i < hi; i++) {
-        mls_start[i] = acc;
-        acc += mls_count[i];
-        mls_count[i] = 0u;
+        cell_start[i] = acc;
+        acc += cell_count[i];
+        cell_count[i] = 0u;
     }
 }

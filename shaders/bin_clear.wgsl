@@ -1,9 +1,12 @@
-// Stage `p2g` with MLS, pass 1 of 5: zero the per-cell particle counts and
-// the integration cells' occupied flags. CPU twin: `Mls::bin` (src/cpu/mls.rs).
+// Binning (shared/bins.wgsl), pass 1 of 4: zero the per-cell particle
+// counts and, with MLS, the integration cells' occupied flags.
+// CPU twin: `Mls::bin` (src/cpu/mls.rs).
 #include "shared/common.wgsl"
 
-@group(0) @binding({{B_MLS_COUNT}}) var<storage, read_write> mls_count: array<u32>;
+@group(0) @binding({{B_CELL_COUNT}}) var<storage, read_write> cell_count: array<u32>;
+#if MLS
 @group(0) @binding({{B_MLS_OCC}}) var<storage, read_write> mls_occ: array<u32>;
+#endif
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -12,9 +15,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     if i < (params.nx - 1u) * (params.ny - 1u) {
-        mls_count[i] = 0u;
+        cell_count[i] = 0u;
     }
+#if MLS
     if i < params.mls_spans_x * params.mls_spans_y {
         mls_occ[i] = 0u;
     }
+#endif
 }
