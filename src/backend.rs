@@ -94,6 +94,41 @@ pub struct NewtonStats {
     pub last_corrections: Vec<f64>,
     /// Halvings of Δt over the run.
     pub cuts: u64,
+    /// Where the time went, summed over every attempt (failed ones too).
+    pub seconds: NewtonSeconds,
+}
+
+/// Wall time of the implicit step's parts (s), summed over the run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct NewtonSeconds {
+    /// Shape functions at the particles, the nodal mass, velocity and
+    /// acceleration, and the unknowns (once per step).
+    pub map: f64,
+    /// The Jacobian's sparsity and faer's symbolic LU (once per step).
+    pub symbolic: f64,
+    /// Residual assembly, stress updates included (once per iterate).
+    pub residual: f64,
+    /// Jacobian assembly (once per iteration).
+    pub jacobian: f64,
+    /// faer's numeric LU factorisation (once per iteration).
+    pub factor: f64,
+    /// The triangular solves and the update of Δu (once per iteration).
+    pub solve: f64,
+    /// Particles take the converged solution (once per step).
+    pub convect: f64,
+}
+
+impl NewtonSeconds {
+    /// Their sum (s).
+    pub fn total(&self) -> f64 {
+        self.map
+            + self.symbolic
+            + self.residual
+            + self.jacobian
+            + self.factor
+            + self.solve
+            + self.convect
+    }
 }
 
 impl NewtonStats {

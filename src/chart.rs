@@ -265,22 +265,31 @@ impl LineChart {
                 }
             }};
         }
+        // Log axes carry their own ticks (`log_ticks`): plotters' own
+        // start at a power of ten, so a range inside one decade got none.
+        let log_axis = |lo: f64, hi: f64| {
+            let (bold, light) = log_ticks(lo, hi);
+            (lo..hi)
+                .log_scale()
+                .with_key_points(bold)
+                .with_light_points(light)
+        };
         match (self.log_x, self.log_y) {
             (false, false) => body!(
                 b.build_cartesian_2d(x0..x1, y0..y1)
                     .map_err(|e| e.to_string())?
             ),
             (true, false) => body!(
-                b.build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                b.build_cartesian_2d(log_axis(x0, x1), y0..y1)
                     .map_err(|e| e.to_string())?
             ),
             (false, true) => body!(
-                b.build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                b.build_cartesian_2d(x0..x1, log_axis(y0, y1))
                     .map_err(|e| e.to_string())?
             ),
             (true, true) => {
                 body!(
-                    b.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                    b.build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))
                         .map_err(|e| e.to_string())?
                 )
             }
@@ -514,6 +523,33 @@ impl StatusGrid {
 }
 
 /// Tick label: powers of ten and 2/5 multiples as 1e3, 2e3; plain numbers otherwise.
+/// Labelled and light ticks of a log axis from `lo` to `hi` (> 0): powers
+/// of ten, with 2 and 5 times them over up to three decades and every
+/// digit within about one; light lines at every digit.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let decades = (hi / lo).log10();
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let step = (decades / 8.0).ceil().max(1.0) as i32;
+    let digits: &[f64] = if decades <= 1.2 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else if decades <= 3.0 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    let at = |ms: &[f64], every: i32| -> Vec<f64> {
+        (k0..=k1)
+            .filter(|k| (k - k0) % every == 0)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(inside)
+            .collect()
+    };
+    let bold = at(digits, step);
+    let light = at(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], 1);
+    (bold, light)
+}
+
 fn tick(v: f64, log: bool) -> String {
     if v == 0.0 {
         return "0".into();
@@ -536,6 +572,22 @@ fn tick(v: f64, log: bool) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_axes_inside_one_decade_are_labelled() {
+        let (bold, light) = log_ticks(0.55, 1.09);
+        assert_eq!(bold.len(), 5, "{bold:?}"); // 0.6, 0.7, 0.8, 0.9, 1
+        assert!((bold[0] - 0.6).abs() < 1e-12 && (bold[4] - 1.0).abs() < 1e-12);
+        assert_eq!(light.len(), 5);
+        let (bold, _) = log_ticks(3e-4, 2e2);
+        // Six decades: powers of ten only.
+        assert_eq!(bold.len(), 6, "{bold:?}");
+        for (b, e) in bold.iter().zip(-3..=2) {
+            assert!((b.log10() - f64::from(e)).abs() < 1e-12, "{bold:?}");
+        }
+        let (bold, _) = log_ticks(0.03, 3.0);
+        assert_eq!(bold.len(), 6, "{bold:?}"); // 0.05, 0.1, 0.2, 0.5, 1, 2
+    }
 
     #[test]
     fn charts_render_to_png_and_svg() {

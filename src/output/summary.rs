@@ -82,6 +82,9 @@ pub struct NewtonSummary {
     pub last_step_residuals: Vec<f64>,
     /// The last step's correction norms |δ| / |Δu|, one per iteration.
     pub last_step_corrections: Vec<f64>,
+    /// Wall time of the step's parts over the run (s): `map`, `symbolic`,
+    /// `residual`, `jacobian`, `factor` (numeric LU), `solve`, `convect`.
+    pub seconds: crate::backend::NewtonSeconds,
 }
 
 impl NewtonSummary {
@@ -93,6 +96,7 @@ impl NewtonSummary {
             cuts: s.cuts,
             last_step_residuals: s.last_residuals.clone(),
             last_step_corrections: s.last_corrections.clone(),
+            seconds: s.seconds,
         }
     }
 }

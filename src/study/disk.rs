@@ -36,7 +36,7 @@ pub const PAPER_LME_28: [f64; 3] = [0.52, 0.07, 0.06];
 /// Interval between the sampled displacements (s).
 const SAMPLE: f64 = 0.01;
 
-fn t_end(quick: bool) -> f64 {
+pub fn t_end(quick: bool) -> f64 {
     if quick { 0.2 } else { 0.5 }
 }
 
@@ -48,10 +48,40 @@ fn steps(quick: bool) -> Vec<f64> {
     }
 }
 
+/// The snapshot times of a run to `t_end`: every `SAMPLE`.
+fn sample_times(t_end: f64) -> Vec<f64> {
+    let n = (t_end / SAMPLE).round() as usize;
+    (1..=n).map(|k| k as f64 * SAMPLE).collect()
+}
+
+/// One run of the disk: `method` (label, shape, γ) at the `k`-th time
+/// step `dt` (k from 1) up to `t_end`, its centre sampled every `SAMPLE`.
+pub fn job(b: BackendChoice, method: (&str, &str, f64), k: usize, dt: f64, t_end: f64) -> Job {
+    let (label, shape, gamma) = method;
+    let mut j = Job::new(
+        format!("{}-{label}-dt{k}", backend_slug(b)),
+        ROLLING_DISK,
+        "rolling_disk",
+    )
+    .set(format!("solver.shape={shape}"))
+    .set(format!("solver.dt={dt}"))
+    .set(format!("solver.t_end={t_end}"))
+    .set("output.vtk_interval=1e9")
+    .tag("backend", backend_slug(b))
+    .tag("method", label)
+    .tag("dt_index", k)
+    .tag("dt", dt);
+    if gamma > 0.0 {
+        j = j.set(format!("solver.lme_gamma={gamma}"));
+    }
+    j.snapshot_times = sample_times(t_end);
+    j.backend = b;
+    j
+}
+
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let t_end = t_end(quick);
-    let n = (t_end / SAMPLE).round() as usize;
-    let times: Vec<f64> = (1..=n).map(|k| k as f64 * SAMPLE).collect();
+    let times = sample_times(t_end);
     let methods: Vec<_> = if quick {
         METHODS.iter().filter(|m| m.1 != "ugimp").collect()
     } else {
@@ -59,27 +89,9 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     };
     let mut out = Vec::new();
     for &b in backends {
-        for &&(label, shape, gamma) in &methods {
+        for &&m in &methods {
             for (k, dt) in steps(quick).into_iter().enumerate() {
-                let mut j = Job::new(
-                    format!("{}-{label}-dt{}", backend_slug(b), k + 1),
-                    ROLLING_DISK,
-                    "rolling_disk",
-                )
-                .set(format!("solver.shape={shape}"))
-                .set(format!("solver.dt={dt}"))
-                .set(format!("solver.t_end={t_end}"))
-                .set("output.vtk_interval=1e9")
-                .tag("backend", backend_slug(b))
-                .tag("method", label)
-                .tag("dt_index", k + 1)
-                .tag("dt", dt);
-                if gamma > 0.0 {
-                    j = j.set(format!("solver.lme_gamma={gamma}"));
-                }
-                j.snapshot_times = times.clone();
-                j.backend = b;
-                out.push(j);
+                out.push(job(b, m, k + 1, dt, t_end));
             }
         }
         // A stick wall in place of the frictional one (the contrast the

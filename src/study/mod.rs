@@ -7,6 +7,7 @@ pub mod block;
 pub mod column;
 pub mod disk;
 pub mod dyka;
+pub mod implicit;
 pub mod mms;
 pub mod plate;
 pub mod runner;
@@ -38,6 +39,10 @@ pub enum StudyName {
     /// Soil column collapse: 4 shapes × 2 meshes, profiles, run-out; and
     /// the cohesionless run-out against the experimental scaling.
     Column,
+    /// Implicit against explicit: the static cantilever (mesh study), Dyka's
+    /// bar and the rolling disk, error against wall time per case, and the
+    /// Newton iteration's cost split (CPU only).
+    Implicit,
     /// All of them, in that order.
     All,
 }
@@ -52,6 +57,7 @@ impl StudyName {
             StudyName::Mms => "mms",
             StudyName::Disk => "disk",
             StudyName::Column => "column",
+            StudyName::Implicit => "implicit",
             StudyName::All => "all",
         }
     }
@@ -180,6 +186,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms,
             StudyName::Disk,
             StudyName::Column,
+            StudyName::Implicit,
         ],
         n => vec![n],
     };
@@ -196,6 +203,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms => mms::jobs(opts.quick, &backends)?,
             StudyName::Disk => disk::jobs(opts.quick, &backends),
             StudyName::Column => column::jobs(opts.quick, &backends),
+            StudyName::Implicit => implicit::jobs(opts.quick),
             StudyName::All => unreachable!(),
         };
         if opts.progress {
@@ -215,6 +223,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms => mms::report(&results, &dir, opts.quick)?,
             StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
+            StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
         crate::output::write_atomic(&dir.join("report.md"), markdown.as_bytes())?;

@@ -69,6 +69,16 @@ impl Job {
             .find(|(key, _)| *key == k)
             .map(|(_, v)| v.as_str())
     }
+
+    /// The job's scene: its case text with its overrides.
+    pub fn scene(&self) -> Result<Scene, crate::error::SceneError> {
+        let overrides = self
+            .sets
+            .iter()
+            .map(|s| Override::parse(s))
+            .collect::<Result<Vec<_>, _>>()?;
+        Scene::from_str(&self.case, self.case_name, self.case_name, &overrides)
+    }
 }
 
 /// What a job produced.
@@ -94,6 +104,8 @@ pub struct RunData {
     pub final_particles: Option<Particles>,
     /// Initial positions of the probes' particles, by probe name.
     pub probe_x0: Vec<(String, [f64; 2])>,
+    /// The implicit integrator's Newton statistics and timers (else None).
+    pub newton: Option<crate::backend::NewtonStats>,
 }
 
 impl RunData {
@@ -159,14 +171,7 @@ impl Observer for Keeper {
 }
 
 fn run_one(job: &Job, threads: usize) -> Result<RunData, String> {
-    let overrides = job
-        .sets
-        .iter()
-        .map(|s| Override::parse(s))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
-    let scene = Scene::from_str(&job.case, job.case_name, job.case_name, &overrides)
-        .map_err(|e| e.to_string())?;
+    let scene = job.scene().map_err(|e| e.to_string())?;
     let mut sim =
         Simulation::new(&scene, &BackendSpec::new(job.backend)).map_err(|e| e.to_string())?;
     let probe_x0 = {
@@ -213,6 +218,7 @@ fn run_one(job: &Job, threads: usize) -> Result<RunData, String> {
         samples: keeper.samples,
         snapshots: keeper.snapshots,
         final_particles: job.keep_final.then_some(particles),
+        newton: backend.newton().cloned(),
         probe_x0,
     })
 }

@@ -35,6 +35,7 @@ use faer::prelude::*;
 use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::solvers::Lu;
 use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 
 /// A residual norm above this many times the step's reference is a
 /// diverging Newton: the step is cut at once rather than iterated further.
@@ -199,7 +200,9 @@ impl ImplicitBackend {
                 }
             }
         }
+        let clock = Instant::now();
         self.convect();
+        self.stats.seconds.convect += clock.elapsed().as_secs_f64();
         self.t = if self.model.t_end - (self.t + self.dt)
             <= crate::model::time_step::LAST_STEP_REL * self.dt
         {
@@ -214,6 +217,7 @@ impl ImplicitBackend {
     /// Shape functions at the particles and the nodal mass, velocity and
     /// acceleration they map to the grid (lumped, eqs. 38–41).
     fn initial_phase(&mut self) -> std::result::Result<(), Fault> {
+        let clock = Instant::now();
         let m = &mut self.model;
         let p = &mut m.particles;
         shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
@@ -255,7 +259,10 @@ impl ImplicitBackend {
         }
         let n = p.len();
         self.dofs = self.build_dofs();
+        let mapped = Instant::now();
+        self.stats.seconds.map += (mapped - clock).as_secs_f64();
         self.pattern = Some(Pattern::new(&self.cache, &self.dofs, n)?);
+        self.stats.seconds.symbolic += mapped.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -382,14 +389,16 @@ impl ImplicitBackend {
         let tol = self.settings.tol;
         let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
         for iter in 0..=self.settings.max_iter {
-            assemble::residual(
+            let clock = Instant::now();
+            let res = assemble::residual(
                 &inp,
                 &self.du,
                 &mut self.iterates,
                 &mut self.r,
                 &mut self.wall_force,
-            )
-            .map_err(AttemptFail::Particle)?;
+            );
+            self.stats.seconds.residual += clock.elapsed().as_secs_f64();
+            res.map_err(AttemptFail::Particle)?;
             let norm = free_norm(&self.r);
             if iter == 0 {
                 reference = norm.max(load_norm);
@@ -417,11 +426,16 @@ impl ImplicitBackend {
             if iter == self.settings.max_iter {
                 return Err(AttemptFail::Newton(ratio));
             }
-            assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values)
-                .map_err(AttemptFail::Particle)?;
+            let clock = Instant::now();
+            let jac = assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values);
+            let assembled = Instant::now();
+            self.stats.seconds.jacobian += (assembled - clock).as_secs_f64();
+            jac.map_err(AttemptFail::Particle)?;
             let k = SparseColMatRef::new(pattern.symbolic.as_ref(), &self.values);
-            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k)
-                .map_err(|_| AttemptFail::Newton(ratio))?;
+            let lu = Lu::try_new_with_symbolic(pattern.lu.clone(), k);
+            let factored = Instant::now();
+            self.stats.seconds.factor += (factored - assembled).as_secs_f64();
+            let lu = lu.map_err(|_| AttemptFail::Newton(ratio))?;
             for (n, &id) in dofs.id.iter().enumerate() {
                 if id == NO_DOF {
                     continue;
@@ -449,6 +463,7 @@ impl ImplicitBackend {
                     }
                 }
             }
+            self.stats.seconds.solve += factored.elapsed().as_secs_f64();
             // A zero increment with a zero correction has converged.
             last_correction = if un > 0.0 {
                 (dn / un).sqrt()
