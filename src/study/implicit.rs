@@ -93,7 +93,7 @@ fn dyka_runs(quick: bool) -> (f64, &'static [f64], &'static [f64]) {
     }
 }
 
-/// The disk's time steps per scheme (s) and its end time.
+/// The disk's time steps (s) of `scheme`: Δt1, Δt1/2, Δt1/4 (`--quick`: Δt1).
 fn disk_steps(scheme: &str, quick: bool) -> Vec<f64> {
     let dt1 = if scheme == "implicit" {
         DISK_IMPLICIT_DT1
