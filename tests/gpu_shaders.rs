@@ -133,6 +133,8 @@ fn variants() -> Vec<Variant> {
                                         gather: !mls
                                             && integrator != Integrator::Musl
                                             && !(multi_material && atomics == AtomicMode::Float),
+                                        // The recursion B-splines take on small grids.
+                                        bspline_small_grid: perturbed,
                                     });
                                 }
                             }

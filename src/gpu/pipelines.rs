@@ -219,6 +219,9 @@ pub struct Variant {
     /// `GpuOptions::scatter`. MUSL (whose remap scatters from the step's
     /// start positions) and MLS scatter.
     pub gather: bool,
+    /// B-splines on a grid too small for the edge tables
+    /// (`bspline::table_fits`): the open-knot recursion instead.
+    pub bspline_small_grid: bool,
 }
 
 impl Variant {
@@ -255,6 +258,13 @@ impl Variant {
             walls: !model.walls.is_empty(),
             ext_force: model.external.is_some(),
             gather: opts.gathers(model),
+            bspline_small_grid: match &model.shape {
+                Shape::Bspline(b) => {
+                    !(crate::model::shape::bspline::table_fits(model.grid.nx, b.degree)
+                        && crate::model::shape::bspline::table_fits(model.grid.ny, b.degree))
+                }
+                _ => false,
+            },
         }
     }
 
@@ -296,6 +306,7 @@ impl Variant {
             .flag("WALLS", self.walls)
             .flag("EXT_FORCE", self.ext_force)
             .flag("GATHER", self.gather)
+            .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
@@ -656,6 +667,7 @@ mod tests {
                                 walls: mms,
                                 ext_force: mms,
                                 gather: false,
+                                bspline_small_grid: perturbed,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)
