@@ -7,7 +7,7 @@
 // CPU twin: `Mls::bin` (src/cpu/mls.rs); the gather's binning has none (the
 // CPU scatters into private grids).
 #include "shared/common.wgsl"
-#if GATHER
+#if ANCHOR_BINS
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
 #endif
@@ -41,7 +41,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
 #endif
     let q = x * params.inv_h;
-#if GATHER
+#if ANCHOR_BINS
     let sc = shape_ctx(p, x);
     if !shape_valid(sc) {
         report_fault(FAULT_LEFT_GRID, p);

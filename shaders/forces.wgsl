@@ -3,7 +3,8 @@
 // stress is already at the step's end, so are the loads.
 // Scatter (one invocation per particle, float atomics) or, built with
 // GATHER, node-centred: one invocation per node sums over the particles
-// binned near it (shared/bins.wgsl, binned in `shape_eval`), without atomics.
+// binned near it (shared/bins.wgsl, binned in `shape_eval`), without atomics;
+// or, built with PATCH, one invocation per bin summing in registers first.
 // CPU twin: src/cpu/forces.rs (a scatter into private grids).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -20,6 +21,13 @@
 @group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
 @group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
+#elif PATCH
+#include "shared/bins.wgsl"
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
+
+#include "shared/atomics.wgsl" ARR=node_acc FN=node_add
 #else
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
 
@@ -66,6 +74,45 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     node_acc[n * NODE_STRIDE + 3u] = f.x;
     node_acc[n * NODE_STRIDE + 4u] = f.y;
+}
+#elif PATCH
+// One invocation per bin of particles sharing a stencil (p2g.wgsl's PATCH).
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let b = linear_index(gid, nwg);
+    if sim.running == 0u || b >= bin_count_all() {
+        return;
+    }
+    let t = load_time();
+    let end = cell_start[b + 1u];
+    var f: array<vec2<f32>, STENCIL>;
+    var node: array<u32, STENCIL>;
+    for (var k = 0u; k < STENCIL; k++) {
+        node[k] = NO_PATCH_NODE;
+    }
+    for (var idx = cell_start[b]; idx < end; idx++) {
+        let p = cell_order[idx];
+        let m = mass[p];
+        let vol = m / rho[p];
+        let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+        let mb = m * body_force(p, t);
+        let c = shape_ctx(p, x0[p] + u[p]);
+        for (var k = 0u; k < STENCIL; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            node[k] = w.node;
+            f[k] += node_force(w, vol, s, mb);
+        }
+    }
+    for (var k = 0u; k < STENCIL; k++) {
+        if node[k] == NO_PATCH_NODE {
+            continue;
+        }
+        node_add(node[k] * NODE_STRIDE + 3u, f[k].x);
+        node_add(node[k] * NODE_STRIDE + 4u, f[k].y);
+    }
 }
 #else
 @compute @workgroup_size(256)

@@ -4,7 +4,9 @@
 // Scatter (one invocation per particle, float atomics) or, built with
 // GATHER, node-centred: one invocation per node sums over the particles
 // binned near it (shared/bins.wgsl, binned in `shape_eval`) and writes its
-// sums once, without atomics. The sums are the same, in another order.
+// sums once, without atomics; or, built with PATCH, one invocation per bin
+// of particles sharing a stencil sums them in registers before the
+// atomics. The sums are the same, in another order.
 // CPU twin: src/cpu/p2g.rs (a scatter into private grids).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -65,6 +67,58 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     node_acc[base] = sum.x;
     node_acc[base + 1u] = sum.y;
     node_acc[base + 2u] = sum.z;
+}
+#elif PATCH
+#include "shared/bins.wgsl"
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
+@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
+
+#include "shared/atomics.wgsl" ARR=node_acc FN=node_add
+
+// One invocation per bin: its particles share their stencil (binned by its
+// anchor), so their sums go to one patch of STENCIL nodes in registers,
+// then one atomic per node and component, not one per particle.
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let b = linear_index(gid, nwg);
+    if sim.running == 0u || b >= bin_count_all() {
+        return;
+    }
+    let end = cell_start[b + 1u];
+    // (mass, momentum x, momentum y) per stencil slot.
+    var sum: array<vec3<f32>, STENCIL>;
+    var node: array<u32, STENCIL>;
+    for (var k = 0u; k < STENCIL; k++) {
+        node[k] = NO_PATCH_NODE;
+    }
+    for (var idx = cell_start[b]; idx < end; idx++) {
+        let p = cell_order[idx];
+        let c = shape_ctx(p, x0[p] + u[p]);
+        if !shape_valid(c) {
+            continue; // reported by bin_count
+        }
+        let m = mass[p];
+        let vel = p2g_velocity(p);
+        for (var k = 0u; k < STENCIL; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            node[k] = w.node;
+            let nm = w.n * m;
+            sum[k] += vec3<f32>(nm, nm * vel.x, nm * vel.y);
+        }
+    }
+    for (var k = 0u; k < STENCIL; k++) {
+        if node[k] == NO_PATCH_NODE {
+            continue;
+        }
+        let base = node[k] * NODE_STRIDE;
+        node_add(base, sum[k].x);
+        node_add(base + 1u, sum[k].y);
+        node_add(base + 2u, sum[k].z);
+    }
 }
 #else
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;

@@ -5,7 +5,9 @@
 // Built with FORCES (pass `StressForces`, what a whole step runs) it goes on
 // to stage `forces` for the same particle with the same weights (the stress
 // is all `forces` needs from it), saving a pass over the particles and a
-// shape evaluation; the stages stay separate passes for parity tests.
+// shape evaluation; the stages stay separate passes for parity tests. Built
+// with FORCES and PATCH, one invocation per bin of particles that share a
+// stencil runs both for each of them and sums the forces in registers.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -32,6 +34,12 @@
 
 #include "shared/body_force.wgsl"
 
+#if PATCH
+#include "shared/bins.wgsl"
+@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
+@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
+#endif
+
 fn node_value(i: u32) -> f32 {
 #if FLOAT_ATOMICS
     return atomicLoad(&node_acc[i]);
@@ -47,19 +55,17 @@ fn node_value(i: u32) -> f32 {
 }
 #endif
 
-@compute @workgroup_size(256)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let p = linear_index(gid, nwg);
-    if sim.running == 0u || p >= params.n_particles {
-        return;
-    }
-#if MUSL
-    // MUSL runs the stress last, after g2p moved the particles: the weights
-    // are those of the step's start (eq. 34), as on the CPU's shape cache.
-    let c = shape_ctx(p, x_start[p]);
-#else
-    let c = shape_ctx(p, x0[p] + u[p]);
-#endif
+// The stress update of particle p with shape context c (velocity gradient,
+// material, density; state written back). `ok` false: a fault was reported.
+struct Updated {
+    ok: bool,
+    s: vec3<f32>,
+    rho: f32,
+}
+
+fn update_particle(p: u32, c: ShapeCtx) -> Updated {
+    var out: Updated;
+    out.ok = false;
     // Velocity gradient L = Σ v ⊗ ∇N as (xx, xy, yx, yy).
     var l = vec4<f32>(0.0);
     for (var k = 0u; k < STENCIL; k++) {
@@ -86,12 +92,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let up = material_update(material_of(p), l, dt, s0, f, q);
     if up.fault != 0u {
         report_fault(up.fault, p);
-        return;
+        return out;
     }
     let s = up.s;
     if !(is_finite(s.x) && is_finite(s.y) && is_finite(s.z)) {
         report_fault(FAULT_NON_FINITE_STRESS, p);
-        return;
+        return out;
     }
     let rho_p = rho[p] / up.j;
     rho[p] = rho_p;
@@ -104,10 +110,79 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     stress[3u * p] = s.x;
     stress[3u * p + 1u] = s.y;
     stress[3u * p + 2u] = s.z;
+    out.ok = true;
+    out.s = s;
+    out.rho = rho_p;
+    return out;
+}
+
+#if PATCH
+// With FORCES: one invocation per bin of particles sharing a stencil
+// (p2g.wgsl's PATCH): each particle's stress, then its forces summed in
+// registers, then one atomic per node and component.
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let b = linear_index(gid, nwg);
+    if sim.running == 0u || b >= bin_count_all() {
+        return;
+    }
+    let t = sim.t + sim.t_lo + sim.dt;
+    let end = cell_start[b + 1u];
+    var fs: array<vec2<f32>, STENCIL>;
+    var node: array<u32, STENCIL>;
+    for (var k = 0u; k < STENCIL; k++) {
+        node[k] = NO_PATCH_NODE;
+    }
+    for (var idx = cell_start[b]; idx < end; idx++) {
+        let p = cell_order[idx];
+        let c = shape_ctx(p, x0[p] + u[p]);
+        let up = update_particle(p, c);
+        if !up.ok {
+            continue;
+        }
+        let m = mass[p];
+        let vol = m / up.rho;
+        let mb = m * body_force(p, t);
+        for (var k = 0u; k < STENCIL; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            node[k] = w.node;
+            fs[k] += node_force(w, vol, up.s, mb);
+        }
+    }
+    for (var k = 0u; k < STENCIL; k++) {
+        if node[k] == NO_PATCH_NODE {
+            continue;
+        }
+        node_add(node[k] * NODE_STRIDE + 3u, fs[k].x);
+        node_add(node[k] * NODE_STRIDE + 4u, fs[k].y);
+    }
+}
+#else
+@compute @workgroup_size(256)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let p = linear_index(gid, nwg);
+    if sim.running == 0u || p >= params.n_particles {
+        return;
+    }
+#if MUSL
+    // MUSL runs the stress last, after g2p moved the particles: the weights
+    // are those of the step's start (eq. 34), as on the CPU's shape cache.
+    let c = shape_ctx(p, x_start[p]);
+#else
+    let c = shape_ctx(p, x0[p] + u[p]);
+#endif
+    let up = update_particle(p, c);
+    if !up.ok {
+        return;
+    }
 #if FORCES
     let m = mass[p];
-    let vol = m / rho_p;
+    let vol = m / up.rho;
     let mb = m * body_force(p, sim.t + sim.t_lo + sim.dt);
-    add_particle_forces(c, vol, s, mb);
+    add_particle_forces(c, vol, up.s, mb);
 #endif
 }
+#endif

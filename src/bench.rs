@@ -46,25 +46,30 @@ pub fn standard_cases() -> Vec<Case> {
 /// Extra cases: LME with weights stored per slot on the GPU (the
 /// alternative to recomputing them from λ in each pass), elastoplastic LME
 /// (Mohr–Coulomb), the B-splines with and without MLS reconstruction, and
-/// `*-scatter` and `*-gather`: p2g and forces on the GPU as particle-centred
-/// scatters with float atomics or node-centred gathers, whichever the case
-/// does not run by default (`GpuOptions::gather`).
+/// `*-scatter`, `*-gather` and `*-patch`: p2g and forces on the GPU as
+/// particle-centred scatters with float atomics, node-centred gathers or
+/// per-bin scatters summing in registers first, whichever the case does not
+/// run by default (`GpuOptions::gather`, `GpuOptions::patch`).
 pub fn extra_cases() -> Vec<Case> {
     let mut stored = Case::new("lme-g3-stored", &["solver.shape=lme", "solver.lme_gamma=3"]);
     stored.gpu.lme_stored = true;
-    let p2g = |label: &str, sets: &[&str], gather: bool| {
+    let p2g = |label: &str, sets: &[&str], gather: bool, patch: bool| {
         let mut c = Case::new(label, sets);
         c.gpu.gather = Some(gather);
+        c.gpu.patch = Some(patch);
         c
     };
     vec![
         stored,
-        p2g("linear-scatter", &["solver.shape=linear"], false),
-        p2g("bspline2-gather", &["solver.shape=bspline2"], true),
+        p2g("linear-scatter", &["solver.shape=linear"], false, false),
+        p2g("linear-patch", &["solver.shape=linear"], false, true),
+        p2g("bspline2-gather", &["solver.shape=bspline2"], true, false),
+        p2g("bspline2-scatter", &["solver.shape=bspline2"], false, false),
         p2g(
             "lme-g3-gather",
             &["solver.shape=lme", "solver.lme_gamma=3"],
             true,
+            false,
         ),
         // Elastoplastic LME: the square's impact stresses (about 50 kPa)
         // exceed this Mohr–Coulomb strength, so the return mapping runs.

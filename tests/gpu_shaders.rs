@@ -133,6 +133,21 @@ fn variants() -> Vec<Variant> {
                                         gather: !mls
                                             && integrator != Integrator::Musl
                                             && !(multi_material && atomics == AtomicMode::Float),
+                                        // The recursion B-splines take on small grids.
+                                        bspline_small_grid: multi_material,
+                                        // Per-bin scatter where it applies and
+                                        // the variant does not gather.
+                                        patch: !perturbed
+                                            && !mls
+                                            && integrator != Integrator::Musl
+                                            && multi_material
+                                            && atomics == AtomicMode::Float
+                                            && matches!(
+                                                shape,
+                                                ShapeKind::Linear
+                                                    | ShapeKind::Bspline2
+                                                    | ShapeKind::Bspline3
+                                            ),
                                     });
                                 }
                             }
@@ -198,8 +213,8 @@ fn every_pass_validates_in_every_variant() {
                 "{pass:?} {v:?}: MLS buffers without MLS"
             );
             assert!(
-                !(has(Buf::CellCount) || has(Buf::CellOrder)) || v.mls || v.gather,
-                "{pass:?} {v:?}: cell bins without MLS or gather"
+                !(has(Buf::CellCount) || has(Buf::CellOrder)) || v.mls || v.gather || v.patch,
+                "{pass:?} {v:?}: cell bins without MLS, gather or patch"
             );
             assert!(
                 !(has(Buf::Walls) || has(Buf::WallMask)) || v.walls,
@@ -228,9 +243,11 @@ fn pass_uses_shape(pass: Pass) -> bool {
         Pass::LmeNewton
             | Pass::P2g
             | Pass::P2gGather
+            | Pass::P2gPatch
             | Pass::Stress
             | Pass::Forces
             | Pass::ForcesGather
+            | Pass::ForcesPatch
             | Pass::G2p
             | Pass::MlsP2g
             | Pass::MlsForces

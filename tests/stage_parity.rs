@@ -705,11 +705,21 @@ fn stages_match_lme() {
 const GATHER: GpuOptions = GpuOptions {
     lme_stored: false,
     gather: Some(true),
+    patch: None,
 };
-/// The scatters with float atomics, for linear shapes (which gather by default).
+/// The scatters with float atomics, one invocation per particle, for linear
+/// shapes (which gather by default) and B-splines (which scatter per bin).
 const SCATTER: GpuOptions = GpuOptions {
     lme_stored: false,
     gather: Some(false),
+    patch: Some(false),
+};
+/// The scatters per bin of particles sharing a stencil, summing in
+/// registers before the atomics (`GpuOptions::patch`; by default B-splines).
+const PATCH: GpuOptions = GpuOptions {
+    lme_stored: false,
+    gather: Some(false),
+    patch: Some(true),
 };
 
 #[test]
@@ -769,7 +779,21 @@ fn stages_match_gather_and_scatter() {
         GpuOptions {
             lme_stored: true,
             gather: Some(true),
+            patch: None,
         },
+    );
+    parity_with("linear npc, patch", &["solver.shape=linear"], false, PATCH);
+    parity_with(
+        "bspline2 npc, scatter per particle",
+        &["solver.shape=bspline2"],
+        false,
+        SCATTER,
+    );
+    parity_with(
+        "bspline3 fe, patch, CAS atomics",
+        &["solver.shape=bspline3", "solver.integrator=fe"],
+        true,
+        PATCH,
     );
 }
 

@@ -11,7 +11,7 @@ fn bin_cell(q: vec2<f32>) -> u32 {
     return j * (params.nx - 1u) + i;
 }
 
-#if GATHER
+#if ANCHOR_BINS
 // Gather passes bin each particle by its stencil's anchor (`shape_anchor`,
 // its lowest node), clamped to the cells, rather than by the cell that
 // holds it: node (i, j) then finds every particle that may reach it in the
@@ -23,6 +23,14 @@ fn bin_anchor_cell(a: vec2<i32>) -> u32 {
     let c = vec2<u32>(clamp(a, vec2<i32>(0), top));
     return c.y * (params.nx - 1u) + c.x;
 }
+
+// Bins: one per grid cell.
+fn bin_count_all() -> u32 {
+    return (params.nx - 1u) * (params.ny - 1u);
+}
+
+// A patch slot no particle of the bin reached (PATCH).
+const NO_PATCH_NODE: u32 = 0xffffffffu;
 
 // A box of cells, inclusive.
 struct CellBox {

@@ -24,36 +24,56 @@ struct Basis1 {
     dn: vec4<f32>,
 }
 
-// Away from the edge (every knot t_{s−p}..t_{s+p+1} uniform) the closed
-// form of the cardinal B-splines; near it the open-knot recursion.
+// One code path for every lane (no branch on the particle's position: on
+// a SIMD software adapter like llvmpipe both sides of a divergent branch
+// run, so the recursion would run beside the closed form for every
+// particle): each span's p + 1 bases are fixed polynomials in
+// c = u − s + p/2, one row of coefficients per left-edge span s = p..2p − 1
+// and one for the interior, picked with selects; the right edge is the left
+// one mirrored (N_i(u) = N_{n−1−i}(n − 1 − u)). On grids too small for the
+// edges to stay apart (BSPLINE_SMALL_GRID: fewer than 3p + 1 nodes in a
+// direction) the open-knot recursion runs. CPU twin: `table_basis`.
 fn bs_basis(u: f32, n: u32) -> Basis1 {
     let s = clamp(i32(floor(u + 0.5 * f32(BSPLINE_P + 1))), BSPLINE_P, i32(n) - 1);
-    if s > 2 * BSPLINE_P && s + BSPLINE_P + 2 <= i32(n) {
-        return bs_uniform_basis(u, s);
-    }
+#if BSPLINE_SMALL_GRID
     return bs_open_basis(u, s, n);
+#else
+    let right = s + BSPLINE_P >= i32(n);
+    let sm = select(s, i32(n) + BSPLINE_P - 1 - s, right);
+    let c = select(u, f32(n - 1u) - u, right) - f32(sm) + 0.5 * f32(BSPLINE_P);
+    let row = sm - BSPLINE_P;
+    var nb: vec4<f32>;
+    var dn: vec4<f32>;
+    if BSPLINE_P == 2 {
+        let k0 = bs_pick2(row, vec4<f32>(1.0 / 9.0, 28.0 / 45.0, 4.0 / 15.0, 0.0), vec4<f32>(1.0 / 10.0, 31.0 / 40.0, 1.0 / 8.0, 0.0), vec4<f32>(1.0 / 8.0, 3.0 / 4.0, 1.0 / 8.0, 0.0));
+        let k1 = bs_pick2(row, vec4<f32>(-4.0 / 9.0, -4.0 / 45.0, 8.0 / 15.0, 0.0), vec4<f32>(-2.0 / 5.0, -1.0 / 10.0, 1.0 / 2.0, 0.0), vec4<f32>(-1.0 / 2.0, 0.0, 1.0 / 2.0, 0.0));
+        let k2 = bs_pick2(row, vec4<f32>(4.0 / 9.0, -32.0 / 45.0, 4.0 / 15.0, 0.0), vec4<f32>(2.0 / 5.0, -9.0 / 10.0, 1.0 / 2.0, 0.0), vec4<f32>(1.0 / 2.0, -1.0, 1.0 / 2.0, 0.0));
+        nb = k0 + c * (k1 + c * k2);
+        dn = k1 + 2.0 * c * k2;
+        nb = select(nb, nb.zyxw, right);
+        dn = select(dn, -dn.zyxw, right);
+    } else {
+        let k0 = bs_pick3(row, vec4<f32>(1.0 / 64.0, 21.0 / 64.0, 33.0 / 64.0, 9.0 / 64.0), vec4<f32>(1.0 / 72.0, 211.0 / 576.0, 115.0 / 192.0, 1.0 / 48.0), vec4<f32>(1.0 / 64.0, 31.0 / 64.0, 23.0 / 48.0, 1.0 / 48.0), vec4<f32>(1.0 / 48.0, 23.0 / 48.0, 23.0 / 48.0, 1.0 / 48.0));
+        let k1 = bs_pick3(row, vec4<f32>(-3.0 / 32.0, -15.0 / 32.0, 9.0 / 32.0, 9.0 / 32.0), vec4<f32>(-1.0 / 12.0, -49.0 / 96.0, 15.0 / 32.0, 1.0 / 8.0), vec4<f32>(-3.0 / 32.0, -21.0 / 32.0, 5.0 / 8.0, 1.0 / 8.0), vec4<f32>(-1.0 / 8.0, -5.0 / 8.0, 5.0 / 8.0, 1.0 / 8.0));
+        let k2 = bs_pick3(row, vec4<f32>(3.0 / 16.0, -1.0 / 16.0, -5.0 / 16.0, 3.0 / 16.0), vec4<f32>(1.0 / 6.0, -5.0 / 48.0, -5.0 / 16.0, 1.0 / 4.0), vec4<f32>(3.0 / 16.0, -3.0 / 16.0, -1.0 / 4.0, 1.0 / 4.0), vec4<f32>(1.0 / 4.0, -1.0 / 4.0, -1.0 / 4.0, 1.0 / 4.0));
+        let k3 = bs_pick3(row, vec4<f32>(-1.0 / 8.0, 19.0 / 72.0, -13.0 / 72.0, 1.0 / 24.0), vec4<f32>(-1.0 / 9.0, 23.0 / 72.0, -3.0 / 8.0, 1.0 / 6.0), vec4<f32>(-1.0 / 8.0, 11.0 / 24.0, -1.0 / 2.0, 1.0 / 6.0), vec4<f32>(-1.0 / 6.0, 1.0 / 2.0, -1.0 / 2.0, 1.0 / 6.0));
+        nb = k0 + c * (k1 + c * (k2 + c * k3));
+        dn = k1 + c * (2.0 * k2 + 3.0 * c * k3);
+        nb = select(nb, nb.wzyx, right);
+        dn = select(dn, -dn.wzyx, right);
+    }
+    return Basis1(u32(s - BSPLINE_P), nb, dn);
+#endif
 }
 
-// Uniform knots: quadratic with f = u − first in [0.5, 1.5), cubic with
-// t = u − (first + 1) in [0, 1).
-fn bs_uniform_basis(u: f32, s: i32) -> Basis1 {
-    let first = s - BSPLINE_P;
-    if BSPLINE_P == 2 {
-        let f = u - f32(first);
-        let a = 1.5 - f;
-        let b = f - 1.0;
-        let c = f - 0.5;
-        return Basis1(u32(first), vec4<f32>(0.5 * a * a, 0.75 - b * b, 0.5 * c * c, 0.0), vec4<f32>(-a, -2.0 * b, c, 0.0));
-    }
-    let t = u - f32(first + 1);
-    let t2 = t * t;
-    let t3 = t2 * t;
-    let r = 1.0 - t;
-    return Basis1(
-        u32(first),
-        vec4<f32>(r * r * r / 6.0, 0.5 * t3 - t2 + 2.0 / 3.0, -0.5 * t3 + 0.5 * t2 + 0.5 * t + 1.0 / 6.0, t3 / 6.0),
-        vec4<f32>(-0.5 * r * r, 1.5 * t2 - 2.0 * t, -1.5 * t2 + t + 0.5, 0.5 * t2),
-    );
+// Coefficient rows (`table_basis` in src/model/shape/bspline.rs): the
+// left edge's spans, then the interior for row ≥ p.
+fn bs_pick2(row: i32, e0: vec4<f32>, e1: vec4<f32>, interior: vec4<f32>) -> vec4<f32> {
+    return select(select(interior, e1, row == 1), e0, row == 0);
+}
+
+fn bs_pick3(row: i32, e0: vec4<f32>, e1: vec4<f32>, e2: vec4<f32>, interior: vec4<f32>) -> vec4<f32> {
+    return select(select(select(interior, e2, row == 2), e1, row == 1), e0, row == 0);
 }
 
 // The general open-knot evaluation on span s (Cox-de Boor).

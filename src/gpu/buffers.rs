@@ -131,7 +131,7 @@ pub struct Buffers {
     pub n_groups: usize,
     /// Walls (their reactions follow the groups' in `Buf::Reactions`).
     pub n_walls: usize,
-    /// Grid cells where particles are binned (MLS or gather; else 0), and
+    /// Grid cells where particles are binned (MLS, gather or patch; else 0), and
     /// MLS Gauss points (0 without MLS).
     pub n_cells: usize,
     pub n_gauss: usize,
@@ -173,7 +173,7 @@ impl Buffers {
             ),
         ];
         particle_data(model, params, opts, &mut data);
-        let bins = model.mls || opts.gathers(model);
+        let bins = model.mls || opts.gathers(model) || opts.patches(model);
         grid_and_output_data(model, params, bins, &mut data);
         let map = upload(ctx, data, model)?;
         let g = &model.grid;

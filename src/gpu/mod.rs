@@ -50,6 +50,13 @@ pub struct GpuOptions {
     /// node visit more particles and evaluate each one's shape anew.
     /// MUSL and MLS always scatter.
     pub gather: Option<bool>,
+    /// `p2g` and `forces` scattered per bin of particles that share their
+    /// stencil (`Some(true)`: one invocation per bin sums its particles in
+    /// registers, then one atomic per node of the stencil) or per particle
+    /// (`Some(false)`); `None` picks what measured faster
+    /// (docs/performance.md). Only linear shapes and B-splines on a regular
+    /// grid that do not gather, without MLS or MUSL.
+    pub patch: Option<bool>,
 }
 
 impl GpuOptions {
@@ -57,6 +64,17 @@ impl GpuOptions {
     pub fn gathers(&self, model: &Model) -> bool {
         let auto = matches!(model.shape, Shape::Linear) && !model.grid.is_perturbed();
         self.gather.unwrap_or(auto) && !model.mls && model.integrator != Integrator::Musl
+    }
+
+    /// Whether `p2g` and `forces` scatter per bin (`pipelines::Variant::patch`).
+    pub fn patches(&self, model: &Model) -> bool {
+        let fits = matches!(model.shape, Shape::Linear | Shape::Bspline(_))
+            && !model.grid.is_perturbed()
+            && !model.mls
+            && model.integrator != Integrator::Musl
+            && !self.gathers(model);
+        let auto = matches!(model.shape, Shape::Bspline(_));
+        self.patch.unwrap_or(auto) && fits
     }
 }
 

@@ -30,6 +30,11 @@ pub enum Pass {
     /// one invocation per node over the binned particles (no atomics).
     P2g,
     P2gGather,
+    /// p2g.wgsl built with PATCH: one invocation per bin of particles that
+    /// share a stencil (linear and B-splines on a regular grid), summing
+    /// their contributions in registers, then one atomic per node and
+    /// component of the stencil.
+    P2gPatch,
     MlsP2g,
     GridPredict,
     Stress,
@@ -37,9 +42,13 @@ pub enum Pass {
     /// what a whole step runs without MLS. Not in `ALL`, which lists the
     /// passes of the stages one by one.
     StressForces,
+    /// `StressForces` built with PATCH: per bin, as `P2gPatch`. Not in `ALL`.
+    StressForcesPatch,
     /// forces.wgsl as a scatter, or built with GATHER as `P2gGather` is.
     Forces,
     ForcesGather,
+    /// forces.wgsl built with PATCH, as `P2gPatch`.
+    ForcesPatch,
     MlsForces,
     GridCorrect,
     G2p,
@@ -69,7 +78,7 @@ enum Domain {
 }
 
 impl Pass {
-    pub const ALL: [Pass; 24] = [
+    pub const ALL: [Pass; 26] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -80,11 +89,13 @@ impl Pass {
         Pass::BinFill,
         Pass::P2g,
         Pass::P2gGather,
+        Pass::P2gPatch,
         Pass::MlsP2g,
         Pass::GridPredict,
         Pass::Stress,
         Pass::Forces,
         Pass::ForcesGather,
+        Pass::ForcesPatch,
         Pass::MlsForces,
         Pass::GridCorrect,
         Pass::G2p,
@@ -103,10 +114,10 @@ impl Pass {
             Pass::StepBegin => "step_begin.wgsl",
             Pass::ClearGrid => "clear_grid.wgsl",
             Pass::LmeNewton => "lme_newton.wgsl",
-            Pass::P2g | Pass::P2gGather => "p2g.wgsl",
+            Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
-            Pass::Stress | Pass::StressForces => "stress.wgsl",
-            Pass::Forces | Pass::ForcesGather => "forces.wgsl",
+            Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
+            Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
             Pass::G2p => "g2p.wgsl",
             Pass::StepEnd => "step_end.wgsl",
             Pass::Probes => "probes.wgsl",
@@ -125,7 +136,9 @@ impl Pass {
     fn domain(self) -> Domain {
         match self {
             Pass::StepBegin | Pass::StepEnd | Pass::BinScan => Domain::One,
-            Pass::BinClear => Domain::Cells,
+            Pass::BinClear | Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => {
+                Domain::Cells
+            }
             Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
             Pass::ClearGrid
             | Pass::GridPredict
@@ -151,14 +164,16 @@ impl Pass {
             Stage::ShapeEval if plan.gather && plan.lme => {
                 &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
             }
-            Stage::ShapeEval if plan.gather => &BINS,
+            Stage::ShapeEval if plan.gather || plan.patch => &BINS,
             Stage::ShapeEval if plan.lme => &[Pass::LmeNewton],
             Stage::ShapeEval => &[],
             Stage::P2g if plan.mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
             Stage::P2g if plan.gather => &[Pass::P2gGather],
+            Stage::P2g if plan.patch => &[Pass::P2gPatch],
             Stage::P2g => &[Pass::P2g],
             Stage::Forces if plan.mls => &[Pass::MlsForces],
             Stage::Forces if plan.gather => &[Pass::ForcesGather],
+            Stage::Forces if plan.patch => &[Pass::ForcesPatch],
             Stage::GridPredict => &[Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
@@ -179,6 +194,9 @@ pub struct StepPlan {
     /// `p2g` and `forces` gather at nodes over particles binned in
     /// `shape_eval` (`Variant::gather`).
     pub gather: bool,
+    /// `p2g` and `forces` scatter per bin of particles binned in
+    /// `shape_eval` (`Variant::patch`).
+    pub patch: bool,
 }
 
 /// Everything that selects a shader variant.
@@ -219,6 +237,14 @@ pub struct Variant {
     /// `GpuOptions::scatter`. MUSL (whose remap scatters from the step's
     /// start positions) and MLS scatter.
     pub gather: bool,
+    /// B-splines on a grid too small for the edge tables
+    /// (`bspline::table_fits`): the open-knot recursion instead.
+    pub bspline_small_grid: bool,
+    /// `p2g` and `forces` (and the fused `StressForces`) scatter per bin of
+    /// particles that share their stencil's anchor, summing in registers
+    /// before the atomics (PATCH): linear and B-splines on a regular grid
+    /// where they do not gather (`GpuOptions::patches`).
+    pub patch: bool,
 }
 
 impl Variant {
@@ -255,6 +281,14 @@ impl Variant {
             walls: !model.walls.is_empty(),
             ext_force: model.external.is_some(),
             gather: opts.gathers(model),
+            patch: opts.patches(model),
+            bspline_small_grid: match &model.shape {
+                Shape::Bspline(b) => {
+                    !(crate::model::shape::bspline::table_fits(model.grid.nx, b.degree)
+                        && crate::model::shape::bspline::table_fits(model.grid.ny, b.degree))
+                }
+                _ => false,
+            },
         }
     }
 
@@ -264,6 +298,7 @@ impl Variant {
             mls: self.mls,
             musl: self.integrator == Integrator::Musl,
             gather: self.gather,
+            patch: self.patch,
         }
     }
 
@@ -296,6 +331,8 @@ impl Variant {
             .flag("WALLS", self.walls)
             .flag("EXT_FORCE", self.ext_force)
             .flag("GATHER", self.gather)
+            .flag("ANCHOR_BINS", self.gather || self.patch)
+            .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
@@ -326,13 +363,16 @@ impl Variant {
         match pass {
             Pass::LmeNewton => self.shape == crate::scene::ShapeKind::Lme,
             Pass::BinClear | Pass::BinCount | Pass::BinScan | Pass::BinFill => {
-                self.mls || self.gather
+                self.mls || self.gather || self.patch
             }
             Pass::MlsP2g | Pass::MlsForces => self.mls,
-            Pass::P2g | Pass::Forces => !self.mls && !self.gather,
+            Pass::P2g | Pass::Forces => !self.mls && !self.gather && !self.patch,
             Pass::P2gGather | Pass::ForcesGather => self.gather,
+            Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => self.patch,
             // MUSL runs the stress last, apart from the forces.
-            Pass::StressForces => !self.mls && !self.gather && self.integrator != Integrator::Musl,
+            Pass::StressForces => {
+                !self.mls && !self.gather && !self.patch && self.integrator != Integrator::Musl
+            }
             Pass::RemapClear => self.integrator == Integrator::Musl,
             Pass::Remap => self.integrator == Integrator::Musl && !self.mls,
             Pass::MlsRemap => self.integrator == Integrator::Musl && self.mls,
@@ -355,11 +395,29 @@ pub fn lme_side(model: &Model) -> u32 {
 /// without it.)
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
-    if matches!(pass, Pass::P2g | Pass::Forces | Pass::StressForces) {
+    if matches!(
+        pass,
+        Pass::P2g
+            | Pass::Forces
+            | Pass::StressForces
+            | Pass::P2gPatch
+            | Pass::ForcesPatch
+            | Pass::StressForcesPatch
+    ) {
         d.flag("GATHER", false);
     }
     d.flag("CORRECT", pass == Pass::GridCorrect)
-        .flag("FORCES", pass == Pass::StressForces)
+        .flag(
+            "PATCH",
+            matches!(
+                pass,
+                Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
+            ),
+        )
+        .flag(
+            "FORCES",
+            matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
+        )
         .flag("CLEAR", pass == Pass::RemapClear);
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
@@ -450,7 +508,10 @@ impl Pipelines {
         let variant = Variant::of(model, ctx.atomics, opts);
         let d = variant.defines();
         let mut built = Vec::new();
-        for pass in Pass::ALL.into_iter().chain([Pass::StressForces]) {
+        for pass in Pass::ALL
+            .into_iter()
+            .chain([Pass::StressForces, Pass::StressForcesPatch])
+        {
             if !variant.uses(pass) {
                 continue;
             }
@@ -582,8 +643,9 @@ impl Pipelines {
         list.iter()
             .flat_map(move |stage| Pass::for_stage(*stage, plan).iter().copied())
             .filter_map(move |pass| match pass {
+                Pass::Stress if fuse && plan.patch => Some(Pass::StressForcesPatch),
                 Pass::Stress if fuse => Some(Pass::StressForces),
-                Pass::Forces if fuse => None,
+                Pass::Forces | Pass::ForcesPatch if fuse => None,
                 p => Some(p),
             })
             .chain([Pass::StepEnd])
@@ -622,6 +684,7 @@ mod tests {
             position: NpcPosition::Corrected,
         };
         let mut checked = 0;
+        let mut patched = 0;
         for shape in [
             ShapeKind::Linear,
             ShapeKind::Ugimp,
@@ -656,6 +719,8 @@ mod tests {
                                 walls: mms,
                                 ext_force: mms,
                                 gather: false,
+                                bspline_small_grid: perturbed,
+                                patch: false,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)
@@ -664,11 +729,25 @@ mod tests {
                             assert!(b.iter().any(|b| b.buf == Buf::NodeAcc && b.writable));
                             assert!(b.iter().any(|b| b.buf == Buf::Mass));
                             checked += 1;
+                            // The per-bin variant, where it applies.
+                            if matches!(
+                                shape,
+                                ShapeKind::Linear | ShapeKind::Bspline2 | ShapeKind::Bspline3
+                            ) && !perturbed
+                            {
+                                let v = Variant { patch: true, ..v };
+                                let src = expand(Pass::StressForcesPatch, &v.defines()).unwrap();
+                                let m = validate(&src, "stress.wgsl", atomics)
+                                    .unwrap_or_else(|e| panic!("{v:?}: {e}"));
+                                assert!(bindings(&m).iter().any(|b| b.buf == Buf::CellOrder));
+                                patched += 1;
+                            }
                         }
                     }
                 }
             }
         }
         assert_eq!(checked, 120);
+        assert_eq!(patched, 36);
     }
 }

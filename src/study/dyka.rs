@@ -60,7 +60,11 @@ pub fn job(backend: BackendChoice, h: f64, method: usize, integrator: &str) -> J
     // them at y = 0.5 mm, for h = 1 mm): the paper's point A, the
     // impactor's free end, and the middle.
     .set(format!("output.probes.free_end=[0.0, {}]", h / 2.0))
-    .set(format!("output.probes.middle=[{}, {}]", DYKA_L / 2.0, h / 2.0))
+    .set(format!(
+        "output.probes.middle=[{}, {}]",
+        DYKA_L / 2.0,
+        h / 2.0
+    ))
     .set(format!("solver.shape={shape}"))
     .set(format!("solver.integrator={integrator}"))
     .tag("backend", backend_slug(backend))

@@ -47,16 +47,129 @@ pub fn greville(i: usize, n: usize, p: usize) -> f64 {
 /// Away from the grid's edge every knot the span touches (t_{s−p} to
 /// t_{s+p+1}) is uniform and the bases are the cardinal B-splines centred
 /// on their nodes, evaluated in closed form (`uniform_basis`); within 2p
-/// cells of the edge the open-knot recursion (`open_basis`) runs. Both give
-/// the same functions (equal to round-off, tested below).
+/// cells of the edge the fixed edge polynomials (`table_basis`, on grids of
+/// at least `3p + 1` nodes per direction) or, on smaller grids, the
+/// open-knot recursion (`open_basis`). All give the same functions (equal
+/// to round-off, tested below).
 #[inline]
 pub fn basis(u: f64, n: usize, p: usize) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
     let s = span(u, n, p);
     if s > 2 * p && s + p + 2 <= n {
         uniform_basis(u, s, p)
+    } else if table_fits(n, p) {
+        table_basis(u, s, n, p)
     } else {
         open_basis(u, s, n, p)
     }
+}
+
+/// Whether `table_basis` holds on a grid of `n` nodes: the left edge's
+/// spans (s < 2p) must not reach the right edge's knots (s + p + 1 < n).
+#[inline]
+pub fn table_fits(n: usize, p: usize) -> bool {
+    n > 3 * p
+}
+
+/// The nonzero bases of every span as polynomials in c = u − s + p/2 (the
+/// span's centre at c = 0 in the interior): `BSPLINE{2,3}_TABLE[row][k][r]`
+/// is the coefficient of c^k of basis first + r. Rows 0..p are the left
+/// edge's spans s = p..2p − 1 (open knots: the cardinal B-splines cut by
+/// the clamped knots), row p is every interior span (the cardinal
+/// B-splines); the right edge is the left one mirrored (N_i(u) =
+/// N_{n−1−i}(n − 1 − u)). Derived from the Cox-de Boor recursion in exact
+/// rationals; the WGSL twin (`bs_basis`) holds the same numbers.
+const BSPLINE2_TABLE: [[[f64; 3]; 3]; 3] = [
+    // s = 2: knots 0, 0, 0, 3/2, 5/2, 7/2
+    [
+        [1.0 / 9.0, 28.0 / 45.0, 4.0 / 15.0],
+        [-4.0 / 9.0, -4.0 / 45.0, 8.0 / 15.0],
+        [4.0 / 9.0, -32.0 / 45.0, 4.0 / 15.0],
+    ],
+    // s = 3: knots 0, 0, 3/2, 5/2, 7/2, 9/2
+    [
+        [1.0 / 10.0, 31.0 / 40.0, 1.0 / 8.0],
+        [-2.0 / 5.0, -1.0 / 10.0, 1.0 / 2.0],
+        [2.0 / 5.0, -9.0 / 10.0, 1.0 / 2.0],
+    ],
+    // interior
+    [
+        [1.0 / 8.0, 3.0 / 4.0, 1.0 / 8.0],
+        [-1.0 / 2.0, 0.0, 1.0 / 2.0],
+        [1.0 / 2.0, -1.0, 1.0 / 2.0],
+    ],
+];
+
+const BSPLINE3_TABLE: [[[f64; 4]; 4]; 4] = [
+    // s = 3: knots 0, 0, 0, 0, 2, 3, 4, 5
+    [
+        [1.0 / 64.0, 21.0 / 64.0, 33.0 / 64.0, 9.0 / 64.0],
+        [-3.0 / 32.0, -15.0 / 32.0, 9.0 / 32.0, 9.0 / 32.0],
+        [3.0 / 16.0, -1.0 / 16.0, -5.0 / 16.0, 3.0 / 16.0],
+        [-1.0 / 8.0, 19.0 / 72.0, -13.0 / 72.0, 1.0 / 24.0],
+    ],
+    // s = 4: knots 0, 0, 0, 2, 3, 4, 5, 6
+    [
+        [1.0 / 72.0, 211.0 / 576.0, 115.0 / 192.0, 1.0 / 48.0],
+        [-1.0 / 12.0, -49.0 / 96.0, 15.0 / 32.0, 1.0 / 8.0],
+        [1.0 / 6.0, -5.0 / 48.0, -5.0 / 16.0, 1.0 / 4.0],
+        [-1.0 / 9.0, 23.0 / 72.0, -3.0 / 8.0, 1.0 / 6.0],
+    ],
+    // s = 5: knots 0, 0, 2, 3, 4, 5, 6, 7
+    [
+        [1.0 / 64.0, 31.0 / 64.0, 23.0 / 48.0, 1.0 / 48.0],
+        [-3.0 / 32.0, -21.0 / 32.0, 5.0 / 8.0, 1.0 / 8.0],
+        [3.0 / 16.0, -3.0 / 16.0, -1.0 / 4.0, 1.0 / 4.0],
+        [-1.0 / 8.0, 11.0 / 24.0, -1.0 / 2.0, 1.0 / 6.0],
+    ],
+    // interior
+    [
+        [1.0 / 48.0, 23.0 / 48.0, 23.0 / 48.0, 1.0 / 48.0],
+        [-1.0 / 8.0, -5.0 / 8.0, 5.0 / 8.0, 1.0 / 8.0],
+        [1.0 / 4.0, -1.0 / 4.0, -1.0 / 4.0, 1.0 / 4.0],
+        [-1.0 / 6.0, 1.0 / 2.0, -1.0 / 2.0, 1.0 / 6.0],
+    ],
+];
+
+/// Any span `s` (valid where `table_fits`) from the tables above: a span
+/// of the right edge is evaluated as its mirror on the left (reversed
+/// bases, negated derivatives). No recursion and no data-dependent loop:
+/// the WGSL twin runs it in every lane with selects.
+#[inline]
+pub fn table_basis(
+    u: f64,
+    s: usize,
+    n: usize,
+    p: usize,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    let right = s + p >= n;
+    let (um, sm) = if right {
+        ((n - 1) as f64 - u, n + p - 1 - s)
+    } else {
+        (u, s)
+    };
+    let c = um - sm as f64 + 0.5 * p as f64;
+    let row = (sm - p).min(p);
+    let mut nb = [0.0; MAX_DEGREE + 1];
+    let mut dn = [0.0; MAX_DEGREE + 1];
+    for r in 0..=p {
+        // Horner in c for the value and its derivative.
+        let coef = |k: usize| {
+            if p == 2 {
+                BSPLINE2_TABLE[row][k][r]
+            } else {
+                BSPLINE3_TABLE[row][k][r]
+            }
+        };
+        let (mut v, mut d) = (coef(p), 0.0);
+        for k in (0..p).rev() {
+            d = d * c + v;
+            v = v * c + coef(k);
+        }
+        let r_out = if right { p - r } else { r };
+        nb[r_out] = v;
+        dn[r_out] = if right { -d } else { d };
+    }
+    (s - p, nb, dn)
 }
 
 /// Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
@@ -240,6 +353,43 @@ mod tests {
                 interior > 200,
                 "p {p}: the closed form ran {interior} times"
             );
+        }
+    }
+
+    #[test]
+    fn edge_tables_match_the_open_knot_recursion_on_every_span() {
+        for p in [2, 3] {
+            for n in [3 * p + 1, 3 * p + 2, 16, 41] {
+                assert!(table_fits(n, p));
+                let mut u = 0.0;
+                let mut spans = std::collections::BTreeSet::new();
+                while u <= (n - 1) as f64 {
+                    let s = span(u, n, p);
+                    spans.insert(s);
+                    let (f0, n0, d0) = open_basis(u, s, n, p);
+                    let (f1, n1, d1) = table_basis(u, s, n, p);
+                    let (f2, n2, d2) = basis(u, n, p);
+                    assert_eq!(f0, f1);
+                    assert_eq!(f0, f2);
+                    for r in 0..=p {
+                        for (a, b) in [
+                            (n0[r], n1[r]),
+                            (d0[r], d1[r]),
+                            (n0[r], n2[r]),
+                            (d0[r], d2[r]),
+                        ] {
+                            assert!((a - b).abs() < 1e-14, "p {p} n {n} u {u} r {r}: {a} vs {b}");
+                        }
+                    }
+                    u += 0.0137;
+                }
+                // Both ends included, and every span visited.
+                let (_, n1, d1) = table_basis((n - 1) as f64, n - 1, n, p);
+                assert_eq!(n1[p], 1.0);
+                assert!(d1[p] > 0.0);
+                assert_eq!(spans.len(), n - p, "p {p} n {n}");
+            }
+            assert!(!table_fits(3 * p, p));
         }
     }
 
