@@ -21,7 +21,7 @@ pub use walls::{Wall, Walls};
 use crate::error::SceneError;
 use crate::model::material::Material;
 use crate::model::shape::Shape;
-use crate::scene::{Fix, IntegratorKind, NpcPosition, Scene, seed};
+use crate::scene::{Fix, ImplicitMass, IntegratorKind, NpcPosition, Scene, seed};
 
 /// Nodes lighter than this (kg) count as empty. Relative to the lightest
 /// particle: 1e-9 keeps LME tail nodes (N ≳ 1e-6) and drops only round-off.
@@ -96,6 +96,8 @@ pub struct ImplicitSettings {
     pub max_iter: u32,
     /// Halvings of Δt allowed for a step before the run is unstable.
     pub max_cuts: u32,
+    /// Lumped instead of consistent mass.
+    pub lumped_mass: bool,
 }
 
 impl Integrator {
@@ -195,6 +197,7 @@ impl Model {
                 tol: f.solver.newton_tol,
                 max_iter: f.solver.newton_max_iter,
                 max_cuts: f.solver.newton_max_cuts,
+                lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
             }),
         };
         let particles = Particles::from_seeds(

@@ -10,19 +10,21 @@
 //!   f_int,I = Σ_p V_p P ∇N_I,
 //!   f_ext,I = Σ_p m_p N_I b_p,
 //!   (M a)_I = Σ_p m_p N_I Σ_K N_K a_K   (consistent mass, eq. 35),
+//!        or Σ_p m_p N_I a_I             (lumped, `solver.implicit_mass`),
 //!   R = f_ext − f_int − M a + f_contact,
 //! and the Jacobian K = −∂R/∂Δu:
-//!   K_IK = Σ_p V_p ∇N_I · A · ∇N_K + Σ_p m_p N_I N_K / (β Δt²) + K_contact,
+//!   K_IK = Σ_p V_p ∇N_I · A · ∇N_K + M_IK / (β Δt²) + K_contact,
 //! with A = ∂P/∂ΔF. Pulled back to the step's start this is exactly the
 //! paper's spatial geometric + material stiffness (eqs. 32–34): the same
-//! linearisation written in the other configuration.
+//! linearisation written in the other configuration. Wall contact forces
+//! and their stiffness are `contact`'s, per contact state.
 
+use super::contact::{self, ContactPair, ContactState};
 use crate::cpu::ShapeCache;
 use crate::model::Model;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::Material;
 use crate::model::material::increment::{StepState, mul};
-use crate::model::walls::{CONTACT_FRICTION, Wall};
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::solvers::SymbolicLu;
 use rayon::prelude::*;
@@ -208,19 +210,23 @@ pub struct StepInputs<'a> {
     pub a: &'a [[f64; 2]],
     pub newmark: Newmark,
     pub dofs: &'a Dofs,
+    /// Wall contact penalty k (N/m per metre of thickness).
     pub penalty: f64,
+    /// The nodes behind `slip` and `friction` walls that are unknowns.
+    pub pairs: &'a [ContactPair],
+    /// Lumped mass, M_II = Σ_p m_p N_I, instead of the consistent one.
+    pub lumped_mass: bool,
 }
 
-/// Nodal residual at the iterate `du` (N per metre of thickness), every
-/// node and component, fixed ones included (their residual is minus the
-/// support's reaction), with the particle iterates it used. `wall_force`
-/// receives each wall's contact force on the material.
+/// Nodal residual of the particles at the iterate `du` (N per metre of
+/// thickness), every node and component, fixed ones included (their
+/// residual is minus the support's reaction), with the particle iterates it
+/// used; wall contact is added by `add_contact`.
 pub fn residual(
     inp: &StepInputs,
     du: &[[f64; 2]],
     iterates: &mut [ParticleIterate],
     r: &mut [[f64; 2]],
-    wall_force: &mut [[f64; 2]],
 ) -> Result<(), Fault> {
     let nn = du.len();
     // Particle updates first (they may fault), then one scatter.
@@ -249,14 +255,15 @@ pub fn residual(
         .enumerate()
         .fold(
             || vec![[0.0; 2]; nn],
-            |mut acc, (c, its)| {
+            |mut sum, (c, its)| {
                 for (k, it) in its.iter().enumerate() {
                     let p = c * chunk + k;
                     let (nodes, w) = inp.cache.particle(p);
                     let (m, vol) = (inp.model.particles.mass[p], inp.volume[p]);
-                    // Particle acceleration at the step's end (eq. 47).
+                    // Particle acceleration at the step's end (eq. 47),
+                    // for the consistent mass.
                     let mut ap = [0.0; 2];
-                    if !nw.is_static {
+                    if !nw.is_static && !inp.lumped_mass {
                         for (&n, wk) in nodes.iter().zip(w) {
                             let n = n as usize;
                             let an = nw.accel(du[n], inp.v[n], inp.a[n]);
@@ -266,14 +273,21 @@ pub fn residual(
                     }
                     let b = inp.body[p];
                     for (&n, wk) in nodes.iter().zip(w) {
-                        let f = &mut acc[n as usize];
+                        let n = n as usize;
+                        // Lumped: the node's own acceleration.
+                        let acc = if inp.lumped_mass {
+                            nw.accel(du[n], inp.v[n], inp.a[n])
+                        } else {
+                            ap
+                        };
+                        let f = &mut sum[n];
                         for i in 0..2 {
                             let internal = vol * (it.p[2 * i] * wk[1] + it.p[2 * i + 1] * wk[2]);
-                            f[i] += wk[0] * m * (b[i] - ap[i]) - internal;
+                            f[i] += wk[0] * m * (b[i] - acc[i]) - internal;
                         }
                     }
                 }
-                acc
+                sum
             },
         )
         .reduce_with(|mut a, b| {
@@ -285,76 +299,45 @@ pub fn residual(
         })
         .unwrap_or_else(|| vec![[0.0; 2]; nn]);
     r.copy_from_slice(&partial);
-    for f in wall_force.iter_mut() {
-        *f = [0.0; 2];
-    }
-    if !inp.model.walls.list.is_empty() {
-        for (n, &mask) in inp.model.walls.mask.iter().enumerate() {
-            if mask == 0 || inp.dofs.id[n] == NO_DOF {
-                continue;
-            }
-            for (k, wall) in inp.model.walls.list.iter().enumerate() {
-                if mask & (1 << k) != 0 {
-                    let (f, _) = contact(wall, du[n], inp.penalty);
-                    r[n][0] += f[0];
-                    r[n][1] += f[1];
-                    wall_force[k][0] += f[0];
-                    wall_force[k][1] += f[1];
-                }
-            }
-        }
-    }
     Ok(())
 }
 
-/// A wall's penalty force on a node displaced by `du` into it, and the
-/// force's derivative −∂f/∂Δu (2 × 2, row-major). The node is in contact
-/// when Δu·n ≤ 0 (it moves further behind the line): the normal force is
-/// −k (Δu·n) n; ``friction` adds Coulomb's law on the tangential
-/// displacement (stick −k Δu_t up to μ |f_n|, then μ |f_n| against the
-/// slip), `slip` nothing. Stick walls are fixed components instead.
-pub fn contact(wall: &Wall, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
-    let n = wall.normal;
-    let g = du[0] * n[0] + du[1] * n[1];
-    // g = 0 counts as contact (zero force, full stiffness): a node resting
-    // on the wall starts each step in the active set, so Newton does not
-    // chatter between free fall and the penalty's push-back.
-    if g > 0.0 {
-        return ([0.0; 2], [0.0; 4]);
+/// Adds the walls' contact forces at `du` to `r`, each pair under its
+/// `states` entry, or under Coulomb's law itself when `states` is None;
+/// `wall_force`, when given, receives each wall's force on the material.
+pub fn add_contact(
+    inp: &StepInputs,
+    du: &[[f64; 2]],
+    states: Option<&[ContactState]>,
+    r: &mut [[f64; 2]],
+    mut wall_force: Option<&mut [[f64; 2]]>,
+) {
+    if let Some(wf) = wall_force.as_deref_mut() {
+        wf.fill([0.0; 2]);
     }
-    let fnorm = -k * g;
-    let mut f = [fnorm * n[0], fnorm * n[1]];
-    let mut kt = [
-        k * n[0] * n[0],
-        k * n[0] * n[1],
-        k * n[1] * n[0],
-        k * n[1] * n[1],
-    ];
-    if wall.contact == CONTACT_FRICTION {
-        let t = [-n[1], n[0]];
-        let s = du[0] * t[0] + du[1] * t[1];
-        let stick = k * s.abs() <= wall.mu * fnorm;
-        if stick {
-            f[0] -= k * s * t[0];
-            f[1] -= k * s * t[1];
-            for a in 0..2 {
-                for b in 0..2 {
-                    kt[2 * a + b] += k * t[a] * t[b];
-                }
-            }
-        } else {
-            // f_t = −μ k |g| sign(s) t = μ k g sign(s) t.
-            let sg = s.signum();
-            f[0] += wall.mu * k * g * sg * t[0];
-            f[1] += wall.mu * k * g * sg * t[1];
-            for a in 0..2 {
-                for b in 0..2 {
-                    kt[2 * a + b] -= wall.mu * k * sg * t[a] * n[b];
-                }
-            }
+    let walls = &inp.model.walls.list;
+    for (i, pair) in inp.pairs.iter().enumerate() {
+        let (n, k) = (pair.node as usize, pair.wall as usize);
+        let state = states.map_or_else(|| contact::natural_state(&walls[k], du[n]), |s| s[i]);
+        let (f, _) = contact::force(&walls[k], du[n], inp.penalty, state);
+        r[n][0] += f[0];
+        r[n][1] += f[1];
+        if let Some(wf) = wall_force.as_deref_mut() {
+            wf[k][0] += f[0];
+            wf[k][1] += f[1];
         }
     }
-    (f, kt)
+}
+
+/// Each pair's state under Coulomb's law at `du`.
+pub fn natural_states(inp: &StepInputs, du: &[[f64; 2]], states: &mut Vec<ContactState>) {
+    let walls = &inp.model.walls.list;
+    states.clear();
+    states.extend(
+        inp.pairs
+            .iter()
+            .map(|p| contact::natural_state(&walls[p.wall as usize], du[p.node as usize])),
+    );
 }
 
 /// The Jacobian's sparsity for one step, in compressed columns: node b's
@@ -371,8 +354,16 @@ pub struct Pattern {
 }
 
 impl Pattern {
-    /// Fails only when faer cannot build the structure (out of memory).
-    pub fn new(cache: &ShapeCache, dofs: &Dofs, particles: usize) -> Result<Pattern, Fault> {
+    /// The structure of this step's Jacobian; `previous`, the last step's,
+    /// is kept (with its symbolic LU, the dearer part) when the couplings
+    /// are the same. Fails only when faer cannot build the structure (out
+    /// of memory).
+    pub fn new(
+        cache: &ShapeCache,
+        dofs: &Dofs,
+        particles: usize,
+        previous: Option<Pattern>,
+    ) -> Result<Pattern, Fault> {
         let fail = |_| Fault {
             particle: None,
             kind: FaultKind::NonFinite {
@@ -403,6 +394,11 @@ impl Pattern {
             adj_start[b + 1] += adj_start[b];
         }
         let adj: Vec<u32> = pairs.iter().map(|&pr| pr as u32).collect();
+        if let Some(prev) = previous {
+            if prev.adj_start == adj_start && prev.adj == adj {
+                return Ok(prev);
+            }
+        }
         let mut col_ptr = Vec::with_capacity(2 * n + 1);
         let mut row_idx = Vec::with_capacity(4 * adj.len());
         for b in 0..n {
@@ -440,20 +436,76 @@ impl Pattern {
     }
 }
 
+/// Per active node: the particles whose support holds it, each with the
+/// node's position in the particle's list (`ShapeCache::particle`).
+#[derive(Debug, Clone, Default)]
+pub struct Incidence {
+    start: Vec<usize>,
+    entries: Vec<(u32, u32)>,
+}
+
+impl Incidence {
+    pub fn new(cache: &ShapeCache, dofs: &Dofs, particles: usize) -> Incidence {
+        let mut start = vec![0usize; dofs.active + 1];
+        for p in 0..particles {
+            for &n in cache.particle(p).0 {
+                let id = dofs.id[n as usize];
+                if id != NO_DOF {
+                    start[id as usize + 1] += 1;
+                }
+            }
+        }
+        for b in 0..dofs.active {
+            start[b + 1] += start[b];
+        }
+        let mut next = start.clone();
+        let mut entries = vec![(0, 0); start[dofs.active]];
+        for p in 0..particles {
+            for (k, &n) in cache.particle(p).0.iter().enumerate() {
+                let id = dofs.id[n as usize];
+                if id != NO_DOF {
+                    entries[next[id as usize]] = (p as u32, k as u32);
+                    next[id as usize] += 1;
+                }
+            }
+        }
+        Incidence { start, entries }
+    }
+
+    /// (particle, position of the node in its list) for active node `id`.
+    #[inline]
+    pub fn of(&self, id: usize) -> &[(u32, u32)] {
+        &self.entries[self.start[id]..self.start[id + 1]]
+    }
+}
+
 /// Fills `values` (the `Pattern`'s slots) with the Jacobian at `du`:
-/// particles' stiffness and inertia, walls' contact stiffness, and the
-/// identity on held components.
+/// particles' stiffness and inertia, walls' contact stiffness (each pair
+/// under its `states` entry), and the identity on held components.
 pub fn jacobian(
     inp: &StepInputs,
     pattern: &Pattern,
     du: &[[f64; 2]],
+    incidence: &Incidence,
     iterates: &[ParticleIterate],
+    states: &[ContactState],
     values: &mut Vec<f64>,
 ) -> Result<(), Fault> {
     values.clear();
     values.resize(pattern.nnz, 0.0);
     let inertia = inp.newmark.accel_slope();
-    // A = ∂P/∂ΔF per particle, in parallel; then one ordered scatter.
+    // N_I N_K (consistent) or N_I on the diagonal (lumped).
+    let lumped = inp.lumped_mass;
+    let mass_weight = |na: f64, nb: f64, same: bool| {
+        if !lumped {
+            na * nb
+        } else if same {
+            na
+        } else {
+            0.0
+        }
+    };
+    // A = ∂P/∂ΔF per particle, in parallel; then the columns in parallel.
     let tangents: Result<Vec<[[f64; 4]; 4]>, Fault> = iterates
         .par_iter()
         .enumerate()
@@ -464,53 +516,66 @@ pub fn jacobian(
         .collect();
     let tangents = tangents?;
     let dofs = inp.dofs;
-    for (p, a) in tangents.iter().enumerate() {
-        let (nodes, w) = inp.cache.particle(p);
-        let (m, vol) = (inp.model.particles.mass[p], inp.volume[p]);
-        for (&nb, wb) in nodes.iter().zip(w) {
-            let ib = dofs.id[nb as usize];
-            if ib == NO_DOF {
-                continue;
-            }
-            for (&na, wa) in nodes.iter().zip(w) {
-                let ia = dofs.id[na as usize];
-                if ia == NO_DOF {
-                    continue;
-                }
-                let base = pattern.slot(ia, ib, 0, 0);
-                let col_len = pattern.slot(ia, ib, 0, 1) - base;
-                for k in 0..2 {
-                    for i in 0..2 {
-                        let mut v = 0.0;
-                        for big_j in 0..2 {
-                            let ga = wa[1 + big_j];
-                            v += ga
-                                * (a[2 * i + big_j][2 * k] * wb[1]
-                                    + a[2 * i + big_j][2 * k + 1] * wb[2]);
-                        }
-                        v *= vol;
-                        if i == k {
-                            v += m * wa[0] * wb[0] * inertia;
-                        }
-                        values[base + k * col_len + i] += v;
-                    }
-                }
-            }
-        }
+    // Node b's two columns are one run of `values`; each is summed over
+    // the particles that touch b, in particle order (so the sum does not
+    // depend on the threads).
+    let mut columns: Vec<&mut [f64]> = Vec::with_capacity(dofs.active);
+    let mut rest = values.as_mut_slice();
+    for b in 0..dofs.active {
+        let len = 4 * (pattern.adj_start[b + 1] - pattern.adj_start[b]);
+        let (col, r) = rest.split_at_mut(len);
+        columns.push(col);
+        rest = r;
     }
-    for (n, &mask) in inp.model.walls.mask.iter().enumerate() {
-        let id = dofs.id.get(n).copied().unwrap_or(NO_DOF);
-        if mask == 0 || id == NO_DOF {
-            continue;
-        }
-        for (k, wall) in inp.model.walls.list.iter().enumerate() {
-            if mask & (1 << k) != 0 {
-                let (_, dk) = contact(wall, du[n], inp.penalty);
-                for i in 0..2 {
-                    for c in 0..2 {
-                        values[pattern.slot(id, id, i, c)] += dk[2 * i + c];
+    columns
+        .into_par_iter()
+        .enumerate()
+        .with_min_len(16)
+        .for_each(|(ib, col)| {
+            let list = &pattern.adj[pattern.adj_start[ib]..pattern.adj_start[ib + 1]];
+            let col_len = 2 * list.len();
+            for &(p, kb) in incidence.of(ib) {
+                let p = p as usize;
+                let a = &tangents[p];
+                let (nodes, w) = inp.cache.particle(p);
+                let wb = w[kb as usize];
+                let (m, vol) = (inp.model.particles.mass[p], inp.volume[p]);
+                // A ∇N_b, per (i, J) and k.
+                let mut ab = [[0.0; 2]; 4];
+                for (row, abr) in a.iter().zip(ab.iter_mut()) {
+                    for (k, v) in abr.iter_mut().enumerate() {
+                        *v = row[2 * k] * wb[1] + row[2 * k + 1] * wb[2];
                     }
                 }
+                for (&na, wa) in nodes.iter().zip(w) {
+                    let ia = dofs.id[na as usize];
+                    if ia == NO_DOF {
+                        continue;
+                    }
+                    let j = list
+                        .binary_search(&ia)
+                        .expect("every coupled pair is in the pattern");
+                    let inertia_ab = m * inertia * mass_weight(wa[0], wb[0], ia as usize == ib);
+                    for k in 0..2 {
+                        for i in 0..2 {
+                            let mut v = vol * (wa[1] * ab[2 * i][k] + wa[2] * ab[2 * i + 1][k]);
+                            if i == k {
+                                v += inertia_ab;
+                            }
+                            col[k * col_len + 2 * j + i] += v;
+                        }
+                    }
+                }
+            }
+        });
+    let walls = &inp.model.walls.list;
+    for (pair, &state) in inp.pairs.iter().zip(states) {
+        let n = pair.node as usize;
+        let id = dofs.id[n];
+        let (_, dk) = contact::force(&walls[pair.wall as usize], du[n], inp.penalty, state);
+        for i in 0..2 {
+            for c in 0..2 {
+                values[pattern.slot(id, id, i, c)] += dk[2 * i + c];
             }
         }
     }

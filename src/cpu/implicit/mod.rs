@@ -8,7 +8,9 @@
 //! 2. UL-FEM phase: Newton on R(Δu) = 0 (`assemble`), the grid moving with
 //!    the iterate, the sparse Jacobian factorised by faer's sparse LU;
 //!    converged when the residual norm over the step's reference and the
-//!    correction norm over Δu are both below `solver.newton_tol`.
+//!    mass-weighted correction norm over Δu's are both below
+//!    `solver.newton_tol` (the latter its square root). Wall contacts
+//!    (`contact`) hold their state after the first iterations (`attempt`).
 //! 3. Convective phase: particles take the converged grid solution
 //!    (eqs. 46–49): x += Σ N Δu, a = Σ N a_I, v += Δt((1 − γ) a_n + γ a);
 //!    stress, F and plastic state are those of the converged iterate; the
@@ -22,6 +24,7 @@
 //! over `load_steps` steps of pseudo-time.
 
 pub mod assemble;
+pub mod contact;
 
 use crate::backend::{Backend, Halt, NewtonSample, NewtonStats, Sample, State, stop_requested};
 use crate::cpu::{ShapeCache, shape_eval};
@@ -30,7 +33,8 @@ use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::increment::StepState;
 use crate::model::walls::CONTACT_STICK;
 use crate::model::{FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
-use assemble::{Dofs, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
+use assemble::{Dofs, Incidence, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
+use contact::{ContactPair, ContactState};
 use faer::prelude::*;
 use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::solvers::Lu;
@@ -40,6 +44,23 @@ use std::time::Instant;
 /// A residual norm above this many times the step's reference is a
 /// diverging Newton: the step is cut at once rather than iterated further.
 const DIVERGED_RATIO: f64 = 1e8;
+
+/// Newton iterations whose contact states follow the iterate before they
+/// are held (`ImplicitBackend::attempt`).
+const FREE_CONTACT_ITERATIONS: u32 = 2;
+
+/// `ImplicitBackend::jacobian_mismatch`'s answer.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct JacobianCheck {
+    /// Largest |K_ij − (−∂R_i/∂Δu_j)_FD| over the largest |K_ij| of its
+    /// column, or 1 / `PENALTY_REL` of the largest of all if more (so the
+    /// contact penalty's columns do not hide the material's).
+    pub mismatch: f64,
+    /// Wall contacts open, sticking and slipping at the Δu checked.
+    pub open: usize,
+    pub stick: usize,
+    pub slip: usize,
+}
 
 /// Why one attempt at a step failed.
 enum AttemptFail {
@@ -58,9 +79,12 @@ pub struct ImplicitBackend {
     node_mass: Vec<f64>,
     node_v: Vec<[f64; 2]>,
     node_a: Vec<[f64; 2]>,
-    /// The iterate Δu and the residual, per node.
+    /// The iterate Δu and the residual, per node: the particles' part,
+    /// with Coulomb's law, and with the held contact states.
     du: Vec<[f64; 2]>,
+    r_body: Vec<[f64; 2]>,
     r: Vec<[f64; 2]>,
+    r_held: Vec<[f64; 2]>,
     iterates: Vec<ParticleIterate>,
     start: Vec<StepState>,
     volume: Vec<f64>,
@@ -69,6 +93,13 @@ pub struct ImplicitBackend {
     /// The step's unknowns and the Jacobian's structure (built once per step).
     dofs: Dofs,
     pattern: Option<Pattern>,
+    incidence: Incidence,
+    /// The step's wall contacts, their held and their natural states.
+    pairs: Vec<ContactPair>,
+    held: Vec<ContactState>,
+    natural: Vec<ContactState>,
+    /// Per node and wall: the contact state of the last converged step.
+    node_states: Vec<ContactState>,
     /// Per constraint group then per wall: reaction of the last step (N/m).
     reactions: Vec<[f64; 2]>,
     wall_force: Vec<[f64; 2]>,
@@ -117,7 +148,9 @@ impl ImplicitBackend {
             node_v: vec![[0.0; 2]; nodes],
             node_a: vec![[0.0; 2]; nodes],
             du: vec![[0.0; 2]; nodes],
+            r_body: vec![[0.0; 2]; nodes],
             r: vec![[0.0; 2]; nodes],
+            r_held: vec![[0.0; 2]; nodes],
             iterates: vec![blank; n],
             start: vec![blank.state; n],
             volume: vec![0.0; n],
@@ -125,6 +158,11 @@ impl ImplicitBackend {
             values: Vec::new(),
             dofs: Dofs::default(),
             pattern: None,
+            incidence: Incidence::default(),
+            pairs: Vec::new(),
+            held: Vec::new(),
+            natural: Vec::new(),
+            node_states: vec![ContactState::Stick; nodes * model.walls.list.len()],
             reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
             wall_force: vec![[0.0; 2]; model.walls.list.len()],
             mass_eps: crate::model::MASS_EPS_REL * min_mass,
@@ -261,9 +299,37 @@ impl ImplicitBackend {
         self.dofs = self.build_dofs();
         let mapped = Instant::now();
         self.stats.seconds.map += (mapped - clock).as_secs_f64();
-        self.pattern = Some(Pattern::new(&self.cache, &self.dofs, n)?);
+        self.pairs = self.build_pairs();
+        self.incidence = Incidence::new(&self.cache, &self.dofs, n);
+        self.pattern = Some(Pattern::new(
+            &self.cache,
+            &self.dofs,
+            n,
+            self.pattern.take(),
+        )?);
         self.stats.seconds.symbolic += mapped.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// The step's wall contacts: every unknown node behind a `slip` or
+    /// `friction` wall (stick walls hold theirs instead).
+    fn build_pairs(&self) -> Vec<ContactPair> {
+        let walls = &self.model.walls;
+        let mut pairs = Vec::new();
+        for (n, &mask) in walls.mask.iter().enumerate() {
+            if mask == 0 || self.dofs.id[n] == NO_DOF {
+                continue;
+            }
+            for (k, w) in walls.list.iter().enumerate() {
+                if mask & (1 << k) != 0 && w.contact != CONTACT_STICK {
+                    pairs.push(ContactPair {
+                        node: n as u32,
+                        wall: k as u32,
+                    });
+                }
+            }
+        }
+        pairs
     }
 
     /// The step's unknowns: nodes with mass, their held components
@@ -338,6 +404,16 @@ impl ImplicitBackend {
 
     /// Newton on one step of `dt`; on success the converged iterate is in
     /// `du` and `iterates`, and `dt` is the step's.
+    ///
+    /// Wall contact is piecewise smooth (open, stick, slip), and Newton
+    /// across its kinks can cycle: a light node behind the wall flips its
+    /// slip direction, or opens and closes, at every iterate. So the
+    /// contact states follow the iterate for the first
+    /// `FREE_CONTACT_ITERATIONS` iterations only, then are held: Newton
+    /// solves the smooth problem of the held states, and when that is
+    /// solved (residual at most `newton_tol`) but Coulomb's law is not, the
+    /// held states are revised (`contact::revise`) and Newton goes on.
+    /// Convergence is always judged on Coulomb's law itself.
     fn attempt(&mut self, dt: f64) -> std::result::Result<(), AttemptFail> {
         self.fill_body(dt);
         self.predict(dt);
@@ -358,6 +434,8 @@ impl ImplicitBackend {
             newmark,
             dofs,
             penalty: self.penalty,
+            pairs: &self.pairs,
+            lumped_mass: self.settings.lumped_mass,
         };
         // The load's own size, |Σ_p N m_p b_p| over the free components.
         let mut fext = vec![[0.0f64; 2]; self.du.len()];
@@ -388,32 +466,45 @@ impl ImplicitBackend {
         let mut last_correction = f64::INFINITY;
         let tol = self.settings.tol;
         let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
+        let walls = m.walls.list.len();
+        let slot = |p: &ContactPair| p.node as usize * walls + p.wall as usize;
         for iter in 0..=self.settings.max_iter {
             let clock = Instant::now();
-            let res = assemble::residual(
-                &inp,
-                &self.du,
-                &mut self.iterates,
-                &mut self.r,
-                &mut self.wall_force,
-            );
+            let res = assemble::residual(&inp, &self.du, &mut self.iterates, &mut self.r_body);
             self.stats.seconds.residual += clock.elapsed().as_secs_f64();
             res.map_err(AttemptFail::Particle)?;
+            let clock = Instant::now();
+            self.r.copy_from_slice(&self.r_body);
+            assemble::add_contact(
+                &inp,
+                &self.du,
+                None,
+                &mut self.r,
+                Some(&mut self.wall_force),
+            );
+            assemble::natural_states(&inp, &self.du, &mut self.natural);
+            self.stats.seconds.residual += clock.elapsed().as_secs_f64();
             let norm = free_norm(&self.r);
             if iter == 0 {
                 reference = norm.max(load_norm);
             }
-            let ratio = if reference > 0.0 {
-                norm / reference
-            } else {
-                0.0
+            let rel = |norm: f64| {
+                if reference > 0.0 {
+                    norm / reference
+                } else {
+                    0.0
+                }
             };
+            let ratio = rel(norm);
             residuals.push(ratio);
             if !ratio.is_finite() || ratio > DIVERGED_RATIO {
                 return Err(AttemptFail::Newton(ratio));
             }
             let converged = ratio <= tol && (iter == 0 || last_correction <= tol.sqrt());
             if converged || dofs.active == 0 {
+                for (p, &st) in self.pairs.iter().zip(&self.natural) {
+                    self.node_states[slot(p)] = st;
+                }
                 self.dt = dt;
                 self.stats.steps += 1;
                 self.stats.iterations += iter as u64;
@@ -426,8 +517,33 @@ impl ImplicitBackend {
             if iter == self.settings.max_iter {
                 return Err(AttemptFail::Newton(ratio));
             }
+            // The contact states this iteration's Newton step assumes: the
+            // last step's first (Δu = 0 says nothing), then the iterate's,
+            // then held, and revised once their own problem is solved.
+            if iter == 0 {
+                self.held.clear();
+                self.held
+                    .extend(self.pairs.iter().map(|p| self.node_states[slot(p)]));
+            } else if iter < FREE_CONTACT_ITERATIONS {
+                self.held.clone_from(&self.natural);
+            }
+            held_residual(&inp, &self.du, &self.held, &self.r_body, &mut self.r_held);
+            if iter >= FREE_CONTACT_ITERATIONS && rel(free_norm(&self.r_held)) <= tol {
+                for (h, &n) in self.held.iter_mut().zip(&self.natural) {
+                    *h = contact::revise(*h, n);
+                }
+                held_residual(&inp, &self.du, &self.held, &self.r_body, &mut self.r_held);
+            }
             let clock = Instant::now();
-            let jac = assemble::jacobian(&inp, pattern, &self.du, &self.iterates, &mut self.values);
+            let jac = assemble::jacobian(
+                &inp,
+                pattern,
+                &self.du,
+                &self.incidence,
+                &self.iterates,
+                &self.held,
+                &mut self.values,
+            );
             let assembled = Instant::now();
             self.stats.seconds.jacobian += (assembled - clock).as_secs_f64();
             jac.map_err(AttemptFail::Particle)?;
@@ -441,11 +557,17 @@ impl ImplicitBackend {
                     continue;
                 }
                 for c in 0..2 {
-                    rhs[(2 * id as usize + c, 0)] =
-                        if dofs.free(n, c) { self.r[n][c] } else { 0.0 };
+                    rhs[(2 * id as usize + c, 0)] = if dofs.free(n, c) {
+                        self.r_held[n][c]
+                    } else {
+                        0.0
+                    };
                 }
             }
             lu.solve_in_place(rhs.as_mut());
+            // The correction's size in the mass-weighted norm, so that a
+            // node holding a sliver of a particle (which may move far for
+            // the little it weighs) does not decide convergence.
             let (mut dn, mut un) = (0.0, 0.0);
             for (n, &id) in dofs.id.iter().enumerate() {
                 if id == NO_DOF {
@@ -458,8 +580,9 @@ impl ImplicitBackend {
                             return Err(AttemptFail::Newton(ratio));
                         }
                         self.du[n][c] += delta;
-                        dn += delta * delta;
-                        un += self.du[n][c] * self.du[n][c];
+                        let mass = self.node_mass[n];
+                        dn += mass * delta * delta;
+                        un += mass * self.du[n][c] * self.du[n][c];
                     }
                 }
             }
@@ -475,16 +598,25 @@ impl ImplicitBackend {
         Err(AttemptFail::Newton(f64::NAN))
     }
 
+    /// The nodes in wall contact at the next step (behind a `slip` or
+    /// `friction` wall, with mass), one per contact: for tests.
+    pub fn contact_nodes(&mut self) -> std::result::Result<Vec<usize>, Fault> {
+        self.initial_phase()?;
+        Ok(self.pairs.iter().map(|p| p.node as usize).collect())
+    }
+
     /// Checks the assembled Jacobian against a central difference of the
-    /// residual (a test of `assemble`): at a step of `dt` from the current
-    /// state, with Δu set to `du_of(node)` on the free components, returns
-    /// the largest |K_ij − (−∂R_i/∂Δu_j)_FD| over the largest |K_ij|.
+    /// residual (a test of `assemble` and `contact`): at a step of `dt`
+    /// from the current state, with Δu set to `du_of(node)` on the free
+    /// components. The residual is Coulomb's law itself, the Jacobian that
+    /// of the contact states at Δu, so a difference that crosses a state's
+    /// edge shows as a mismatch (choose Δu away from them).
     pub fn jacobian_mismatch(
         &mut self,
         dt: f64,
         du_of: impl Fn(usize) -> [f64; 2],
         eps: f64,
-    ) -> std::result::Result<f64, Fault> {
+    ) -> std::result::Result<JacobianCheck, Fault> {
         self.initial_phase()?;
         self.fill_body(dt);
         self.predict(dt);
@@ -509,17 +641,47 @@ impl ImplicitBackend {
             newmark,
             dofs: &self.dofs,
             penalty: self.penalty,
+            pairs: &self.pairs,
+            lumped_mass: self.settings.lumped_mass,
         };
         let mut its = self.iterates.clone();
         let mut wf = self.wall_force.clone();
-        assemble::residual(&inp, &self.du, &mut its, &mut self.r, &mut wf)?;
-        assemble::jacobian(&inp, pattern, &self.du, &its, &mut self.values)?;
-        let scale = self.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let residual = |du: &[[f64; 2]],
+                        its: &mut [ParticleIterate],
+                        r: &mut [[f64; 2]],
+                        wf: &mut [[f64; 2]]| {
+            assemble::residual(&inp, du, its, r).map(|()| {
+                assemble::add_contact(&inp, du, None, r, Some(wf));
+            })
+        };
+        residual(&self.du, &mut its, &mut self.r, &mut wf)?;
+        assemble::natural_states(&inp, &self.du, &mut self.natural);
+        assemble::jacobian(
+            &inp,
+            pattern,
+            &self.du,
+            &self.incidence,
+            &its,
+            &self.natural,
+            &mut self.values,
+        )?;
+        let mut check = JacobianCheck::default();
+        for st in &self.natural {
+            match st {
+                ContactState::Open => check.open += 1,
+                ContactState::Stick => check.stick += 1,
+                ContactState::Slip(_) => check.slip += 1,
+            }
+        }
         let nodes: Vec<usize> = (0..self.du.len())
             .filter(|&n| self.dofs.id[n] != NO_DOF)
             .collect();
         let (mut rp, mut rm) = (self.r.clone(), self.r.clone());
-        let mut worst = 0.0f64;
+        let mut column = Vec::new();
+        // A column's scale is at least the material's, 1 / PENALTY_REL of
+        // the contact's: a column of a node that carries a sliver of mass
+        // is then not held to the difference's round-off.
+        let floor = self.values.iter().fold(0.0f64, |a, v| a.max(v.abs())) / assemble::PENALTY_REL;
         for &nb in &nodes {
             for k in 0..2 {
                 if !self.dofs.free(nb, k) {
@@ -527,9 +689,11 @@ impl ImplicitBackend {
                 }
                 let mut du = self.du.clone();
                 du[nb][k] += eps;
-                assemble::residual(&inp, &du, &mut its, &mut rp, &mut wf)?;
+                residual(&du, &mut its, &mut rp, &mut wf)?;
                 du[nb][k] -= 2.0 * eps;
-                assemble::residual(&inp, &du, &mut its, &mut rm, &mut wf)?;
+                residual(&du, &mut its, &mut rm, &mut wf)?;
+                // (assembled, difference) down column (nb, k).
+                column.clear();
                 for &na in &nodes {
                     for i in 0..2 {
                         if !self.dofs.free(na, i) {
@@ -546,12 +710,16 @@ impl ImplicitBackend {
                         } else {
                             0.0
                         };
-                        worst = worst.max((k_ab - fd).abs() / scale);
+                        column.push((k_ab, fd));
                     }
+                }
+                let scale = column.iter().fold(floor, |a, &(v, _)| a.max(v.abs()));
+                for &(v, fd) in &column {
+                    check.mismatch = check.mismatch.max((v - fd).abs() / scale);
                 }
             }
         }
-        Ok(worst)
+        Ok(check)
     }
 
     /// Particles take the converged grid solution (eqs. 46–49); reactions.
@@ -620,6 +788,19 @@ impl ImplicitBackend {
             };
         }
     }
+}
+
+/// The residual under the held contact states: the particles' part plus
+/// each contact's force in its held state.
+fn held_residual(
+    inp: &StepInputs,
+    du: &[[f64; 2]],
+    held: &[ContactState],
+    r_body: &[[f64; 2]],
+    r_held: &mut [[f64; 2]],
+) {
+    r_held.copy_from_slice(r_body);
+    assemble::add_contact(inp, du, Some(held), r_held, None);
 }
 
 impl Backend for ImplicitBackend {

@@ -1,0 +1,215 @@
+//! Wall contact in the implicit step: a penalty on the nodes behind a
+//! `slip` or `friction` wall, written per contact state so that Newton can
+//! hold the state of every wall node fixed while it converges (an active
+//! set), and the rule that revises a held state from the law's own.
+//!
+//! A node is in contact when its increment moves it further behind the
+//! wall's line, g = Δu·n ≤ 0; the normal force is then −k g n. Coulomb's
+//! law on the tangential increment s = Δu·t (t = n rotated a quarter turn)
+//! is a return map: the trial (stick) force −k s t if |k s| ≤ μ k |g|,
+//! else μ k |g| against the slip. Within one state the force is linear in
+//! Δu, so its derivative is exact there; the law as a whole is only
+//! piecewise smooth, which is why Newton holds the states (`mod.rs`).
+
+use crate::model::walls::{CONTACT_FRICTION, Wall};
+
+/// A wall node's contact state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactState {
+    /// Separating (g > 0): no force.
+    Open,
+    /// In contact, held tangentially: f = −k Δu.
+    Stick,
+    /// In contact, sliding along +t (`1.0`) or −t (`-1.0`):
+    /// f = −k g n + μ k g σ t (μ = 0 on a `slip` wall).
+    Slip(f64),
+}
+
+/// A node behind a wall, with mass: one contact of the step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactPair {
+    pub node: u32,
+    /// Index into the model's wall list.
+    pub wall: u32,
+}
+
+/// Normal and tangential components of an increment: (g, s).
+#[inline]
+fn components(wall: &Wall, du: [f64; 2]) -> (f64, f64) {
+    let n = wall.normal;
+    (du[0] * n[0] + du[1] * n[1], -du[0] * n[1] + du[1] * n[0])
+}
+
+/// The state Coulomb's law gives at `du`. g = 0 counts as contact (zero
+/// force, full stiffness): a node resting on the wall starts each step in
+/// contact, so Newton does not begin by letting it fall through.
+pub fn natural_state(wall: &Wall, du: [f64; 2]) -> ContactState {
+    let (g, s) = components(wall, du);
+    if g > 0.0 {
+        ContactState::Open
+    } else if wall.contact != CONTACT_FRICTION {
+        ContactState::Slip(1.0)
+    } else if s.abs() <= wall.mu * -g {
+        ContactState::Stick
+    } else {
+        ContactState::Slip(s.signum())
+    }
+}
+
+/// The force on a node displaced by `du` under `state`, and its derivative
+/// −∂f/∂Δu (2 × 2, row-major). Linear in Δu: exact for any `du`, also one
+/// outside the state (a held state then gives a tensile normal force, or
+/// friction along the slip, which the state revision removes).
+pub fn force(wall: &Wall, du: [f64; 2], k: f64, state: ContactState) -> ([f64; 2], [f64; 4]) {
+    let n = wall.normal;
+    let t = [-n[1], n[0]];
+    let (g, s) = components(wall, du);
+    let outer = |a: [f64; 2], b: [f64; 2], c: f64| {
+        [
+            c * a[0] * b[0],
+            c * a[0] * b[1],
+            c * a[1] * b[0],
+            c * a[1] * b[1],
+        ]
+    };
+    match state {
+        ContactState::Open => ([0.0; 2], [0.0; 4]),
+        ContactState::Stick => {
+            let f = [-k * (g * n[0] + s * t[0]), -k * (g * n[1] + s * t[1])];
+            (f, [k, 0.0, 0.0, k])
+        }
+        ContactState::Slip(sigma) => {
+            let mu = if wall.contact == CONTACT_FRICTION {
+                wall.mu
+            } else {
+                0.0
+            };
+            // f = −k g n + μ k g σ t (g ≤ 0: friction −μ k |g| σ t).
+            let f = [
+                -k * g * n[0] + mu * k * g * sigma * t[0],
+                -k * g * n[1] + mu * k * g * sigma * t[1],
+            ];
+            let nn = outer(n, n, k);
+            let tn = outer(t, n, -mu * k * sigma);
+            (f, std::array::from_fn(|i| nn[i] + tn[i]))
+        }
+    }
+}
+
+/// Coulomb's law itself: the force under the state it gives at `du`.
+pub fn contact(wall: &Wall, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
+    force(wall, du, k, natural_state(wall, du))
+}
+
+/// The state to hold next, from the held one and the law's at Newton's
+/// solution under the held one. A slip that came out reversed means the
+/// node is held between the two directions: stick. Otherwise the law's.
+pub fn revise(held: ContactState, natural: ContactState) -> ContactState {
+    match (held, natural) {
+        (ContactState::Slip(a), ContactState::Slip(b)) if a != b => ContactState::Stick,
+        (_, b) => b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::walls::CONTACT_SLIP;
+
+    fn wall(contact: u32) -> Wall {
+        let n = [0.6, 0.8];
+        Wall {
+            name: "w".into(),
+            point: [0.0; 2],
+            normal: n,
+            contact,
+            mu: 0.5,
+            nodes: Vec::new(),
+        }
+    }
+
+    /// Δu from normal and tangential parts.
+    fn du(w: &Wall, g: f64, s: f64) -> [f64; 2] {
+        let n = w.normal;
+        [g * n[0] - s * n[1], g * n[1] + s * n[0]]
+    }
+
+    #[test]
+    fn states_follow_coulomb() {
+        let w = wall(CONTACT_FRICTION);
+        assert_eq!(natural_state(&w, du(&w, 1e-6, 0.0)), ContactState::Open);
+        assert_eq!(natural_state(&w, du(&w, 0.0, 0.0)), ContactState::Stick);
+        assert_eq!(natural_state(&w, du(&w, -1e-6, 4e-7)), ContactState::Stick);
+        assert_eq!(
+            natural_state(&w, du(&w, -1e-6, -6e-7)),
+            ContactState::Slip(-1.0)
+        );
+        let s = wall(CONTACT_SLIP);
+        assert_eq!(
+            natural_state(&s, du(&s, -1e-6, 0.0)),
+            ContactState::Slip(1.0)
+        );
+    }
+
+    #[test]
+    fn slip_force_is_mu_times_the_normal_one_against_the_slip() {
+        let w = wall(CONTACT_FRICTION);
+        let k = 1e9;
+        let (f, _) = contact(&w, du(&w, -1e-6, 5e-6), k);
+        let n = w.normal;
+        let t = [-n[1], n[0]];
+        let fn_ = f[0] * n[0] + f[1] * n[1];
+        let ft = f[0] * t[0] + f[1] * t[1];
+        assert!((fn_ - 1e3).abs() < 1e-9, "{fn_}");
+        assert!((ft + 0.5e3).abs() < 1e-9, "{ft}");
+    }
+
+    #[test]
+    fn the_law_is_continuous_across_stick_and_slip() {
+        let w = wall(CONTACT_FRICTION);
+        let k = 1e9;
+        // At |s| = μ|g| both states give the same force.
+        let d = du(&w, -1e-6, 0.5e-6);
+        let (a, _) = force(&w, d, k, ContactState::Stick);
+        let (b, _) = force(&w, d, k, ContactState::Slip(1.0));
+        for i in 0..2 {
+            assert!((a[i] - b[i]).abs() < 1e-9 * k * 1e-6, "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn the_derivative_is_exact_within_a_state() {
+        let w = wall(CONTACT_FRICTION);
+        let k = 1e9;
+        let d = du(&w, -1e-6, 3e-6);
+        for state in [
+            ContactState::Open,
+            ContactState::Stick,
+            ContactState::Slip(1.0),
+            ContactState::Slip(-1.0),
+        ] {
+            let (_, kt) = force(&w, d, k, state);
+            let eps = 1e-9;
+            for c in 0..2 {
+                let (mut p, mut m) = (d, d);
+                p[c] += eps;
+                m[c] -= eps;
+                let (fp, _) = force(&w, p, k, state);
+                let (fm, _) = force(&w, m, k, state);
+                for r in 0..2 {
+                    let fd = -(fp[r] - fm[r]) / (2.0 * eps);
+                    assert!((kt[2 * r + c] - fd).abs() < 1e-6 * k, "{state:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_reversed_slip_becomes_stick() {
+        use ContactState::*;
+        assert_eq!(revise(Slip(1.0), Slip(-1.0)), Stick);
+        assert_eq!(revise(Stick, Slip(-1.0)), Slip(-1.0));
+        assert_eq!(revise(Slip(1.0), Open), Open);
+        assert_eq!(revise(Open, Stick), Stick);
+    }
+}
