@@ -92,7 +92,7 @@ enum Command {
     /// Run one of the papers' comparisons (or all): CSV tables and charts in
     /// --out; with --doc FILE (e.g. docs/verification.md) also the study's section there.
     Study {
-        /// dyka, block, plate-impact, stability, mms or all.
+        /// Which study (one of the values below), or all.
         #[arg(value_enum)]
         name: StudyName,
         /// auto = the CPU path, plus the GPU when a hardware adapter exists.

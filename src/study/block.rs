@@ -4,7 +4,7 @@
 //! against depth at t_end with the exact line.
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, image, sig, table};
+use super::{Method, backend_slug, image, sig, table};
 use crate::cases::ELASTIC_BLOCK;
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
@@ -17,7 +17,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// (label, shape, γ) of each method.
-pub const METHODS: [(&str, &str, f64); 4] = [
+pub const METHODS: [Method; 4] = [
     ("linear", "linear", 0.0),
     ("ugimp", "ugimp", 0.0),
     ("lme-g0.8", "lme", 0.8),
@@ -28,19 +28,14 @@ pub fn jobs(_quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     // The block is cheap (100 particles): the quick sweep is the full one.
     let mut out = Vec::new();
     for &b in backends {
-        for (label, shape, gamma) in METHODS {
+        for m in METHODS {
             let mut j = Job::new(
-                format!("{}-{label}", backend_slug(b)),
+                format!("{}-{}", backend_slug(b), m.0),
                 ELASTIC_BLOCK,
                 "elastic_block",
             )
-            .set(format!("solver.shape={shape}"))
-            .tag("backend", backend_slug(b))
-            .tag("method", label);
-            if gamma > 0.0 {
-                j = j.set(format!("solver.lme_gamma={gamma}"));
-            }
-            j.backend = b;
+            .on(b)
+            .method(m);
             j.keep_final = true;
             out.push(j);
         }

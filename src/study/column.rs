@@ -7,7 +7,7 @@
 //! 2005; Lube et al. 2005).
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, image, sig, table};
+use super::{Method, backend_slug, image, sig, table};
 use crate::cases::{COLUMN_COLLAPSE, GRANULAR_COLLAPSE};
 use crate::chart::{LineChart, Panel, ParticleImage, Series};
 use crate::error::Result;
@@ -17,7 +17,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// (label, shape, γ) of each method.
-pub const METHODS: [(&str, &str, f64); 4] = [
+pub const METHODS: [Method; 4] = [
     ("linear", "linear", 0.0),
     ("ugimp", "ugimp", 0.0),
     ("lme-g1.8", "lme", 1.8),
@@ -49,51 +49,41 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     };
     for &b in backends {
         for &h in meshes {
-            for (label, shape, gamma) in METHODS {
+            for m in METHODS {
                 let mut j = Job::new(
-                    format!("{}-cohesive-{label}-h{h}", backend_slug(b)),
+                    format!("{}-cohesive-{}-h{h}", backend_slug(b), m.0),
                     COLUMN_COLLAPSE,
                     "column_collapse",
                 )
                 .set(format!("grid.h={h}"))
-                .set(format!("solver.shape={shape}"))
                 .set("output.vtk_interval=1e9")
-                .tag("backend", backend_slug(b))
+                .on(b)
                 .tag("case", "cohesive")
-                .tag("method", label)
+                .method(m)
                 .tag("h", h);
-                if gamma > 0.0 {
-                    j = j.set(format!("solver.lme_gamma={gamma}"));
-                }
                 if quick {
                     j = j.set(format!("solver.t_end={}", times[times.len() - 1]));
                 }
                 j.snapshot_times = times.clone();
                 j.keep_final = true;
-                j.backend = b;
                 out.push(j);
             }
         }
         if quick {
             continue;
         }
-        for (label, shape, gamma) in METHODS {
+        for m in METHODS {
             let mut j = Job::new(
-                format!("{}-granular-{label}", backend_slug(b)),
+                format!("{}-granular-{}", backend_slug(b), m.0),
                 GRANULAR_COLLAPSE,
                 "granular_collapse",
             )
-            .set(format!("solver.shape={shape}"))
             .set("output.vtk_interval=1e9")
-            .tag("backend", backend_slug(b))
+            .on(b)
             .tag("case", "granular")
-            .tag("method", label)
+            .method(m)
             .tag("h", 0.025);
-            if gamma > 0.0 {
-                j = j.set(format!("solver.lme_gamma={gamma}"));
-            }
             j.keep_final = true;
-            j.backend = b;
             out.push(j);
         }
     }

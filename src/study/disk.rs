@@ -6,7 +6,7 @@
 //! front) and the displacement history at the smallest step.
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, image, sig, table};
+use super::{Method, backend_slug, image, sig, table};
 use crate::cases::ROLLING_DISK;
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
@@ -18,7 +18,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// (label, shape, γ) of each method.
-pub const METHODS: [(&str, &str, f64); 4] = [
+pub const METHODS: [Method; 4] = [
     ("linear", "linear", 0.0),
     ("ugimp", "ugimp", 0.0),
     ("lme-g2.8", "lme", 2.8),
@@ -56,26 +56,20 @@ fn sample_times(t_end: f64) -> Vec<f64> {
 
 /// One run of the disk: `method` (label, shape, γ) at the `k`-th time
 /// step `dt` (k from 1) up to `t_end`, its centre sampled every `SAMPLE`.
-pub fn job(b: BackendChoice, method: (&str, &str, f64), k: usize, dt: f64, t_end: f64) -> Job {
-    let (label, shape, gamma) = method;
+pub fn job(b: BackendChoice, method: Method, k: usize, dt: f64, t_end: f64) -> Job {
     let mut j = Job::new(
-        format!("{}-{label}-dt{k}", backend_slug(b)),
+        format!("{}-{}-dt{k}", backend_slug(b), method.0),
         ROLLING_DISK,
         "rolling_disk",
     )
-    .set(format!("solver.shape={shape}"))
     .set(format!("solver.dt={dt}"))
     .set(format!("solver.t_end={t_end}"))
     .set("output.vtk_interval=1e9")
-    .tag("backend", backend_slug(b))
-    .tag("method", label)
+    .on(b)
+    .method(method)
     .tag("dt_index", k)
     .tag("dt", dt);
-    if gamma > 0.0 {
-        j = j.set(format!("solver.lme_gamma={gamma}"));
-    }
     j.snapshot_times = sample_times(t_end);
-    j.backend = b;
     j
 }
 
@@ -101,16 +95,14 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
             stick_variant(),
             "rolling_disk",
         )
-        .set("solver.shape=linear")
         .set(format!("solver.dt={DT1}"))
         .set(format!("solver.t_end={t_end}"))
         .set("output.vtk_interval=1e9")
-        .tag("backend", backend_slug(b))
-        .tag("method", "linear-stick")
+        .on(b)
+        .method(("linear-stick", "linear", 0.0))
         .tag("dt_index", 1)
         .tag("dt", DT1);
         j.snapshot_times = times.clone();
-        j.backend = b;
         out.push(j);
         // The wall's grid contact error shrinks with the contact patch's
         // width sqrt(2 R h): one linear run on a grid twice as fine
@@ -121,17 +113,15 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
                 ROLLING_DISK,
                 "rolling_disk",
             )
-            .set("solver.shape=linear")
             .set(format!("grid.h={FINE_H}"))
             .set(format!("solver.dt={}", DT1 / 2.0))
             .set(format!("solver.t_end={t_end}"))
             .set("output.vtk_interval=1e9")
-            .tag("backend", backend_slug(b))
-            .tag("method", "linear-fine")
+            .on(b)
+            .method(("linear-fine", "linear", 0.0))
             .tag("dt_index", 2)
             .tag("dt", DT1 / 2.0);
             j.snapshot_times = times.clone();
-            j.backend = b;
             out.push(j);
         }
     }

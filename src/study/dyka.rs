@@ -5,7 +5,7 @@
 //! NPC (Fig. 8), the γ sweep (Fig. 9) and uGIMP vs LME (Fig. 10).
 
 use super::runner::{Job, JobResult};
-use super::{backend_slug, backends_of, image, sig, table};
+use super::{Method, backend_slug, backends_of, image, sig, table};
 use crate::cases::{DYKA_BAR, DYKA_L};
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
@@ -25,7 +25,7 @@ pub const H_QUICK: [f64; 4] = [5e-4, 1e-3, 3.3325e-3, 1e-2];
 pub const H_HISTORY: f64 = 1e-3;
 
 /// (label, shape, γ) of each method.
-pub const METHODS: [(&str, &str, f64); 5] = [
+pub const METHODS: [Method; 5] = [
     ("linear", "linear", 0.0),
     ("ugimp", "ugimp", 0.0),
     ("lme-g2", "lme", 2.0),
@@ -37,45 +37,47 @@ pub const INTEGRATORS: [&str; 2] = ["fe", "npc"];
 
 /// One job: the bar one cell thick (h × h cells, so 2 × 2 particles across).
 pub fn job(backend: BackendChoice, h: f64, method: usize, integrator: &str) -> Job {
-    let (label, shape, gamma) = METHODS[method];
-    let mut j = Job::new(
-        format!(
-            "{}-{label}-{integrator}-h{}mm",
-            backend_slug(backend),
-            sig(h * 1e3)
+    let m = METHODS[method];
+    bar_at(
+        Job::new(
+            format!(
+                "{}-{}-{integrator}-h{}mm",
+                backend_slug(backend),
+                m.0,
+                sig(h * 1e3)
+            ),
+            DYKA_BAR,
+            "dyka_bar",
         ),
-        DYKA_BAR,
-        "dyka_bar",
+        h,
     )
-    .set(format!("grid.h={h}"))
-    .set(format!(
-        "bodies.impactor.rects=[[0.0, 0.0, {}, {h}]]",
-        DYKA_L / 4.0
-    ))
-    .set(format!(
-        "bodies.bar.rects=[[{}, 0.0, {DYKA_L}, {h}]]",
-        DYKA_L / 4.0
-    ))
-    // The probes on the bar's axis at every cell size (the case file puts
-    // them at y = 0.5 mm, for h = 1 mm): the paper's point A, the
-    // impactor's free end, and the middle.
-    .set(format!("output.probes.free_end=[0.0, {}]", h / 2.0))
-    .set(format!(
-        "output.probes.middle=[{}, {}]",
-        DYKA_L / 2.0,
-        h / 2.0
-    ))
-    .set(format!("solver.shape={shape}"))
     .set(format!("solver.integrator={integrator}"))
-    .tag("backend", backend_slug(backend))
-    .tag("method", label)
+    .on(backend)
+    .method(m)
     .tag("integrator", integrator)
-    .tag("h_mm", sig(h * 1e3));
-    if gamma > 0.0 {
-        j = j.set(format!("solver.lme_gamma={gamma}"));
-    }
-    j.backend = backend;
-    j
+    .tag("h_mm", sig(h * 1e3))
+}
+
+/// `j` (a job of the `dyka_bar` case) at cell size `h`: the bar one cell
+/// thick (h × h cells, so 2 × 2 particles across), and the probes on the
+/// bar's axis (the case file puts them at y = 0.5 mm, for h = 1 mm): the
+/// paper's point A, the impactor's free end, and the middle.
+pub fn bar_at(j: Job, h: f64) -> Job {
+    j.set(format!("grid.h={h}"))
+        .set(format!(
+            "bodies.impactor.rects=[[0.0, 0.0, {}, {h}]]",
+            DYKA_L / 4.0
+        ))
+        .set(format!(
+            "bodies.bar.rects=[[{}, 0.0, {DYKA_L}, {h}]]",
+            DYKA_L / 4.0
+        ))
+        .set(format!("output.probes.free_end=[0.0, {}]", h / 2.0))
+        .set(format!(
+            "output.probes.middle=[{}, {}]",
+            DYKA_L / 2.0,
+            h / 2.0
+        ))
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {

@@ -118,13 +118,7 @@ pub fn backends(b: StudyBackend) -> Vec<BackendChoice> {
     }
 }
 
-pub fn backend_slug(b: BackendChoice) -> &'static str {
-    match b {
-        BackendChoice::Cpu => "cpu",
-        BackendChoice::Gpu => "gpu",
-        BackendChoice::Auto => "auto",
-    }
-}
+pub use runner::{Method, backend_slug};
 
 /// The backends the study's runs used, in order of first appearance.
 pub fn backends_of(results: &[runner::JobResult]) -> Vec<&str> {

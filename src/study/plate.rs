@@ -38,14 +38,13 @@ fn job(b: BackendChoice, quick: bool, shape: &str, integrator: &str, perturbed: 
     .set(format!("solver.shape={shape}"))
     .set(format!("solver.integrator={integrator}"))
     .set("output.vtk_interval=1e9")
-    .tag("backend", backend_slug(b))
+    .on(b)
     .tag("shape", shape)
     .tag("integrator", integrator)
     .tag("grid", grid);
     if perturbed {
         j = j.set(format!("grid.perturb={PERTURB}"));
     }
-    j.backend = b;
     j.keep_final = true;
     j
 }

@@ -5,7 +5,7 @@
 
 use super::runner::{Job, JobResult};
 use super::{backend_slug, image, sig, table};
-use crate::cases::{COLUMN_COLLAPSE, DYKA_BAR, DYKA_L, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK};
+use crate::cases::{COLUMN_COLLAPSE, DYKA_BAR, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK};
 use crate::error::Result;
 use crate::exact::Errors;
 use crate::simulation::BackendChoice;
@@ -101,37 +101,23 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
                     ),
                     text,
                     name,
-                )
-                .set(format!("grid.h={}", col.h))
-                .set(format!("solver.shape={shape}"))
+                );
+                j = if col.case == "dyka_bar" {
+                    super::dyka::bar_at(j, col.h)
+                } else {
+                    j.set(format!("grid.h={}", col.h))
+                }
                 .set(format!("solver.integrator={integ}"))
-                .tag("backend", backend_slug(b))
-                .tag("method", label)
+                .on(b)
+                .method((label, shape, *gamma))
                 .tag("column", ci)
                 .tag("row", mi);
-                if *gamma > 0.0 {
-                    j = j.set(format!("solver.lme_gamma={gamma}"));
-                }
                 if col.perturb > 0.0 {
                     j = j.set(format!("grid.perturb={}", col.perturb));
-                }
-                if col.case == "dyka_bar" {
-                    j = j
-                        .set(format!(
-                            "bodies.impactor.rects=[[0.0, 0.0, {}, {}]]",
-                            DYKA_L / 4.0,
-                            col.h
-                        ))
-                        .set(format!(
-                            "bodies.bar.rects=[[{}, 0.0, {DYKA_L}, {}]]",
-                            DYKA_L / 4.0,
-                            col.h
-                        ));
                 }
                 if col.case == "plate_impact" {
                     j = j.set("output.vtk_interval=1e9");
                 }
-                j.backend = b;
                 out.push(j);
             }
         }

@@ -16,6 +16,19 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
+/// A shape function as the studies name it: (label, `solver.shape`, LME γ;
+/// 0 for shapes without one).
+pub type Method = (&'static str, &'static str, f64);
+
+/// A backend's short name in run labels and tables.
+pub fn backend_slug(b: BackendChoice) -> &'static str {
+    match b {
+        BackendChoice::Cpu => "cpu",
+        BackendChoice::Gpu => "gpu",
+        BackendChoice::Auto => "auto",
+    }
+}
+
 /// One simulation of a study.
 #[derive(Debug, Clone)]
 pub struct Job {
@@ -61,6 +74,25 @@ impl Job {
     pub fn tag(mut self, k: &'static str, v: impl ToString) -> Self {
         self.tags.push((k, v.to_string()));
         self
+    }
+
+    /// Runs on `b`, tagged `backend` with its slug (`cpu`, `gpu`, `auto`).
+    pub fn on(mut self, b: BackendChoice) -> Self {
+        self.backend = b;
+        self.tag("backend", backend_slug(b))
+    }
+
+    /// Sets `solver.shape`, and `solver.lme_gamma` when γ > 0, tagged
+    /// `method` with the method's label.
+    pub fn method(self, (label, shape, gamma): Method) -> Self {
+        let j = self
+            .set(format!("solver.shape={shape}"))
+            .tag("method", label);
+        if gamma > 0.0 {
+            j.set(format!("solver.lme_gamma={gamma}"))
+        } else {
+            j
+        }
     }
 
     pub fn tag_value(&self, k: &str) -> Option<&str> {
