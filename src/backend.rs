@@ -42,6 +42,9 @@ pub struct State {
     pub t: f64,
     /// Time step of the step in progress, or of the last one (s).
     pub dt: f64,
+    /// The implicit integrator's Newton statistics so far, so a resumed
+    /// run's `summary.json` covers the whole run (None otherwise).
+    pub newton: Option<NewtonStats>,
 }
 
 /// State of one probe particle.

@@ -128,6 +128,7 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
         force: vec![[0.0; 2]; nodes],
         t: ck.t,
         dt: ck.dt,
+        newton: ck.newton.clone(),
     };
     sim.backend().restore(&state, ck.steps)?;
     // What the run wrote after its checkpoint goes; the snapshots up to it stay.
@@ -494,6 +495,7 @@ impl Observer for Writer {
             cursor: *cursor,
             samples: self.samples.clone(),
             snapshots: self.snapshots.clone(),
+            newton: backend.newton().cloned(),
         };
         self.write(checkpoint::FILE, &ck.encode())?;
         // The CSV files as of the checkpoint, so a kill leaves them consistent with it.

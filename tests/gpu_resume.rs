@@ -41,6 +41,7 @@ impl Observer for Stopper {
             force: vec![[0.0; 2]; nodes],
             t: b.time(),
             dt: 0.0,
+            newton: None,
         };
         self.saved = Some((state, b.steps(), *cursor));
         Ok(())

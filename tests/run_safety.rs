@@ -342,6 +342,41 @@ fn resume_from_a_periodic_checkpoint_gives_the_same_particles_on_the_block() {
 }
 
 #[test]
+fn a_resumed_implicit_run_reports_the_whole_runs_newton_statistics() {
+    // The checkpoint carries the Newton counters and the per-sample Newton
+    // columns, so summary.json and probes.csv of a resumed run are those
+    // of the uninterrupted one (the timers aside).
+    let out = tmp("implicit");
+    let sets = &[
+        "solver.integrator=implicit",
+        "solver.cfl=1",
+        "solver.t_end=2e-5",
+        "output.sample_interval=2e-6",
+        "output.checkpoint_interval=1.1e-5",
+    ];
+    let o = run("dyka_bar.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = summary(&out)["newton"].clone();
+    let probes = read(&out.join("probes.csv"));
+    assert!(probes.lines().next().unwrap().contains("newton_iterations"));
+    let o = resume(&out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    assert!(s["resumed_from"].as_f64().unwrap() > 1e-5, "{s}");
+    for key in [
+        "steps",
+        "iterations_mean",
+        "iterations_max",
+        "cuts",
+        "last_step_residuals",
+    ] {
+        assert_eq!(s["newton"][key], whole[key], "{key}: {s}");
+    }
+    assert!(whole["steps"].as_u64().unwrap() > 50, "{whole}");
+    assert_eq!(read(&out.join("probes.csv")), probes);
+}
+
+#[test]
 fn a_damaged_or_missing_checkpoint_is_refused_with_exit_2() {
     let out = tmp("damaged");
     let o = run(

@@ -171,6 +171,7 @@ impl CpuBackend {
             force: self.force.clone(),
             t: self.t,
             dt: self.dt,
+            newton: None,
         }
     }
 

@@ -14,7 +14,7 @@
 //! items; f64 are stored bit for bit, so a resumed run starts from the exact
 //! state. A file from another version or with a wrong checksum is refused.
 
-use crate::backend::{ProbeState, Sample};
+use crate::backend::{NewtonSample, NewtonSeconds, NewtonStats, ProbeState, Sample};
 use crate::error::{Error, Result};
 use crate::model::Particles;
 use crate::model::energy::Energy;
@@ -24,8 +24,9 @@ use std::path::Path;
 /// File name in the output folder.
 pub const FILE: &str = "checkpoint.lmeck";
 const MAGIC: &[u8; 8] = b"LMEMPMCK";
-/// Bumped whenever the payload changes (2: the plastic state).
-pub const FORMAT: u32 = 2;
+/// Bumped whenever the payload changes (2: the plastic state; 3: the
+/// implicit integrator's Newton statistics and per-sample Newton figures).
+pub const FORMAT: u32 = 3;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -45,6 +46,9 @@ pub struct Checkpoint {
     pub samples: Vec<Sample>,
     /// The snapshots written so far: (time, path in the folder).
     pub snapshots: Vec<(f64, String)>,
+    /// The implicit integrator's Newton statistics so far (None for the
+    /// explicit integrators).
+    pub newton: Option<NewtonStats>,
 }
 
 impl Checkpoint {
@@ -87,10 +91,30 @@ impl Checkpoint {
             });
             e.energy(&s.energy);
             e.pairs(&s.reactions);
+            e.option(s.newton.as_ref(), |e, n| {
+                e.u32(n.iterations);
+                e.f64(n.residual);
+                e.f64(n.dt);
+            });
         });
         e.list(&self.snapshots, |e, (t, name)| {
             e.f64(*t);
             e.str(name);
+        });
+        e.option(self.newton.as_ref(), |e, n| {
+            e.u64(n.steps);
+            e.u64(n.iterations);
+            e.u32(n.max_iterations);
+            e.u32(n.last_iterations);
+            e.f64s(&n.last_residuals);
+            e.f64s(&n.last_corrections);
+            e.u64(n.cuts);
+            let s = &n.seconds;
+            for v in [
+                s.map, s.symbolic, s.residual, s.jacobian, s.factor, s.solve, s.convect,
+            ] {
+                e.f64(v);
+            }
         });
         let sum = fnv1a(&e.0);
         e.u64(sum);
@@ -157,10 +181,36 @@ impl Checkpoint {
                 })?,
                 energy: d.energy()?,
                 reactions: d.pairs()?,
-                newton: None,
+                newton: d.option(|d| {
+                    Ok(NewtonSample {
+                        iterations: d.u32()?,
+                        residual: d.f64()?,
+                        dt: d.f64()?,
+                    })
+                })?,
             })
         })?;
         let snapshots = d.list(|d| Ok((d.f64()?, d.str()?)))?;
+        let newton = d.option(|d| {
+            Ok(NewtonStats {
+                steps: d.u64()?,
+                iterations: d.u64()?,
+                max_iterations: d.u32()?,
+                last_iterations: d.u32()?,
+                last_residuals: d.list(|d| d.f64())?,
+                last_corrections: d.list(|d| d.f64())?,
+                cuts: d.u64()?,
+                seconds: NewtonSeconds {
+                    map: d.f64()?,
+                    symbolic: d.f64()?,
+                    residual: d.f64()?,
+                    jacobian: d.f64()?,
+                    factor: d.f64()?,
+                    solve: d.f64()?,
+                    convect: d.f64()?,
+                },
+            })
+        })?;
         if !d.0.is_empty() {
             return Err(bad("has trailing bytes"));
         }
@@ -191,6 +241,7 @@ impl Checkpoint {
             cursor,
             samples,
             snapshots,
+            newton,
         })
     }
 
@@ -247,6 +298,13 @@ impl Enc {
             e.f64(x[1]);
         });
     }
+    /// A u32 flag (0 = none, 1 = some) and the value.
+    fn option<T>(&mut self, v: Option<&T>, each: impl FnOnce(&mut Enc, &T)) {
+        self.u32(u32::from(v.is_some()));
+        if let Some(v) = v {
+            each(self, v);
+        }
+    }
     fn energy(&mut self, en: &Energy) {
         self.f64(en.kinetic);
         self.f64(en.strain);
@@ -288,6 +346,13 @@ impl Dec<'_> {
     }
     fn pairs(&mut self) -> Result<Vec<[f64; 2]>> {
         self.list(|d| Ok([d.f64()?, d.f64()?]))
+    }
+    fn option<T>(&mut self, each: impl FnOnce(&mut Self) -> Result<T>) -> Result<Option<T>> {
+        match self.u32()? {
+            0 => Ok(None),
+            1 => each(self).map(Some),
+            _ => Err(bad("holds an invalid flag")),
+        }
     }
     fn energy(&mut self) -> Result<Energy> {
         Ok(Energy {
@@ -347,9 +412,31 @@ mod tests {
                 }],
                 energy: Energy::default(),
                 reactions: vec![[1.0, -1.0]],
-                newton: None,
+                newton: Some(NewtonSample {
+                    iterations: 3,
+                    residual: 2.5e-11,
+                    dt: 1e-3,
+                }),
             }],
             snapshots: vec![(0.0, "vtk/particles_00000.vtu".into())],
+            newton: Some(NewtonStats {
+                steps: 12,
+                iterations: 31,
+                max_iterations: 4,
+                last_iterations: 2,
+                last_residuals: vec![1.0, 3e-4, 1e-9],
+                last_corrections: vec![1.0, 2e-6],
+                cuts: 1,
+                seconds: NewtonSeconds {
+                    map: 0.1,
+                    symbolic: 0.2,
+                    residual: 0.3,
+                    jacobian: 0.4,
+                    factor: 0.5,
+                    solve: 0.6,
+                    convect: 0.7,
+                },
+            }),
         }
     }
 
@@ -369,6 +456,7 @@ mod tests {
         assert_eq!(d.samples, c.samples);
         assert_eq!(d.snapshots, c.snapshots);
         assert_eq!(d.scene_toml, c.scene_toml);
+        assert_eq!(d.newton, c.newton);
     }
 
     #[test]

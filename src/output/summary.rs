@@ -70,7 +70,7 @@ pub struct Summary {
 /// Newton iterations of an implicit run.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct NewtonSummary {
-    /// Converged steps (since a resume, if resumed).
+    /// Converged steps over the whole run (a resumed run included).
     pub steps: u64,
     /// Iterations per step: mean and most.
     pub iterations_mean: f64,

@@ -877,6 +877,9 @@ impl Backend for ImplicitBackend {
         self.t = state.t;
         self.dt = state.dt;
         self.steps = steps;
+        if let Some(stats) = &state.newton {
+            self.stats = stats.clone();
+        }
         Ok(())
     }
 }
