@@ -243,17 +243,17 @@ pub fn csv(points: &[Point]) -> String {
     s
 }
 
-/// Markdown table row for a point.
+/// Markdown table row for a point (bytes per particle "-" where unknown:
+/// the peer's).
 pub fn table_row(p: &Point) -> String {
+    let bytes = if p.bytes_per_particle.is_finite() {
+        format!("{:.0}", p.bytes_per_particle)
+    } else {
+        "-".to_string()
+    };
     format!(
-        "| {} | {} | {} | {} | {:.3} | {:.3e} | {:.0} |",
-        p.backend,
-        p.case,
-        p.particles,
-        p.steps,
-        p.seconds,
-        p.particle_steps_per_second,
-        p.bytes_per_particle
+        "| {} | {} | {} | {} | {:.3} | {:.3e} | {bytes} |",
+        p.backend, p.case, p.particles, p.steps, p.seconds, p.particle_steps_per_second,
     )
 }
 
@@ -335,6 +335,104 @@ pub fn ratio_table(r: &[Ratio]) -> String {
         );
     }
     s
+}
+
+/// Backend name of the peer's points: `peer: COMMAND`.
+pub const PEER_PREFIX: &str = "peer: ";
+
+/// Runs a peer's throughput script, `sh -c "COMMAND N1,N2,…"` (the particle
+/// counts appended as one comma-separated argument, as
+/// `../shared/bench/peer.sh ARCH` takes them), and reads its points from
+/// stdout lines of the form `NAME n=N steps=S wall=W particle-steps/s=X`
+/// (the other lines are ignored). The project does not depend on the peer:
+/// this only runs what the user names.
+pub fn peer(command: &str, sizes: &[usize]) -> Result<Vec<Point>> {
+    let list: Vec<String> = sizes.iter().map(usize::to_string).collect();
+    let line = format!("{command} {}", list.join(","));
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(&line)
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| crate::Error::Bench(format!("cannot start `sh -c {line:?}`: {e}")))?;
+    if !out.status.success() {
+        return Err(crate::Error::Bench(format!(
+            "the peer `{line}` failed ({})",
+            out.status
+        )));
+    }
+    let points = parse_peer(command, &String::from_utf8_lossy(&out.stdout));
+    if points.is_empty() {
+        return Err(crate::Error::Bench(format!(
+            "the peer `{line}` printed no line with n=… and particle-steps/s=…"
+        )));
+    }
+    Ok(points)
+}
+
+/// The points in a peer's output (see [`peer`]).
+pub fn parse_peer(command: &str, stdout: &str) -> Vec<Point> {
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let mut words = l.split_whitespace();
+            let name = words.next()?;
+            let (mut n, mut steps, mut wall, mut rate) = (None, 0, f64::NAN, None);
+            for w in words {
+                match w.split_once('=') {
+                    Some(("n", v)) => n = v.parse::<usize>().ok(),
+                    Some(("steps", v)) => steps = v.parse().unwrap_or(0),
+                    Some(("wall", v)) => wall = v.parse().unwrap_or(f64::NAN),
+                    Some(("particle-steps/s", v)) => rate = v.parse::<f64>().ok(),
+                    _ => {}
+                }
+            }
+            Some(Point {
+                backend: format!("{PEER_PREFIX}{command}"),
+                case: name.to_string(),
+                particles: n?,
+                steps,
+                seconds: wall,
+                particle_steps_per_second: rate.filter(|r| r.is_finite() && *r > 0.0)?,
+                bytes_per_particle: f64::NAN,
+            })
+        })
+        .collect()
+}
+
+/// Markdown table of each of our points over the peer's at the nearest
+/// particle count (within 10 %: a bench scene's count is the nearest
+/// whole grid's), all measured in the same `lme-mpm bench` run.
+pub fn peer_table(points: &[Point]) -> Option<String> {
+    let (peers, ours): (Vec<&Point>, Vec<&Point>) = points
+        .iter()
+        .partition(|p| p.backend.starts_with(PEER_PREFIX));
+    let mut s = String::from(
+        "| backend | case | particles | particle-steps/s | peer particle-steps/s | ours / peer |\n|---|---|---|---|---|---|\n",
+    );
+    let mut any = false;
+    for p in ours {
+        let near = peers.iter().min_by(|a, b| {
+            let d = |q: &Point| (q.particles as f64 / p.particles as f64).ln().abs();
+            d(a).total_cmp(&d(b))
+        });
+        let Some(q) = near.filter(|q| (q.particles as f64 / p.particles as f64 - 1.0).abs() <= 0.1)
+        else {
+            continue;
+        };
+        any = true;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.3e} | {:.3e} | {:.2} |",
+            p.backend,
+            p.case,
+            p.particles,
+            p.particle_steps_per_second,
+            q.particle_steps_per_second,
+            p.particle_steps_per_second / q.particle_steps_per_second
+        );
+    }
+    any.then_some(s)
 }
 
 /// Log-log chart of particle-steps per second against particle count, one

@@ -38,6 +38,10 @@ pub enum Error {
     /// The GPU device reported an error (validation, out of memory, lost device).
     #[error("GPU error: {0}")]
     Gpu(String),
+
+    /// `bench --peer`: the peer's command failed or printed no measurement.
+    #[error("bench: {0}")]
+    Bench(String),
 }
 
 impl Error {

@@ -124,38 +124,49 @@ enum Command {
     Sweep(SweepArgs),
     /// Measure particle-steps per second of whole steps on a synthetic scene,
     /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
-    Bench {
-        /// Backends to measure.
-        #[arg(long, value_enum, default_value_t = BenchBackends::Both)]
-        backend: BenchBackends,
-        /// GPU adapter (part of its name); an error with --backend cpu.
-        #[arg(long)]
-        adapter: Option<String>,
-        /// Particle counts, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
-        particles: Vec<usize>,
-        /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
-        /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed),
-        /// lme-g3-mohr-coulomb (elastoplastic), bspline2, bspline3, bspline2-mls, bspline3-mls,
-        /// linear-scatter, linear-patch, bspline2-gather, bspline2-scatter, lme-g3-gather (GPU:
-        /// p2g and forces scattered per particle with float atomics, gathered at nodes, or
-        /// scattered per bin summing in registers first, whichever the case does not run by
-        /// default).
-        #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
-        cases: Vec<String>,
-        /// Seconds of stepping per point (after one warm-up step).
-        #[arg(long, default_value_t = 2.0)]
-        seconds: f64,
-        /// Folder for bench.csv.
-        #[arg(long, default_value = "out/bench")]
-        out: PathBuf,
-        /// Also rewrite the measured tables in this markdown file (e.g. docs/performance.md).
-        #[arg(long)]
-        doc: Option<PathBuf>,
-        /// Name of the doc section and chart (`bench-NAME`); default: the --backend value.
-        #[arg(long)]
-        section: Option<String>,
-    },
+    Bench(BenchArgs),
+}
+
+/// `lme-mpm bench`'s arguments.
+#[derive(clap::Args, Debug)]
+struct BenchArgs {
+    /// Backends to measure.
+    #[arg(long, value_enum, default_value_t = BenchBackends::Both)]
+    backend: BenchBackends,
+    /// GPU adapter (part of its name); an error with --backend cpu.
+    #[arg(long)]
+    adapter: Option<String>,
+    /// Particle counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
+    particles: Vec<usize>,
+    /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
+    /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed),
+    /// lme-g3-mohr-coulomb (elastoplastic), bspline2, bspline3, bspline2-mls, bspline3-mls,
+    /// linear-scatter, linear-patch, bspline2-gather, bspline2-scatter, lme-g3-gather (GPU:
+    /// p2g and forces scattered per particle with float atomics, gathered at nodes, or
+    /// scattered per bin summing in registers first, whichever the case does not run by
+    /// default).
+    #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
+    cases: Vec<String>,
+    /// Seconds of stepping per point (after one warm-up step).
+    #[arg(long, default_value_t = 2.0)]
+    seconds: f64,
+    /// Folder for bench.csv.
+    #[arg(long, default_value = "out/bench")]
+    out: PathBuf,
+    /// Also rewrite the measured tables in this markdown file (e.g. docs/performance.md).
+    #[arg(long)]
+    doc: Option<PathBuf>,
+    /// Name of the doc section and chart (`bench-NAME`); default: the --backend value.
+    #[arg(long)]
+    section: Option<String>,
+    /// Also run a peer's throughput script after ours, in the same run, and
+    /// print our particle-steps/s over its at each size: `sh -c "COMMAND
+    /// N1,N2,…"` with the --particles counts appended; it must print lines
+    /// `NAME n=N steps=S wall=W particle-steps/s=X`. E.g. --peer
+    /// "../shared/bench/peer.sh vulkan" (Taichi's MLS-MPM, installed on first use).
+    #[arg(long, value_name = "COMMAND")]
+    peer: Option<String>,
 }
 
 /// Preflight limits of `run` and `check` (see docs/outputs.md).
@@ -316,24 +327,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Sweep(args) => sweep(args),
-        Command::Bench {
-            backend,
-            adapter,
-            particles,
-            cases,
-            seconds,
-            out,
-            doc,
-            section,
-        } => bench(
-            backend,
-            adapter.as_deref(),
-            &particles,
-            &cases,
-            seconds,
-            &out,
-            doc.as_deref().map(|d| (d, section.as_deref())),
-        ),
+        Command::Bench(args) => bench(&args),
         Command::Check { scene, set, limits } => {
             let scene = match load(&scene, &set) {
                 Ok(s) => s,
@@ -690,16 +684,16 @@ fn info() -> ExitCode {
     ExitCode::SUCCESS
 }
 
-fn bench(
-    backends: BenchBackends,
-    adapter: Option<&str>,
-    particles: &[usize],
-    cases: &[String],
-    seconds: f64,
-    out: &std::path::Path,
-    doc: Option<(&std::path::Path, Option<&str>)>,
-) -> ExitCode {
+fn bench(args: &BenchArgs) -> ExitCode {
     use lme_mpm::bench;
+    let (backends, adapter, particles, seconds) = (
+        args.backend,
+        args.adapter.as_deref(),
+        &args.particles,
+        args.seconds,
+    );
+    let (cases, out, peer) = (&args.cases, args.out.as_path(), args.peer.as_deref());
+    let doc = args.doc.as_deref().map(|d| (d, args.section.as_deref()));
     if let Some(code) =
         adapter_without_gpu(&adapter.map(String::from), backends == BenchBackends::Cpu)
     {
@@ -751,6 +745,28 @@ fn bench(
     let ratios = bench::ratios(&points);
     if !ratios.is_empty() {
         println!("\n{}", bench::ratio_table(&ratios));
+    }
+    // The peer right after ours, so both see the same machine; a failing
+    // peer costs its rows only, never ours.
+    let mut peer_failed = None;
+    if let Some(command) = peer {
+        eprintln!("bench: running the peer `{command}`");
+        match bench::peer(command, particles) {
+            Ok(p) => {
+                for q in &p {
+                    println!("{}", bench::table_row(q));
+                }
+                points.extend(p);
+            }
+            Err(e) => {
+                eprintln!("error: {e}; bench.csv keeps our points");
+                peer_failed = Some(e);
+            }
+        }
+    }
+    let against_peer = bench::peer_table(&points);
+    if let Some(t) = &against_peer {
+        println!("\n{t}");
     }
     if let Err(e) = std::fs::create_dir_all(out) {
         eprintln!("error: cannot create {}: {e}", out.display());
@@ -811,6 +827,10 @@ fn bench(
             body.push('\n');
             body.push_str(&bench::ratio_table(&ratios));
         }
+        if let Some(t) = &against_peer {
+            body.push('\n');
+            body.push_str(t);
+        }
         body.push_str(&format!(
             "\n![particle-steps per second against particles](charts/bench-{name}.png)\n"
         ));
@@ -819,5 +839,9 @@ fn bench(
             return fail(&e);
         }
     }
-    ExitCode::SUCCESS
+    match peer_failed {
+        // Said above, when it failed.
+        Some(e) => ExitCode::from(e.exit_code() as u8),
+        None => ExitCode::SUCCESS,
+    }
 }

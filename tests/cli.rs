@@ -772,3 +772,56 @@ fn bad_boundaries_exit_2_naming_the_key() {
         assert!(!out.exists(), "{what}: output folder was created");
     }
 }
+
+#[test]
+fn bench_runs_a_named_peer_after_ours_and_prints_the_ratio() {
+    // A stand-in for ../shared/bench/peer.sh: it receives the particle
+    // counts as one argument and prints one line per count (and noise).
+    let dir = tmp("bench-peer");
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("peer.sh");
+    std::fs::write(
+        &script,
+        "echo 'starting'\nfor n in $(echo \"$1\" | tr , ' '); do\n  echo \"fake-peer n=$n steps=10 wall=1.0 particle-steps/s=1.000e3\"\ndone\n",
+    )
+    .unwrap();
+    let out = dir.join("bench");
+    let peer = format!("sh {}", script.display());
+    let o = bin()
+        .args(["bench", "--backend", "cpu", "--cases", "linear"])
+        .args(["--particles", "2000", "--seconds", "0.2", "--peer", &peer])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("| fake-peer | 2000 | 10 |"), "{text}");
+    // Our row over the peer's 1e3 particle-steps/s.
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("| cpu") && l.contains("1.000e3"))
+        .unwrap_or_else(|| panic!("no ratio row: {text}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    let ours: f64 = cells[4].parse().unwrap();
+    let ratio: f64 = cells[6].parse().unwrap();
+    assert!((ratio - ours / 1e3).abs() <= 0.01 * ratio, "{row}");
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert!(csv.contains("fake-peer,2000,10,"), "{csv}");
+
+    // A failing peer costs its rows only: ours are written, exit 1.
+    let o = bin()
+        .args(["bench", "--backend", "cpu", "--cases", "linear"])
+        .args(["--particles", "2000", "--seconds", "0.2", "--peer", "false"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("peer"), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert!(
+        csv.contains("linear,") && !csv.contains("fake-peer"),
+        "{csv}"
+    );
+}

@@ -199,13 +199,13 @@ pub fn jobs(quick: bool) -> Vec<Job> {
     out
 }
 
+/// The disk's completed runs: (scheme, method, Δt index) → (eq. 67 error
+/// %, wall s, Newton iterations per step).
+type DiskRuns<'a> = std::collections::BTreeMap<(&'a str, &'a str, usize), (f64, f64, Option<f64>)>;
+
 /// The disk's implicit runs against the explicit ones at the same Δt
 /// index, per shape: error, wall-time ratio, Newton iterations per step.
-fn disk_findings(
-    md: &mut String,
-    done: &std::collections::BTreeMap<(&str, &str, usize), (f64, f64, Option<f64>)>,
-    n: usize,
-) {
+fn disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
     let mut lines = Vec::new();
     let mut spread: Vec<f64> = Vec::new();
     for (label, _) in SHAPES {
@@ -799,9 +799,7 @@ impl Report<'_> {
         let mut curves = Vec::new();
         // "implicit linear: Δt1 at 0.0443 s, …" per series with a stopped run.
         let mut stopped_text = Vec::new();
-        // (scheme, method, Δt index) → (error %, wall s, Newton iterations per step).
-        let mut done: std::collections::BTreeMap<(&str, &str, usize), (f64, f64, Option<f64>)> =
-            Default::default();
+        let mut done = DiskRuns::new();
         for (scheme, dashed) in [("implicit", false), ("explicit", true)] {
             for (ci, (label, _)) in SHAPES.iter().enumerate() {
                 let mut row = vec![scheme.to_string(), label.to_string()];
