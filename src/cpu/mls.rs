@@ -206,13 +206,14 @@ impl Mls {
 
     /// Visits every particle within 3h of any of the 4 Gauss points of
     /// integration cell `ic`, passing its packed data, [Δx, Δy] per Gauss
-    /// point in units of h, and the weight w per Gauss point.
+    /// point in units of h, the weight w per Gauss point, and its index in
+    /// the binned order.
     #[inline]
     fn neighbours(
         &self,
         grid: &Grid,
         ic: usize,
-        mut visit: impl FnMut(&[f64; 8], &[[f64; 2]; 4], &[f64; 4]),
+        mut visit: impl FnMut(&[f64; 8], &[[f64; 2]; 4], &[f64; 4], usize),
     ) {
         let g0 = 4 * ic;
         let lo = grid.logical(self.gp_x[g0]);
@@ -230,7 +231,7 @@ impl Mls {
         for j in j0..=j1 {
             let row = j * self.cells[0];
             let (s, e) = (self.cell_start[row + i0], self.cell_start[row + i1 + 1]);
-            for q in &self.packed[s as usize..e as usize] {
+            for (k, q) in self.packed[s as usize..e as usize].iter().enumerate() {
                 let d = [
                     (q[0] - gx[0]) * inv_h,
                     (q[0] - gx[1]) * inv_h,
@@ -251,6 +252,7 @@ impl Mls {
                     q,
                     &[[d[0], d[2]], [d[1], d[2]], [d[0], d[3]], [d[1], d[3]]],
                     &[w[0] * w[2], w[1] * w[2], w[0] * w[3], w[1] * w[3]],
+                    s as usize + k,
                 );
             }
         }
@@ -266,7 +268,7 @@ impl Mls {
                 return;
             }
             let c = &self.coef[4 * ic..4 * ic + 4];
-            self.neighbours(grid, ic, |q, d, w| {
+            self.neighbours(grid, ic, |q, d, w, _| {
                 for k in 0..4 {
                     let phi = w[k] * (c[k][0] + c[k][1] * d[k][0] + c[k][2] * d[k][1]);
                     for f in 0..F {
@@ -316,7 +318,7 @@ impl Mls {
                 // Per Gauss point: A (a00 a01 a02 a11 a12 a22) and the moments Σ w p f.
                 let mut am = [[0.0f64; 6]; 4];
                 let mut mom = [[[0.0f64; 3]; 3]; 4];
-                this.neighbours(grid, ic, |q, d, w| {
+                this.neighbours(grid, ic, |q, d, w, _| {
                     for k in 0..4 {
                         let (wk, dx, dy) = (w[k], d[k][0], d[k][1]);
                         let m = &mut am[k];
@@ -448,6 +450,62 @@ impl Mls {
                 o[2] += nw * val[1];
             }
         });
+    }
+
+    /// Diagnostic, not a stage: the transpose of the fit's quadrature,
+    /// out_p = Σ_g ω_g φ_gp val_g, and V̂_p = Σ_g ω_g φ_gp (the volume the
+    /// fit's quadrature gives particle p), per particle in particle order,
+    /// with this step's coefficients and the particles' positions at the
+    /// step's start (as `p2g` packed them). Since f_I = −Σ_g ω_g σ_g ∇N_I(x_g)
+    /// with σ_g = Σ_p φ_gp σ_p, the strain rate that does the work of those
+    /// forces is V_p L_p = Σ_g ω_g φ_gp ∇v(x_g), and the particle velocity
+    /// change that conserves the nodal momentum q_I = Σ_g N_I (ρv)_g ω_g is
+    /// m_p Δv_p = ρ_p Σ_g ω_g φ_gp Δv(x_g). `tests/mls_reconstruction.rs`
+    /// builds the energy-consistent step from these (docs/methods.md,
+    /// "Why MLS is less accurate"). Sequential: it is for tests.
+    pub fn transpose<const K: usize>(
+        &self,
+        grid: &Grid,
+        val: &[[f64; K]],
+        out: &mut [[f64; K]],
+        vhat: &mut [f64],
+    ) {
+        out.fill([0.0; K]);
+        vhat.fill(0.0);
+        for ic in (0..self.occupied.len()).filter(|&ic| self.occupied[ic]) {
+            let c = &self.coef[4 * ic..4 * ic + 4];
+            self.neighbours(grid, ic, |_, d, w, k| {
+                let p = self.order[k] as usize;
+                for (j, cj) in c.iter().enumerate() {
+                    let g = 4 * ic + j;
+                    let phi = w[j] * (cj[0] + cj[1] * d[j][0] + cj[2] * d[j][1]);
+                    let wphi = self.gp_w[g] * phi;
+                    vhat[p] += wphi;
+                    for f in 0..K {
+                        out[p][f] += wphi * val[g][f];
+                    }
+                }
+            });
+        }
+    }
+
+    /// Diagnostic, not a stage: a nodal field `nodal[I] = [_, ux, uy]` (the
+    /// layout of `mv` after `grid_update::predict`) and its gradient at every
+    /// Gauss point, [ux, uy, ∂ux/∂x, ∂ux/∂y, ∂uy/∂x, ∂uy/∂y].
+    pub fn at_gauss_points(&self, nodal: &[[f64; 3]], out: &mut [[f64; 6]]) {
+        for (g, o) in out.iter_mut().enumerate() {
+            let (nodes, w) = self.gp_shape.particle(g);
+            *o = [0.0; 6];
+            for (&n, wk) in nodes.iter().zip(w) {
+                let u = nodal[n as usize];
+                o[0] += wk[0] * u[1];
+                o[1] += wk[0] * u[2];
+                o[2] += wk[1] * u[1];
+                o[3] += wk[2] * u[1];
+                o[4] += wk[1] * u[2];
+                o[5] += wk[2] * u[2];
+            }
+        }
     }
 }
 
