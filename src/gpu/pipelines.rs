@@ -330,7 +330,6 @@ impl Variant {
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
             .flag("EXT_FORCE", self.ext_force)
-            .flag("GATHER", self.gather)
             .flag("ANCHOR_BINS", self.gather || self.patch)
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
@@ -390,35 +389,42 @@ pub fn lme_side(model: &Model) -> u32 {
     }
 }
 
-/// Expands a pass's WGSL for `d`, adding the pass's own flag. (GATHER is
-/// the variant's: it also changes `bin_count`; a scatter pass expands
-/// without it.)
+/// Expands a pass's WGSL for `d`, adding the pass's own flags: WALK where
+/// the pass puts per-particle terms on nodes through shared/bins.wgsl's
+/// walks, GATHER or PATCH for which walk.
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
-    if matches!(
-        pass,
-        Pass::P2g
-            | Pass::Forces
-            | Pass::StressForces
-            | Pass::P2gPatch
-            | Pass::ForcesPatch
-            | Pass::StressForcesPatch
-    ) {
-        d.flag("GATHER", false);
-    }
-    d.flag("CORRECT", pass == Pass::GridCorrect)
-        .flag(
-            "PATCH",
-            matches!(
-                pass,
-                Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
-            ),
-        )
-        .flag(
-            "FORCES",
-            matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
-        )
-        .flag("CLEAR", pass == Pass::RemapClear);
+    d.flag(
+        "WALK",
+        matches!(
+            pass,
+            Pass::P2g
+                | Pass::P2gGather
+                | Pass::P2gPatch
+                | Pass::Forces
+                | Pass::ForcesGather
+                | Pass::ForcesPatch
+                | Pass::StressForces
+                | Pass::StressForcesPatch
+        ),
+    )
+    .flag(
+        "GATHER",
+        matches!(pass, Pass::P2gGather | Pass::ForcesGather),
+    )
+    .flag("CORRECT", pass == Pass::GridCorrect)
+    .flag(
+        "PATCH",
+        matches!(
+            pass,
+            Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
+        ),
+    )
+    .flag(
+        "FORCES",
+        matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
+    )
+    .flag("CLEAR", pass == Pass::RemapClear);
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
