@@ -31,7 +31,7 @@ pub enum Pass {
     P2g,
     P2gGather,
     /// p2g.wgsl built with PATCH: one invocation per bin of particles that
-    /// share a stencil (linear and B-splines on a regular grid), summing
+    /// share a stencil (linear and B-splines on a regular grid, LME), summing
     /// their contributions in registers, then one atomic per node and
     /// component of the stencil.
     P2gPatch,
@@ -161,7 +161,7 @@ impl Pass {
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
-            Stage::ShapeEval if plan.gather && plan.lme => {
+            Stage::ShapeEval if (plan.gather || plan.patch) && plan.lme => {
                 &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
             }
             Stage::ShapeEval if plan.gather || plan.patch => &BINS,
@@ -242,8 +242,8 @@ pub struct Variant {
     pub bspline_small_grid: bool,
     /// `p2g` and `forces` (and the fused `StressForces`) scatter per bin of
     /// particles that share their stencil's anchor, summing in registers
-    /// before the atomics (PATCH): linear and B-splines on a regular grid
-    /// where they do not gather (`GpuOptions::patches`).
+    /// before the atomics (PATCH): linear and B-splines on a regular grid,
+    /// LME, where they do not gather (`GpuOptions::patches`).
     pub patch: bool,
 }
 
@@ -736,10 +736,11 @@ mod tests {
                             assert!(b.iter().any(|b| b.buf == Buf::Mass));
                             checked += 1;
                             // The per-bin variant, where it applies.
-                            if matches!(
-                                shape,
-                                ShapeKind::Linear | ShapeKind::Bspline2 | ShapeKind::Bspline3
-                            ) && !perturbed
+                            if shape == ShapeKind::Lme
+                                || matches!(
+                                    shape,
+                                    ShapeKind::Linear | ShapeKind::Bspline2 | ShapeKind::Bspline3
+                                ) && !perturbed
                             {
                                 let v = Variant { patch: true, ..v };
                                 let src = expand(Pass::StressForcesPatch, &v.defines()).unwrap();
@@ -754,6 +755,6 @@ mod tests {
             }
         }
         assert_eq!(checked, 120);
-        assert_eq!(patched, 36);
+        assert_eq!(patched, 60);
     }
 }
