@@ -31,21 +31,25 @@ fn largest_exponent(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>) -> f32 {
     return fmax;
 }
 
-// One pass over the box with every exponent shifted by `shift`; `z` is the
-// shifted sum, kept to tell an underflow.
+// One pass over the box's slots that may lie in the support (`lme_span`)
+// with every exponent shifted by `shift`; `z` is the shifted sum, kept to
+// tell an underflow.
 fn objective_shifted(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>, shift: f32) -> Objective {
     var z = 0.0;
     var r = vec2<f32>(0.0);
     var m = vec3<f32>(0.0);
     var count = 0u;
-    for (var k = 0u; k < STENCIL; k++) {
-        let a = lme_node(x, b.x, b.y, k);
-        if a.ok {
-            let e = exp(-params.lme_beta * dot(a.d, a.d) + dot(lam, a.d) - shift);
-            z += e;
-            r += e * a.d;
-            m += e * vec3<f32>(a.d.x * a.d.x, a.d.x * a.d.y, a.d.y * a.d.y);
-            count += 1u;
+    for (var row = 0u; row < SHAPE_WIDTH; row++) {
+        let span = lme_span(x, b.x, b.y, row);
+        for (var k = span.x; k < span.y; k++) {
+            let a = lme_node(x, b.x, b.y, k);
+            if a.ok {
+                let e = exp(-params.lme_beta * dot(a.d, a.d) + dot(lam, a.d) - shift);
+                z += e;
+                r += e * a.d;
+                m += e * vec3<f32>(a.d.x * a.d.x, a.d.x * a.d.y, a.d.y * a.d.y);
+                count += 1u;
+            }
         }
     }
     var o: Objective;

@@ -64,14 +64,17 @@ fn update_particle(p: u32, c: ShapeCtx) -> Updated {
     out.ok = false;
     // Velocity gradient L = Σ v ⊗ ∇N as (xx, xy, yx, yy).
     var l = vec4<f32>(0.0);
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
+    for (var r = 0u; r < SHAPE_ROWS; r++) {
+        let span = shape_span(c, r);
+        for (var k = span.x; k < span.y; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            let b = w.node * NODE_STRIDE;
+            let vn = vec2<f32>(node_value(b + 1u), node_value(b + 2u));
+            l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
         }
-        let b = w.node * NODE_STRIDE;
-        let vn = vec2<f32>(node_value(b + 1u), node_value(b + 2u));
-        l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
     }
     let dt = sim.dt;
 #if DEF_GRAD

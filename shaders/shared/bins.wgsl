@@ -95,12 +95,15 @@ fn gather_node(i: u32, j: u32) -> BinSum {
 // Particle-centred: particle (c, q) adds its term to each node of its
 // stencil with atomics.
 fn scatter_particle(c: ShapeCtx, q: BinParticle) {
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
+    for (var r = 0u; r < SHAPE_ROWS; r++) {
+        let span = shape_span(c, r);
+        for (var k = span.x; k < span.y; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            bin_add(w.node, bin_term(q, w));
         }
-        bin_add(w.node, bin_term(q, w));
     }
 }
 
@@ -137,13 +140,16 @@ fn scatter_bin(b: u32) {
             scatter_particle(c, q);
             continue;
         }
-        for (var k = 0u; k < STENCIL; k++) {
-            let w = shape_node(c, k);
-            if !w.ok {
-                continue;
+        for (var r = 0u; r < SHAPE_ROWS; r++) {
+            let span = shape_span(c, r);
+            for (var k = span.x; k < span.y; k++) {
+                let w = shape_node(c, k);
+                if !w.ok {
+                    continue;
+                }
+                node[k] = w.node;
+                sum[k] += bin_term(q, w);
             }
-            node[k] = w.node;
-            sum[k] += bin_term(q, w);
         }
     }
     for (var k = 0u; k < STENCIL; k++) {
