@@ -2,6 +2,9 @@
 //! scene, for docs/performance.md. Not part of `cargo test`.
 //! LME_MPM_PROFILE_CASES=linear,bspline2,lme-g3, LME_MPM_PROFILE_COUNT=100000,
 //! LME_MPM_PROFILE_STEPS=5, LME_MPM_PROFILE_BACKEND=cpu|gpu|both.
+//! Columns: wall ns per particle-step, its share, and (GPU) the process's
+//! CPU time per particle-step, steadier than the wall time on a shared
+//! machine when the adapter is a software one.
 
 use lme_mpm::bench;
 
@@ -26,13 +29,17 @@ fn main() {
             .unwrap_or_else(|| panic!("unknown case {name}"));
         let report = |what: &str, r: Vec<bench::StageTime>| {
             let total: f64 = r.iter().map(|s| s.ns_per_particle_step).sum();
-            println!("\n{what} {name} {count}: {total:.1} ns/particle-step");
+            let cpu: f64 = r.iter().map(|s| s.cpu_ns_per_particle_step).sum();
+            println!(
+                "\n{what} {name} {count}: {total:.1} ns/particle-step (process CPU time {cpu:.1})"
+            );
             for s in r {
                 println!(
-                    "| {:<12} | {:>7.1} | {:>4.0}% |",
+                    "| {:<12} | {:>7.1} | {:>4.0}% | {:>7.1} |",
                     s.name,
                     s.ns_per_particle_step,
-                    100.0 * s.ns_per_particle_step / total
+                    100.0 * s.ns_per_particle_step / total,
+                    s.cpu_ns_per_particle_step
                 );
             }
         };

@@ -28,16 +28,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let c = shape_ctx(p, x0[p] + u[p]);
     var acc = vec2<f32>(0.0);
     var vel = vec2<f32>(0.0);
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
-        }
-        let b = w.node * NODE_STRIDE;
-        let m = node_acc[b];
-        if m > params.mass_eps {
-            acc += w.n * vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]) / m;
-            vel += w.n * vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]);
+    for (var r = 0u; r < SHAPE_ROWS; r++) {
+        let span = shape_span(c, r);
+        for (var k = span.x; k < span.y; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            let b = w.node * NODE_STRIDE;
+            let m = node_acc[b];
+            if m > params.mass_eps {
+                acc += w.n * vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]) / m;
+                vel += w.n * vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]);
+            }
         }
     }
     let vp = v[p] + dt * acc;

@@ -12,13 +12,15 @@
 // log Z, r = ∂ log Z/∂λ, J = ∂r/∂λ ([00, 01, 11]) and the support size.
 struct Objective {
     log_z: f32,
+    // Sum of the shifted exponentials (objective_shifted).
+    z: f32,
     r: vec2<f32>,
     j: vec3<f32>,
     count: u32,
 }
 
-fn objective(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>) -> Objective {
-    // Two passes over the box: the largest exponent first, so exp never overflows.
+// The largest exponent −β|d|² + λ·d over the support.
+fn largest_exponent(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>) -> f32 {
     var fmax = -3.0e38;
     for (var k = 0u; k < STENCIL; k++) {
         let a = lme_node(x, b.x, b.y, k);
@@ -26,25 +28,49 @@ fn objective(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>) -> Objective {
             fmax = max(fmax, -params.lme_beta * dot(a.d, a.d) + dot(lam, a.d));
         }
     }
+    return fmax;
+}
+
+// One pass over the box's slots that may lie in the support (`lme_span`)
+// with every exponent shifted by `shift`; `z` is the shifted sum, kept to
+// tell an underflow.
+fn objective_shifted(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>, shift: f32) -> Objective {
     var z = 0.0;
     var r = vec2<f32>(0.0);
     var m = vec3<f32>(0.0);
     var count = 0u;
-    for (var k = 0u; k < STENCIL; k++) {
-        let a = lme_node(x, b.x, b.y, k);
-        if a.ok {
-            let e = exp(-params.lme_beta * dot(a.d, a.d) + dot(lam, a.d) - fmax);
-            z += e;
-            r += e * a.d;
-            m += e * vec3<f32>(a.d.x * a.d.x, a.d.x * a.d.y, a.d.y * a.d.y);
-            count += 1u;
+    for (var row = 0u; row < SHAPE_WIDTH; row++) {
+        let span = lme_span(x, b.x, b.y, row);
+        for (var k = span.x; k < span.y; k++) {
+            let a = lme_node(x, b.x, b.y, k);
+            if a.ok {
+                let e = exp(-params.lme_beta * dot(a.d, a.d) + dot(lam, a.d) - shift);
+                z += e;
+                r += e * a.d;
+                m += e * vec3<f32>(a.d.x * a.d.x, a.d.x * a.d.y, a.d.y * a.d.y);
+                count += 1u;
+            }
         }
     }
     var o: Objective;
     o.count = count;
+    o.z = z;
     o.r = r / z;
     o.j = m / z - vec3<f32>(o.r.x * o.r.x, o.r.x * o.r.y, o.r.y * o.r.y);
-    o.log_z = fmax + log(z);
+    o.log_z = shift + log(z);
+    return o;
+}
+
+// One pass, shifted by |λ|²/(4β): the largest value −β|d|² + λ·d takes
+// over all d, so no term overflows and the largest is within the box's
+// reach of 1. Every term underflows only if |λ| is tens of times 1/h (a
+// particle pinned to the grid's edge); then a first pass finds the largest
+// exponent to shift by, as this solve always did before (two passes).
+fn objective(x: vec2<f32>, b: vec2<u32>, lam: vec2<f32>) -> Objective {
+    var o = objective_shifted(x, b, lam, dot(lam, lam) / (4.0 * params.lme_beta));
+    if !(o.z >= 1e-30) {
+        o = objective_shifted(x, b, lam, largest_exponent(x, b, lam));
+    }
     return o;
 }
 

@@ -6,7 +6,8 @@
 // binned near it (shared/bins.wgsl, binned in `shape_eval`) and writes its
 // sums once, without atomics; or, built with PATCH, one invocation per bin
 // of particles sharing a stencil sums them in registers before the
-// atomics. The sums are the same, in another order.
+// atomics. The sums are the same, in another order. The walks are
+// shared/bins.wgsl's; this pass defines what a particle puts on a node.
 // CPU twin: src/cpu/p2g.rs (a scatter into private grids).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -33,106 +34,60 @@ fn p2g_velocity(p: u32) -> vec2<f32> {
 }
 
 #if GATHER
-#include "shared/bins.wgsl"
-@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
-@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
-
-@compute @workgroup_size(256)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let n = linear_index(gid, nwg);
-    if sim.running == 0u || n >= params.n_nodes {
-        return;
-    }
-    let i = n % params.nx;
-    let j = n / params.nx;
-    let cells = cells_reaching(i, j);
-    // (mass, momentum x, momentum y)
-    var sum = vec3<f32>(0.0);
-    for (var cj = cells.lo.y; cj <= cells.hi.y; cj++) {
-        let row = cj * (params.nx - 1u);
-        let end = cell_start[row + cells.hi.x + 1u];
-        for (var idx = cell_start[row + cells.lo.x]; idx < end; idx++) {
-            let p = cell_order[idx];
-            let w = shape_at(shape_ctx(p, x0[p] + u[p]), i, j);
-            if !w.ok {
-                continue;
-            }
-            let nm = w.n * mass[p];
-            let vel = p2g_velocity(p);
-            sum += vec3<f32>(nm, nm * vel.x, nm * vel.y);
-        }
-    }
-    let base = n * NODE_STRIDE;
-    node_acc[base] = sum.x;
-    node_acc[base + 1u] = sum.y;
-    node_acc[base + 2u] = sum.z;
-}
-#elif PATCH
-#include "shared/bins.wgsl"
-@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
-@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
-@group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
-
-#include "shared/atomics.wgsl" ARR=node_acc FN=node_add
-
-// One invocation per bin: its particles share their stencil (binned by its
-// anchor), so their sums go to one patch of STENCIL nodes in registers,
-// then one atomic per node and component, not one per particle.
-@compute @workgroup_size(256)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let b = linear_index(gid, nwg);
-    if sim.running == 0u || b >= bin_count_all() {
-        return;
-    }
-    let end = cell_start[b + 1u];
-    // (mass, momentum x, momentum y) per stencil slot.
-    var sum: array<vec3<f32>, STENCIL>;
-    var node: array<u32, STENCIL>;
-    for (var k = 0u; k < STENCIL; k++) {
-        node[k] = NO_PATCH_NODE;
-    }
-    for (var idx = cell_start[b]; idx < end; idx++) {
-        let p = cell_order[idx];
-        let c = shape_ctx(p, x0[p] + u[p]);
-        if !shape_valid(c) {
-            continue; // reported by bin_count
-        }
-        let m = mass[p];
-        let vel = p2g_velocity(p);
-        for (var k = 0u; k < STENCIL; k++) {
-            let w = shape_node(c, k);
-            if !w.ok {
-                continue;
-            }
-            node[k] = w.node;
-            let nm = w.n * m;
-            sum[k] += vec3<f32>(nm, nm * vel.x, nm * vel.y);
-        }
-    }
-    for (var k = 0u; k < STENCIL; k++) {
-        if node[k] == NO_PATCH_NODE {
-            continue;
-        }
-        let base = node[k] * NODE_STRIDE;
-        node_add(base, sum[k].x);
-        node_add(base + 1u, sum[k].y);
-        node_add(base + 2u, sum[k].z);
-    }
-}
 #else
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<{{ATOMIC_T}}>;
 
 #include "shared/atomics.wgsl" ARR=node_acc FN=node_add
 
+fn bin_add(node: u32, s: BinSum) {
+    let base = node * NODE_STRIDE;
+    node_add(base, s.x);
+    node_add(base + 1u, s.y);
+    node_add(base + 2u, s.z);
+}
+#endif
+
+#include "shared/bins.wgsl"
+
+// What the walks of shared/bins.wgsl sum per node: mass and momentum.
+alias BinSum = vec3<f32>;
+
+struct BinParticle {
+    ok: bool,
+    m: f32,
+    vel: vec2<f32>,
+}
+
+fn bin_particle(p: u32, c: ShapeCtx) -> BinParticle {
+    return BinParticle(shape_valid(c), mass[p], p2g_velocity(p));
+}
+
+fn bin_term(q: BinParticle, w: NodeW) -> BinSum {
+    let nm = w.n * q.m;
+    return vec3<f32>(nm, nm * q.vel.x, nm * q.vel.y);
+}
+
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+#if GATHER
+    let n = linear_index(gid, nwg);
+    if sim.running == 0u || n >= params.n_nodes {
+        return;
+    }
+    let sum = gather_node(n % params.nx, n / params.nx);
+    let base = n * NODE_STRIDE;
+    node_acc[base] = sum.x;
+    node_acc[base + 1u] = sum.y;
+    node_acc[base + 2u] = sum.z;
+#elif PATCH
+    // Particles outside the grid are reported by bin_count.
+    scatter_bin(linear_index(gid, nwg));
+#else
     let p = linear_index(gid, nwg);
     if sim.running == 0u || p >= params.n_particles {
         return;
     }
-    let m = mass[p];
-    let vel = p2g_velocity(p);
 #if MUSL
     // The step's start positions, for the remap and the stress after g2p.
     x_start[p] = x0[p] + u[p];
@@ -142,16 +97,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         report_fault(FAULT_LEFT_GRID, p);
         return;
     }
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
-        }
-        let nm = w.n * m;
-        let base = w.node * NODE_STRIDE;
-        node_add(base, nm);
-        node_add(base + 1u, nm * vel.x);
-        node_add(base + 2u, nm * vel.y);
-    }
-}
+    scatter_particle(c, bin_particle(p, c));
 #endif
+}

@@ -7,7 +7,8 @@
 // is all `forces` needs from it), saving a pass over the particles and a
 // shape evaluation; the stages stay separate passes for parity tests. Built
 // with FORCES and PATCH, one invocation per bin of particles that share a
-// stencil runs both for each of them and sums the forces in registers.
+// stencil runs both for each of them and sums the forces in registers (the
+// walks are shared/bins.wgsl's).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -32,13 +33,8 @@
 
 #include "shared/atomics.wgsl" ARR=node_acc FN=node_add
 
-#include "shared/body_force.wgsl"
-
-#if PATCH
 #include "shared/bins.wgsl"
-@group(0) @binding({{B_CELL_START}}) var<storage, read> cell_start: array<u32>;
-@group(0) @binding({{B_CELL_ORDER}}) var<storage, read> cell_order: array<u32>;
-#endif
+#include "shared/body_force.wgsl"
 
 fn node_value(i: u32) -> f32 {
 #if FLOAT_ATOMICS
@@ -68,14 +64,17 @@ fn update_particle(p: u32, c: ShapeCtx) -> Updated {
     out.ok = false;
     // Velocity gradient L = Σ v ⊗ ∇N as (xx, xy, yx, yy).
     var l = vec4<f32>(0.0);
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
+    for (var r = 0u; r < SHAPE_ROWS; r++) {
+        let span = shape_span(c, r);
+        for (var k = span.x; k < span.y; k++) {
+            let w = shape_node(c, k);
+            if !w.ok {
+                continue;
+            }
+            let b = w.node * NODE_STRIDE;
+            let vn = vec2<f32>(node_value(b + 1u), node_value(b + 2u));
+            l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
         }
-        let b = w.node * NODE_STRIDE;
-        let vn = vec2<f32>(node_value(b + 1u), node_value(b + 2u));
-        l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
     }
     let dt = sim.dt;
 #if DEF_GRAD
@@ -116,53 +115,29 @@ fn update_particle(p: u32, c: ShapeCtx) -> Updated {
     return out;
 }
 
-#if PATCH
-// With FORCES: one invocation per bin of particles sharing a stencil
-// (p2g.wgsl's PATCH): each particle's stress, then its forces summed in
-// registers, then one atomic per node and component.
-@compute @workgroup_size(256)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let b = linear_index(gid, nwg);
-    if sim.running == 0u || b >= bin_count_all() {
-        return;
-    }
-    let t = sim.t + sim.t_lo + sim.dt;
-    let end = cell_start[b + 1u];
-    var fs: array<vec2<f32>, STENCIL>;
-    var node: array<u32, STENCIL>;
-    for (var k = 0u; k < STENCIL; k++) {
-        node[k] = NO_PATCH_NODE;
-    }
-    for (var idx = cell_start[b]; idx < end; idx++) {
-        let p = cell_order[idx];
-        let c = shape_ctx(p, x0[p] + u[p]);
-        let up = update_particle(p, c);
-        if !up.ok {
-            continue;
-        }
+#if FORCES
+// What the walks of shared/bins.wgsl (the scatter, or with PATCH the
+// per-bin one) take from a particle: its stress update, then its volume,
+// new stress and body force for the forces.
+fn bin_particle(p: u32, c: ShapeCtx) -> BinParticle {
+    var q: BinParticle;
+    let up = update_particle(p, c);
+    q.ok = up.ok;
+    if up.ok {
         let m = mass[p];
-        let vol = m / up.rho;
-        let mb = m * body_force(p, t);
-        for (var k = 0u; k < STENCIL; k++) {
-            let w = shape_node(c, k);
-            if !w.ok {
-                continue;
-            }
-            node[k] = w.node;
-            fs[k] += node_force(w, vol, up.s, mb);
-        }
+        q.vol = m / up.rho;
+        q.s = up.s;
+        q.mb = m * body_force(p, sim.t + sim.t_lo + sim.dt);
     }
-    for (var k = 0u; k < STENCIL; k++) {
-        if node[k] == NO_PATCH_NODE {
-            continue;
-        }
-        node_add(node[k] * NODE_STRIDE + 3u, fs[k].x);
-        node_add(node[k] * NODE_STRIDE + 4u, fs[k].y);
-    }
+    return q;
 }
-#else
+#endif
+
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+#if PATCH
+    scatter_bin(linear_index(gid, nwg));
+#else
     let p = linear_index(gid, nwg);
     if sim.running == 0u || p >= params.n_particles {
         return;
@@ -174,15 +149,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #else
     let c = shape_ctx(p, x0[p] + u[p]);
 #endif
-    let up = update_particle(p, c);
-    if !up.ok {
-        return;
-    }
 #if FORCES
-    let m = mass[p];
-    let vol = m / up.rho;
-    let mb = m * body_force(p, sim.t + sim.t_lo + sim.dt);
-    add_particle_forces(c, vol, up.s, mb);
+    let q = bin_particle(p, c);
+    if q.ok {
+        scatter_particle(c, q);
+    }
+#else
+    _ = update_particle(p, c);
+#endif
 #endif
 }
-#endif

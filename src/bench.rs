@@ -66,6 +66,12 @@ pub fn extra_cases() -> Vec<Case> {
         p2g("bspline2-gather", &["solver.shape=bspline2"], true, false),
         p2g("bspline2-scatter", &["solver.shape=bspline2"], false, false),
         p2g(
+            "lme-g3-scatter",
+            &["solver.shape=lme", "solver.lme_gamma=3"],
+            false,
+            false,
+        ),
+        p2g(
             "lme-g3-gather",
             &["solver.shape=lme", "solver.lme_gamma=3"],
             true,
@@ -483,6 +489,22 @@ pub struct StageTime {
     pub name: String,
     /// Nanoseconds per particle-step.
     pub ns_per_particle_step: f64,
+    /// CPU time of the whole process (every thread, the software
+    /// adapter's included), nanoseconds per particle-step. On a shared
+    /// machine this moves less with the load than the wall time does, so
+    /// it is what A/B comparisons of a software adapter's passes use.
+    pub cpu_ns_per_particle_step: f64,
+}
+
+/// CPU time (user + system) of this process so far, every thread (s).
+fn process_cpu_seconds() -> f64 {
+    // SAFETY: getrusage writes the struct it is given and nothing else.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return 0.0;
+    }
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(u.ru_utime) + tv(u.ru_stime)
 }
 
 /// Per-stage breakdown of the CPU path: `steps` whole steps, each stage
@@ -508,6 +530,7 @@ pub fn profile_cpu(particles: usize, case: &Case, steps: u64) -> Result<Vec<Stag
         .map(|(s, t)| StageTime {
             name: format!("{s:?}"),
             ns_per_particle_step: t * 1e9 / (n * steps as f64),
+            cpu_ns_per_particle_step: f64::NAN,
         })
         .collect())
 }
@@ -535,17 +558,22 @@ pub fn profile_gpu(
     let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(gpu.plan()).collect();
     // Cost of a submission and wait alone.
     let start = Instant::now();
+    let cpu_start = process_cpu_seconds();
     for _ in 0..20 {
         gpu.read_sim()?;
     }
     let wait = start.elapsed().as_secs_f64() / 20.0;
+    let cpu_wait = (process_cpu_seconds() - cpu_start) / 20.0;
     let mut t = vec![0.0f64; passes.len()];
+    let mut c = vec![0.0f64; passes.len()];
     for _ in 0..steps {
         for (k, pass) in passes.iter().enumerate() {
             let start = Instant::now();
+            let cpu_start = process_cpu_seconds();
             gpu.run_pass(*pass);
             gpu.read_sim()?;
             t[k] += (start.elapsed().as_secs_f64() - wait).max(0.0);
+            c[k] += (process_cpu_seconds() - cpu_start - cpu_wait).max(0.0);
         }
     }
     if let Some(f) = gpu.fault() {
@@ -553,10 +581,11 @@ pub fn profile_gpu(
     }
     Ok(passes
         .iter()
-        .zip(t)
-        .map(|(p, t)| StageTime {
+        .zip(t.iter().zip(c))
+        .map(|(p, (t, c))| StageTime {
             name: format!("{p:?}"),
             ns_per_particle_step: t * 1e9 / (n * steps as f64),
+            cpu_ns_per_particle_step: c * 1e9 / (n * steps as f64),
         })
         .collect())
 }

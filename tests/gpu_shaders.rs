@@ -137,17 +137,19 @@ fn variants() -> Vec<Variant> {
                                         bspline_small_grid: multi_material,
                                         // Per-bin scatter where it applies and
                                         // the variant does not gather.
-                                        patch: !perturbed
-                                            && !mls
+                                        // (LME on any grid.)
+                                        patch: !mls
                                             && integrator != Integrator::Musl
                                             && multi_material
                                             && atomics == AtomicMode::Float
-                                            && matches!(
-                                                shape,
-                                                ShapeKind::Linear
-                                                    | ShapeKind::Bspline2
-                                                    | ShapeKind::Bspline3
-                                            ),
+                                            && (shape == ShapeKind::Lme
+                                                || !perturbed
+                                                    && matches!(
+                                                        shape,
+                                                        ShapeKind::Linear
+                                                            | ShapeKind::Bspline2
+                                                            | ShapeKind::Bspline3
+                                                    )),
                                     });
                                 }
                             }
@@ -178,7 +180,8 @@ fn every_pass_validates_in_every_variant() {
             let has = |b: Buf| binds.iter().any(|x| x.buf == b);
             assert_eq!(
                 has(Buf::NodePos),
-                v.perturbed && (pass_uses_shape(pass) || (pass == Pass::BinCount && v.gather)),
+                v.perturbed
+                    && (pass_uses_shape(pass) || (pass == Pass::BinCount && (v.gather || v.patch))),
                 "{pass:?} {v:?}: node_pos"
             );
             assert!(

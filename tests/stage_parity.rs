@@ -708,14 +708,16 @@ const GATHER: GpuOptions = GpuOptions {
     patch: None,
 };
 /// The scatters with float atomics, one invocation per particle, for linear
-/// shapes (which gather by default) and B-splines (which scatter per bin).
+/// shapes (which gather by default), B-splines and LME (which scatter per
+/// bin).
 const SCATTER: GpuOptions = GpuOptions {
     lme_stored: false,
     gather: Some(false),
     patch: Some(false),
 };
 /// The scatters per bin of particles sharing a stencil, summing in
-/// registers before the atomics (`GpuOptions::patch`; by default B-splines).
+/// registers before the atomics (`GpuOptions::patch`; by default B-splines
+/// and LME).
 const PATCH: GpuOptions = GpuOptions {
     lme_stored: false,
     gather: Some(false),
@@ -788,6 +790,31 @@ fn stages_match_gather_and_scatter() {
         &["solver.shape=bspline2"],
         false,
         SCATTER,
+    );
+    // LME scatters per bin by default (its search box is a box of logical
+    // node indices, shared by a bin's particles on any grid): the
+    // per-particle scatter stays tested here.
+    parity_with(
+        "lme npc, scatter per particle",
+        &["solver.shape=lme"],
+        false,
+        SCATTER,
+    );
+    parity_with(
+        "lme fe perturbed, scatter per particle, CAS atomics",
+        &[
+            "solver.shape=lme",
+            "grid.perturb=0.2",
+            "solver.integrator=fe",
+        ],
+        true,
+        SCATTER,
+    );
+    parity_with(
+        "lme npc perturbed, patch, γ 4",
+        &["solver.shape=lme", "grid.perturb=0.2", "solver.lme_gamma=4"],
+        false,
+        PATCH,
     );
     parity_with(
         "bspline3 fe, patch, CAS atomics",

@@ -66,19 +66,27 @@ fn node_force(w: NodeW, vol: f32, s: vec3<f32>, mb: vec2<f32>) -> vec2<f32> {
     return -vol * vec2<f32>(s.x * w.dn.x + s.z * w.dn.y, s.z * w.dn.x + s.y * w.dn.y) + w.n * mb;
 }
 
-#if !GATHER
-// The scatter: particle p (shape context c) adds `node_force` to each node
-// of its stencil. Shared by forces.wgsl and the fused stress.wgsl (FORCES).
-fn add_particle_forces(c: ShapeCtx, vol: f32, s: vec3<f32>, mb: vec2<f32>) {
-    for (var k = 0u; k < STENCIL; k++) {
-        let w = shape_node(c, k);
-        if !w.ok {
-            continue;
-        }
-        let f = node_force(w, vol, s, mb);
-        let base = w.node * NODE_STRIDE;
-        node_add(base + 3u, f.x);
-        node_add(base + 4u, f.y);
-    }
+#if WALK
+// What forces.wgsl and the fused stress.wgsl (FORCES) put through the
+// walks of shared/bins.wgsl: a particle's volume, stress and body force,
+// and its `node_force` on each node. Each pass defines `bin_particle`.
+alias BinSum = vec2<f32>;
+
+struct BinParticle {
+    ok: bool,
+    vol: f32,
+    s: vec3<f32>,
+    mb: vec2<f32>,
 }
+
+fn bin_term(q: BinParticle, w: NodeW) -> BinSum {
+    return node_force(w, q.vol, q.s, q.mb);
+}
+
+#if !GATHER
+fn bin_add(node: u32, f: BinSum) {
+    node_add(node * NODE_STRIDE + 3u, f.x);
+    node_add(node * NODE_STRIDE + 4u, f.y);
+}
+#endif
 #endif

@@ -1,6 +1,6 @@
 // The shape-function interface every particle stage uses:
 //   let c = shape_ctx(p, x);               // per-particle setup
-//   for (var k = 0u; k < STENCIL; k++) {
+//   for (var k = 0u; k < STENCIL; k++) {     // or per row r < SHAPE_ROWS over shape_span(c, r)
 //       let w = shape_node(c, k);          // k-th candidate node
 //       if !w.ok { continue; }
 //       ... w.node, w.n, w.dn ...

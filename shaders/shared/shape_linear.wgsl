@@ -42,3 +42,10 @@ fn shape_anchor(c: ShapeCtx) -> vec2<i32> {
 fn shape_slot(a: vec2<u32>) -> u32 {
     return select(a.x, 3u - a.x, a.y == 1u);
 }
+
+// One row: every slot (shape_lme.wgsl narrows its rows to the support).
+const SHAPE_ROWS: u32 = 1u;
+
+fn shape_span(c: ShapeCtx, r: u32) -> vec2<u32> {
+    return vec2<u32>(0u, STENCIL);
+}

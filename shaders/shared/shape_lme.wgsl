@@ -37,6 +37,29 @@ fn lme_node(x: vec2<f32>, i0: u32, j0: u32, k: u32) -> LmeNode {
     return r;
 }
 
+// The slots [x, y) of row r of the box from (i0, j0) around x whose node
+// may lie in the support (`lme_node` still checks |d|² ≤ r²): ~14 of the
+// 25 at γ = 3. Loops over these spans visit only them, which a masked
+// branch would not save on a SIMD CPU adapter. On a perturbed grid, the
+// whole row.
+fn lme_span(x: vec2<f32>, i0: u32, j0: u32, r: u32) -> vec2<u32> {
+    let row = r * SHAPE_WIDTH;
+#if PERTURBED
+    return vec2<u32>(row, row + SHAPE_WIDTH);
+#else
+    // Widened by 1e-4 h against rounding: a node just outside is rejected
+    // by `lme_node` anyway.
+    let dy = x.y - f32(j0 + r) * params.h;
+    let h2 = params.lme_r2 - dy * dy;
+    let half = sqrt(max(h2, 0.0)) * params.inv_h + 1e-4;
+    let q = x.x * params.inv_h - f32(i0);
+    let lo = u32(clamp(ceil(q - half), 0.0, f32(SHAPE_WIDTH)));
+    let hi = u32(clamp(floor(q + half) + 1.0, 0.0, f32(SHAPE_WIDTH)));
+    let empty = h2 < -1e-4 * params.h * params.h;
+    return select(vec2<u32>(row + lo, row + max(lo, hi)), vec2<u32>(row), empty);
+#endif
+}
+
 #if LME_STORED
 struct ShapeCtx {
     base: u32,
@@ -103,6 +126,19 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     return w;
 }
 #endif
+
+// Rows of the search box and their slots that may lie in the support
+// (`lme_span`; with stored weights, the whole row).
+const SHAPE_ROWS: u32 = SHAPE_WIDTH;
+
+fn shape_span(c: ShapeCtx, r: u32) -> vec2<u32> {
+#if LME_STORED
+    let row = r * SHAPE_WIDTH;
+    return vec2<u32>(row, row + SHAPE_WIDTH);
+#else
+    return lme_span(c.x, c.i0, c.j0, r);
+#endif
+}
 
 // Lowest node of the search box.
 fn shape_anchor(c: ShapeCtx) -> vec2<i32> {

@@ -54,8 +54,9 @@ pub struct GpuOptions {
     /// stencil (`Some(true)`: one invocation per bin sums its particles in
     /// registers, then one atomic per node of the stencil) or per particle
     /// (`Some(false)`); `None` picks what measured faster
-    /// (docs/performance.md). Only linear shapes and B-splines on a regular
-    /// grid that do not gather, without MLS or MUSL.
+    /// (docs/performance.md): per bin for B-splines and LME. Only linear
+    /// shapes and B-splines on a regular grid and LME on any grid, where
+    /// they do not gather, without MLS or MUSL.
     pub patch: Option<bool>,
 }
 
@@ -68,12 +69,17 @@ impl GpuOptions {
 
     /// Whether `p2g` and `forces` scatter per bin (`pipelines::Variant::patch`).
     pub fn patches(&self, model: &Model) -> bool {
-        let fits = matches!(model.shape, Shape::Linear | Shape::Bspline(_))
-            && !model.grid.is_perturbed()
-            && !model.mls
-            && model.integrator != Integrator::Musl
-            && !self.gathers(model);
-        let auto = matches!(model.shape, Shape::Bspline(_));
+        // A bin's particles share their stencil: for linear shapes and
+        // B-splines its cell on a regular grid; for LME its search box, a
+        // box of logical node indices on any grid.
+        let shares = match model.shape {
+            Shape::Lme(_) => true,
+            Shape::Linear | Shape::Bspline(_) => !model.grid.is_perturbed(),
+            Shape::Ugimp(_) => false,
+        };
+        let fits =
+            shares && !model.mls && model.integrator != Integrator::Musl && !self.gathers(model);
+        let auto = matches!(model.shape, Shape::Bspline(_) | Shape::Lme(_));
         self.patch.unwrap_or(auto) && fits
     }
 }

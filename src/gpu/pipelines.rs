@@ -31,7 +31,7 @@ pub enum Pass {
     P2g,
     P2gGather,
     /// p2g.wgsl built with PATCH: one invocation per bin of particles that
-    /// share a stencil (linear and B-splines on a regular grid), summing
+    /// share a stencil (linear and B-splines on a regular grid, LME), summing
     /// their contributions in registers, then one atomic per node and
     /// component of the stencil.
     P2gPatch,
@@ -161,7 +161,7 @@ impl Pass {
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
-            Stage::ShapeEval if plan.gather && plan.lme => {
+            Stage::ShapeEval if (plan.gather || plan.patch) && plan.lme => {
                 &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
             }
             Stage::ShapeEval if plan.gather || plan.patch => &BINS,
@@ -242,8 +242,8 @@ pub struct Variant {
     pub bspline_small_grid: bool,
     /// `p2g` and `forces` (and the fused `StressForces`) scatter per bin of
     /// particles that share their stencil's anchor, summing in registers
-    /// before the atomics (PATCH): linear and B-splines on a regular grid
-    /// where they do not gather (`GpuOptions::patches`).
+    /// before the atomics (PATCH): linear and B-splines on a regular grid,
+    /// LME, where they do not gather (`GpuOptions::patches`).
     pub patch: bool,
 }
 
@@ -330,7 +330,6 @@ impl Variant {
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
             .flag("EXT_FORCE", self.ext_force)
-            .flag("GATHER", self.gather)
             .flag("ANCHOR_BINS", self.gather || self.patch)
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
@@ -390,35 +389,42 @@ pub fn lme_side(model: &Model) -> u32 {
     }
 }
 
-/// Expands a pass's WGSL for `d`, adding the pass's own flag. (GATHER is
-/// the variant's: it also changes `bin_count`; a scatter pass expands
-/// without it.)
+/// Expands a pass's WGSL for `d`, adding the pass's own flags: WALK where
+/// the pass puts per-particle terms on nodes through shared/bins.wgsl's
+/// walks, GATHER or PATCH for which walk.
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     let mut d = d.clone();
-    if matches!(
-        pass,
-        Pass::P2g
-            | Pass::Forces
-            | Pass::StressForces
-            | Pass::P2gPatch
-            | Pass::ForcesPatch
-            | Pass::StressForcesPatch
-    ) {
-        d.flag("GATHER", false);
-    }
-    d.flag("CORRECT", pass == Pass::GridCorrect)
-        .flag(
-            "PATCH",
-            matches!(
-                pass,
-                Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
-            ),
-        )
-        .flag(
-            "FORCES",
-            matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
-        )
-        .flag("CLEAR", pass == Pass::RemapClear);
+    d.flag(
+        "WALK",
+        matches!(
+            pass,
+            Pass::P2g
+                | Pass::P2gGather
+                | Pass::P2gPatch
+                | Pass::Forces
+                | Pass::ForcesGather
+                | Pass::ForcesPatch
+                | Pass::StressForces
+                | Pass::StressForcesPatch
+        ),
+    )
+    .flag(
+        "GATHER",
+        matches!(pass, Pass::P2gGather | Pass::ForcesGather),
+    )
+    .flag("CORRECT", pass == Pass::GridCorrect)
+    .flag(
+        "PATCH",
+        matches!(
+            pass,
+            Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
+        ),
+    )
+    .flag(
+        "FORCES",
+        matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
+    )
+    .flag("CLEAR", pass == Pass::RemapClear);
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
@@ -730,10 +736,11 @@ mod tests {
                             assert!(b.iter().any(|b| b.buf == Buf::Mass));
                             checked += 1;
                             // The per-bin variant, where it applies.
-                            if matches!(
-                                shape,
-                                ShapeKind::Linear | ShapeKind::Bspline2 | ShapeKind::Bspline3
-                            ) && !perturbed
+                            if shape == ShapeKind::Lme
+                                || matches!(
+                                    shape,
+                                    ShapeKind::Linear | ShapeKind::Bspline2 | ShapeKind::Bspline3
+                                ) && !perturbed
                             {
                                 let v = Variant { patch: true, ..v };
                                 let src = expand(Pass::StressForcesPatch, &v.defines()).unwrap();
@@ -748,6 +755,6 @@ mod tests {
             }
         }
         assert_eq!(checked, 120);
-        assert_eq!(patched, 36);
+        assert_eq!(patched, 60);
     }
 }
