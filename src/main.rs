@@ -142,7 +142,7 @@ struct BenchArgs {
     /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
     /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed),
     /// lme-g3-mohr-coulomb (elastoplastic), bspline2, bspline3, bspline2-mls, bspline3-mls,
-    /// linear-scatter, linear-patch, bspline2-gather, bspline2-scatter, lme-g3-gather (GPU:
+    /// linear-scatter, linear-patch, bspline2-gather, bspline2-scatter, lme-g3-gather, lme-g3-scatter (GPU:
     /// p2g and forces scattered per particle with float atomics, gathered at nodes, or
     /// scattered per bin summing in registers first, whichever the case does not run by
     /// default).
