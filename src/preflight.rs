@@ -238,8 +238,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
     let mut c_max = 0.0f64;
     let mut c_key = String::from("solver.cfl");
     for (_, b) in scene.bodies() {
-        let m = Material::new(&f.materials[&b.material]);
-        let c = m.wave_speed(m.density());
+        let m = Material::from_spec(&b.material, &f.materials[&b.material])?;
+        let c = m.wave_speed(m.density(), &[0.0; 3], &[0.0; 4]);
         let v = b.velocity[0].hypot(b.velocity[1]);
         let s = c.max(v);
         if s > c_max || s.is_nan() {
@@ -312,12 +312,10 @@ fn memory(
 ) -> f64 {
     let f = &scene.file;
     let nodes = nx as f64 * ny as f64;
-    let needs_f = scene
-        .materials()
-        .any(|(_, m)| Material::new(m).needs_deformation_gradient());
-    let needs_plastic = scene
-        .materials()
-        .any(|(_, m)| Material::new(m).needs_plastic_state());
+    // `estimate` has checked the materials before this is called.
+    let materials = crate::model::material::check(&scene.file).unwrap_or_default();
+    let needs_f = materials.iter().any(Material::needs_deformation_gradient);
+    let needs_plastic = materials.iter().any(Material::needs_plastic_state);
     let npc = f.solver.integrator == crate::scene::IntegratorKind::Npc;
     // Particle fields (model::Particles): x, v, x0, mass, rho, stress, body.
     let mut particle = 16.0 * 3.0 + 8.0 * 2.0 + 24.0 + 4.0;

@@ -551,13 +551,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let step_rule = match model.fixed_dt {
         Some(fixed) => {
             // Courant number of the fixed step at t = 0.
-            let c = crate::model::time_step::max_speed(
-                &model.particles.v,
-                &model.particles.rho,
-                &model.particles.body,
-                &model.materials,
-                &model.body_material,
-            );
+            let c = crate::model::time_step::max_speed(model);
             format!(
                 "dt = {fixed} s fixed (Courant number {:.3} at t = 0)",
                 c * fixed / g.min_spacing()
@@ -569,23 +563,23 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         .file
         .materials
         .iter()
-        .map(|(n, m)| {
-            let model = serde_json::to_value(m.model)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default();
-            let mut plastic = String::new();
-            if let (Some(c), Some(phi)) = (m.cohesion, m.friction_angle) {
-                plastic = format!(
-                    ", c = {c} Pa, phi = {phi} deg, psi = {} deg, tension cutoff {}",
-                    m.dilation_angle.unwrap_or(0.0),
-                    m.tension_cutoff
-                        .map_or("at the apex".to_string(), |t| format!("{t} Pa"))
-                );
-            }
+        .zip(&model.materials)
+        .map(|((n, m), mat)| {
+            // Each key with its unit, in the model's own order.
+            let keys: Vec<String> = mat
+                .entry()
+                .keys
+                .iter()
+                .filter_map(|k| {
+                    m.get(k.name)
+                        .map(|v| format!("{} = {v} {}", k.name, k.unit))
+                })
+                .collect();
             format!(
-                "{n} ({model}, E = {} Pa, nu = {}, rho = {} kg/m^3{plastic})",
-                m.youngs_modulus, m.nu, m.density
+                "{n} ({}, density = {} kg/m^3, {})",
+                m.model,
+                m.density,
+                keys.join(", ")
             )
         })
         .collect::<Vec<_>>()

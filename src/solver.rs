@@ -324,7 +324,13 @@ fn energy_floor(backend: &mut dyn Backend) -> f64 {
     let m = backend.model();
     let p = &m.particles;
     let mc2: f64 = (0..p.len())
-        .map(|i| p.mass[i] * m.material_of(i).wave_speed(p.rho[i]).powi(2))
+        .map(|i| {
+            let q = p.plastic.get(i).unwrap_or(&[0.0; 4]);
+            p.mass[i]
+                * m.material_of(i)
+                    .wave_speed(p.rho[i], &p.stress[i], q)
+                    .powi(2)
+        })
         .sum();
     1e-12 * mc2
 }

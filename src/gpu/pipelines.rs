@@ -211,11 +211,8 @@ pub struct Variant {
     pub lme_side: u32,
     /// LME weights stored per slot (`GpuOptions::lme_stored`).
     pub lme_stored: bool,
-    /// Material models compiled in.
-    pub linear_elastic: bool,
-    pub neo_hookean: bool,
-    pub mohr_coulomb: bool,
-    pub drucker_prager: bool,
+    /// Material models compiled in: a bit per registry code.
+    pub materials: u32,
     /// Particles carry a deformation gradient F (`Particles::f`, the
     /// `DefGrad` buffer): some material needs it. Neo-Hookean does today;
     /// a finite-strain plastic model would too, which is why this is not
@@ -249,24 +246,11 @@ pub struct Variant {
 
 impl Variant {
     pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
-        use crate::model::material::Material;
         Variant {
-            linear_elastic: model
+            materials: model
                 .materials
                 .iter()
-                .any(|m| matches!(m, Material::LinearElastic(_))),
-            neo_hookean: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::NeoHookean(_))),
-            mohr_coulomb: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::MohrCoulomb(_))),
-            drucker_prager: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::DruckerPrager(_))),
+                .fold(0, |bits, m| bits | 1 << m.entry().code),
             def_grad: !model.particles.f.is_empty(),
             plastic: !model.particles.plastic.is_empty(),
             lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
@@ -320,10 +304,6 @@ impl Variant {
             .flag("MULTI_MATERIAL", self.multi_material)
             .flag("FLOAT_ATOMICS", self.atomics == AtomicMode::Float)
             .flag("LME_STORED", self.lme_stored)
-            .flag("MAT_LINEAR_ELASTIC", self.linear_elastic)
-            .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
-            .flag("MAT_MOHR_COULOMB", self.mohr_coulomb)
-            .flag("MAT_DRUCKER_PRAGER", self.drucker_prager)
             .flag("DEF_GRAD", self.def_grad)
             .flag("PLASTIC", self.plastic)
             .flag("MMS", self.mms)
@@ -338,6 +318,13 @@ impl Variant {
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
                 .flag("NPC_POSITION_NEWMARK", position == NpcPosition::Newmark);
         }
+        d.generate(
+            "generated/materials.wgsl",
+            crate::model::material::registry::wgsl(
+                &crate::model::material::registry(),
+                self.materials,
+            ),
+        );
         d.value(
             "ATOMIC_T",
             match self.atomics {
@@ -714,10 +701,14 @@ mod tests {
                                 atomics,
                                 lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
                                 lme_stored: false,
-                                linear_elastic: !neo_hookean || multi_material,
-                                neo_hookean,
-                                mohr_coulomb: false,
-                                drucker_prager: false,
+                                // Registry codes: 0 linear elastic, 1 Neo-Hookean.
+                                materials: if neo_hookean && !multi_material {
+                                    2
+                                } else if neo_hookean {
+                                    3
+                                } else {
+                                    1
+                                },
                                 def_grad: neo_hookean,
                                 plastic: false,
                                 mms,

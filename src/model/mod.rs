@@ -160,6 +160,8 @@ impl Model {
     /// that match no node.
     pub fn new(scene: &Scene) -> Result<Model, SceneError> {
         let f = &scene.file;
+        // The materials' own keys (the registry checks them, naming each).
+        let materials: Vec<Material> = material::check(f)?;
         let h = f.grid.h;
         let bbox = seed::bodies_bbox(scene);
         let anchor = f.grid.origin.unwrap_or([bbox[0], bbox[1]]);
@@ -176,7 +178,6 @@ impl Model {
 
         check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
 
-        let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
         let body_material: Vec<u32> = scene
             .bodies()
             .map(|(_, b)| scene.material_index(&b.material) as u32)
