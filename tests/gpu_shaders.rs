@@ -169,7 +169,7 @@ fn every_pass_validates_in_every_variant() {
     for v in variants() {
         let d = v.defines();
         for pass in Pass::ALL {
-            if !v.uses(pass) {
+            if !v.plan().gpu_uses(pass) {
                 continue;
             }
             let src = pipelines::expand(pass, &d).unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
@@ -352,7 +352,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     for v in [mls, lme, musl(true), musl(false)] {
         let d = v.defines();
         for pass in Pass::ALL {
-            if v.uses(pass) {
+            if v.plan().gpu_uses(pass) {
                 let src = pipelines::expand(pass, &d).unwrap();
                 out.push((
                     pass,

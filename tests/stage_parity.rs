@@ -13,7 +13,7 @@ use lme_mpm::gpu::{GpuBackend, GpuOptions};
 use lme_mpm::model::Model;
 use lme_mpm::rng::SplitMix64;
 use lme_mpm::scene::{Override, Scene};
-use lme_mpm::solver::{STEP, Stage, stages};
+use lme_mpm::step::{STEP, Stage, stages};
 
 /// The shape-function families the tolerances are set for: MLS (any shape
 /// with `solver.mls = true`) has its own, its forces and momenta coming from
