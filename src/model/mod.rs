@@ -201,7 +201,7 @@ impl Model {
                 lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
             }),
         };
-        let particles = Particles::from_seeds(
+        let mut particles = Particles::from_seeds(
             &seeds,
             |b| materials[body_material[b as usize] as usize].density(),
             |b| velocities[b as usize],
@@ -210,6 +210,16 @@ impl Model {
             materials.iter().any(Material::needs_deformation_gradient),
             materials.iter().any(Material::needs_plastic_state),
         );
+        // Each model's initial state (zero stress and state unless the
+        // model starts elsewhere, as Cam-clay at p′0 on its unloading line).
+        for i in 0..particles.len() {
+            let m = &materials[body_material[particles.body[i] as usize] as usize];
+            let (s, q) = m.initial_state();
+            particles.stress[i] = s;
+            if let Some(p) = particles.plastic.get_mut(i) {
+                *p = q;
+            }
+        }
 
         let constraints = build_constraints(scene, &grid)?;
         let walls = Walls::new(scene, &grid)?;

@@ -121,6 +121,11 @@ macro_rules! register {
                 match self { $(Material::$variant(m) => <$ty as Constitutive>::strain_energy_density(m, stress, f, q),)* }
             }
 
+            /// The stress (Pa) and plastic state a particle starts with.
+            pub fn initial_state(&self) -> ([f64; 3], PlasticState) {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::initial_state(m),)* }
+            }
+
             /// The GPU parameters (`GpuMaterial::p`), in the entry's order.
             pub fn gpu_params(&self) -> Vec<f32> {
                 match self { $(Material::$variant(m) => <$ty as Constitutive>::gpu_params(m),)* }

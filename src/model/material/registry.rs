@@ -80,6 +80,11 @@ pub trait Constitutive: Sized {
     fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64;
     /// The GPU parameters, in `GPU_PARAMS` order.
     fn gpu_params(&self) -> Vec<f32>;
+    /// The stress (Pa) and plastic state a particle starts with: zero,
+    /// unless the model starts elsewhere.
+    fn initial_state(&self) -> ([f64; 3], PlasticState) {
+        ([0.0; 3], [0.0; 4])
+    }
 }
 
 /// A material's keys as the model reads them: each read is checked (finite,
