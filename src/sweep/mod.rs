@@ -13,6 +13,7 @@
 
 pub mod collect;
 pub mod document;
+pub mod number;
 pub mod plan;
 pub mod record;
 pub mod reference;
