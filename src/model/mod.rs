@@ -5,6 +5,7 @@
 pub mod energy;
 pub mod fault;
 pub mod gauss;
+pub mod geostatic;
 mod grid;
 pub mod loads;
 pub mod material;
@@ -220,6 +221,7 @@ impl Model {
                 *p = q;
             }
         }
+        geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
         let constraints = build_constraints(scene, &grid)?;
         let walls = Walls::new(scene, &grid)?;
@@ -549,4 +551,63 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         });
     }
     Ok(c)
+}
+
+/// Bodies with `initial_stress = "geostatic"`: σ_v from the overburden
+/// above each particle, σ_h = σ_zz = k0 σ_v (`geostatic`). Refused, naming
+/// the key, for a material that keeps F or starts at a state of its own.
+fn geostatic_start(
+    scene: &Scene,
+    materials: &[Material],
+    body_material: &[u32],
+    particles: &mut Particles,
+) -> Result<(), SceneError> {
+    use crate::scene::InitialStress;
+    let bodies: Vec<(&String, &crate::scene::BodySpec)> = scene.bodies().collect();
+    if bodies
+        .iter()
+        .all(|(_, b)| b.initial_stress != InitialStress::Geostatic)
+    {
+        return Ok(());
+    }
+    let density: Vec<f64> = body_material
+        .iter()
+        .map(|&m| materials[m as usize].density())
+        .collect();
+    let mut k0 = Vec::with_capacity(bodies.len());
+    for (bi, (name, b)) in bodies.iter().enumerate() {
+        let m = &materials[body_material[bi] as usize];
+        if b.initial_stress == InitialStress::Geostatic {
+            let own_start = m.initial_state() != ([0.0; 3], [0.0; 4]);
+            if m.needs_deformation_gradient() || own_start {
+                return Err(SceneError::invalid(
+                    format!("bodies.{name}.initial_stress"),
+                    format!(
+                        "= \"geostatic\" needs a material whose state is its stress (linear_elastic, mohr_coulomb, drucker_prager); model = \"{}\" {}",
+                        m.entry().name,
+                        if own_start {
+                            "starts at a stress of its own"
+                        } else {
+                            "keeps a deformation gradient"
+                        }
+                    ),
+                ));
+            }
+        }
+        let spec = &scene.file.materials[&b.material];
+        k0.push(b.k0.unwrap_or_else(|| geostatic::default_k0(spec)));
+    }
+    let g = scene.file.gravity.as_ref().map_or(0.0, |g| -g.g[1]);
+    for i in 0..particles.len() {
+        let b = particles.body[i] as usize;
+        if bodies[b].1.initial_stress != InitialStress::Geostatic {
+            continue;
+        }
+        let sv = -g * geostatic::overburden(scene, &density, particles.x[i]);
+        particles.stress[i] = [k0[b] * sv, sv, 0.0];
+        if let Some(q) = particles.plastic.get_mut(i) {
+            q[material::plastic::SZZ] = k0[b] * sv;
+        }
+    }
+    Ok(())
 }

@@ -181,6 +181,24 @@ pub struct BodySpec {
     /// Simple polygons, each a list of `[x, y]` vertices (m).
     #[serde(default)]
     pub polygons: Vec<Vec<[f64; 2]>>,
+    /// The stress the body starts with. Default `none` (stress-free).
+    #[serde(default)]
+    pub initial_stress: InitialStress,
+    /// With `initial_stress = "geostatic"`: σ_h / σ_v (> 0). Default
+    /// 1 − sin φ for a material with a friction angle, ν/(1 − ν) otherwise.
+    pub k0: Option<f64>,
+}
+
+/// A body's initial stress.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialStress {
+    /// Stress-free (the model's own initial state).
+    #[default]
+    None,
+    /// At rest under gravity: σ_v from the weight of the material above
+    /// each particle, σ_h = σ_zz = k0 σ_v (`model::geostatic`).
+    Geostatic,
 }
 
 fn default_ppc() -> u32 {

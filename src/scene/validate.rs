@@ -417,6 +417,43 @@ fn check_bodies(file: &SceneFile) -> Result<(), SceneError> {
         ));
     }
     check_rect_overlaps(file)?;
+    for (bname, b) in &file.bodies {
+        check_initial_stress(file, bname, b)?;
+    }
+    Ok(())
+}
+
+/// A body's `initial_stress` and `k0`: geostatic needs full gravity along
+/// −y from the start; k0 > 0 and only with it.
+fn check_initial_stress(file: &SceneFile, bname: &str, b: &BodySpec) -> Result<(), SceneError> {
+    let key = |k: &str| format!("bodies.{bname}.{k}");
+    if let Some(k0) = b.k0 {
+        finite(&key("k0"), k0)?;
+        if k0 <= 0.0 {
+            return Err(SceneError::invalid(
+                key("k0"),
+                format!("must be > 0 (σ_h / σ_v), got {k0}"),
+            ));
+        }
+        if b.initial_stress != InitialStress::Geostatic {
+            return Err(SceneError::invalid(
+                key("k0"),
+                "applies only with initial_stress = \"geostatic\"",
+            ));
+        }
+    }
+    if b.initial_stress == InitialStress::Geostatic {
+        let ok = file
+            .gravity
+            .as_ref()
+            .is_some_and(|g| g.g[0] == 0.0 && g.g[1] < 0.0 && g.ramp == Ramp::None);
+        if !ok {
+            return Err(SceneError::invalid(
+                key("initial_stress"),
+                "= \"geostatic\" needs gravity along -y (gravity.g = [0, -g]) at full strength from the start (gravity.ramp = \"none\")",
+            ));
+        }
+    }
     Ok(())
 }
 
