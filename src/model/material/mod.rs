@@ -7,6 +7,7 @@
 pub mod drucker_prager;
 pub mod increment;
 pub mod linear_elastic;
+pub mod modified_cam_clay;
 pub mod mohr_coulomb;
 pub mod neo_hookean;
 pub mod plastic;
