@@ -640,9 +640,10 @@ mod tests {
     #[test]
     fn constant_volume_loading_follows_the_undrained_path() {
         // ε_v = 0 (Δεxx = −Δεyy, plane strain) from isotropic NC p′0.
-        // With v constant on the yield surface (Wood 1990, Soil Behaviour
-        // and Critical State Soil Mechanics, §7.4 / eq. 6.?? for Cam clay's
-        // undrained path; derived here): v = N − λ ln p_c + κ ln(p_c/p′) = v0
+        // With v constant on the yield surface (derived here; the classical
+        // undrained path of modified Cam-clay, e.g. Wood 1990, Soil
+        // Behaviour and Critical State Soil Mechanics, CUP, on undrained
+        // tests of Cam clay): v = N − λ ln p_c + κ ln(p_c/p′) = v0
         // = N − λ ln p′0 gives p_c^(λ−κ) p′^κ = p′0^λ, and f = 0 gives
         // p_c = p′ (1 + η²/M²), so
         //     p′ / p′0 = (M² / (M² + η²))^Λ, Λ = (λ − κ)/λ,

@@ -1,0 +1,221 @@
+// Modified Cam-clay, plane strain, tension positive: exact integration of
+// the unloading line (K = v p′/κ) and of the hardening (λ), associated
+// ellipse f = q²/M² + p′(p′ − p_c), closest-point return by Newton on
+// (ln p′, ln p_c, Δγ), tension to the apex σ = 0. Plastic state
+// q = (σzz, p_c, v, return). Stresses with σzz are (xx, yy, zz, xy).
+// Needs only shared/common.wgsl (FAULT_* codes, Material, is_finite).
+// CPU twin: src/model/material/modified_cam_clay.rs.
+
+// Newton converges when every scaled residual is below this (the CPU's
+// RETURN_TOL_F32; f64 uses 1e-11): f32 residuals round off at
+// ~1e-7 · |ln p′/p_c| (≤ ~20).
+const MCC_RETURN_TOL: f32 = 1e-5;
+// Newton iterations before a fault (MAX_ITER).
+const MCC_MAX_ITER: u32 = 40u;
+// Returns recorded in q.w: the ellipse and the tension apex (the values of
+// ACTIVE_MAIN and ACTIVE_T1 | ACTIVE_T2 | ACTIVE_T3 in material_plastic.wgsl,
+// which this file does not include).
+const MCC_RETURN_ELLIPSE: u32 = 1u;
+const MCC_RETURN_APEX: u32 = 56u;
+// Fault code of a return that did not converge (FaultKind::ReturnNotConverged);
+// not among the FAULT_* codes of types.wgsl yet.
+const MCC_FAULT_NOT_CONVERGED: u32 = 10u;
+
+// The model's parameters, in ModifiedCamClay::packed order.
+struct MccParams {
+    kappa: f32,
+    lambda: f32,
+    // Critical-state ratio M.
+    m_cs: f32,
+    nu: f32,
+    // Constant shear modulus G (Pa); 0: from K and ν.
+    shear: f32,
+    // Pressure floor of the stiffness (Pa).
+    p_floor: f32,
+    // ρ0 v0 (kg/m³): v = rho_v0 / ρ.
+    rho_v0: f32,
+    // v on the NCL at p′ = 1 Pa: N + λ ln(1000).
+    n_pa: f32,
+}
+
+// The parameters from the material record (slots this model borrows:
+// κ in sin_phi, λ in cos_phi, M in sin_psi, p_floor in tension, ρ0 v0 in
+// dp_alpha, N + λ ln 1000 in dp_k; ν and G in nu and shear).
+fn mcc_params(m: Material) -> MccParams {
+    return MccParams(m.sin_phi, m.cos_phi, m.sin_psi, m.nu, m.shear, m.tension, m.dp_alpha, m.dp_k);
+}
+
+struct MccStep {
+    s: vec4<f32>,
+    q: vec4<f32>,
+    fault: u32,
+}
+
+// Result of mcc_update: in-plane stress, plastic state, V_new/V_old, fault
+// (0 = none).
+struct MccUpdate {
+    s: vec3<f32>,
+    q: vec4<f32>,
+    j: f32,
+    fault: u32,
+}
+
+fn mcc_bulk(m: MccParams, p: f32, v: f32) -> f32 {
+    return v * max(p, m.p_floor) / m.kappa;
+}
+
+fn mcc_shear_at(m: MccParams, k: f32) -> f32 {
+    if m.shear > 0.0 {
+        return m.shear;
+    }
+    return 1.5 * k * (1.0 - 2.0 * m.nu) / (1.0 + m.nu);
+}
+
+fn mcc_yield(m: MccParams, p: f32, q: f32, pc: f32) -> f32 {
+    return q * q / (m.m_cs * m.m_cs) + p * (p - pc);
+}
+
+fn mcc_det3(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    return dot(a, cross(b, c));
+}
+
+// Solves the 3×3 system with rows r0, r1, r2 by Cramer's rule; w of the
+// result is 0 when singular (twin of mohr_coulomb::solve3).
+fn mcc_solve3(r0: vec3<f32>, r1: vec3<f32>, r2: vec3<f32>, b: vec3<f32>) -> vec4<f32> {
+    // Columns.
+    let c0 = vec3<f32>(r0.x, r1.x, r2.x);
+    let c1 = vec3<f32>(r0.y, r1.y, r2.y);
+    let c2 = vec3<f32>(r0.z, r1.z, r2.z);
+    let d = mcc_det3(c0, c1, c2);
+    if d == 0.0 || !is_finite(d) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(mcc_det3(b, c1, c2) / d, mcc_det3(c0, b, c2) / d, mcc_det3(c0, c1, b) / d, 1.0);
+}
+
+// One step from the rotated stress s with the strain increment de (both
+// xx, yy, zz, xy): the twin of ModifiedCamClay::step.
+fn mcc_step(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep {
+    let v = q.z;
+    let pc = q.y;
+    let p_n = -(s.x + s.y + s.z) / 3.0;
+    let pb = max(p_n, m.p_floor);
+    let g = mcc_shear_at(m, mcc_bulk(m, p_n, v));
+    let ev = de.x + de.y + de.z;
+    let v_new = v * (1.0 + ev);
+    // Elastic trial: p′ exact along the unloading line, s by 2G Δe.
+    let p_tr = p_n + pb * (exp(-v * ev / m.kappa) - 1.0);
+    let sd = vec4<f32>(s.xyz + vec3<f32>(p_n) + 2.0 * g * (de.xyz - vec3<f32>(ev / 3.0)), s.w + 2.0 * g * de.w);
+    let q_tr = sqrt(1.5 * (dot(sd.xyz, sd.xyz) + 2.0 * sd.w * sd.w));
+    if !(is_finite(p_tr) && is_finite(q_tr)) {
+        return MccStep(s, q, FAULT_NON_FINITE_STRESS);
+    }
+    if p_tr <= 0.0 {
+        // Tension: the apex of the ellipse, where it admits no stress.
+        return MccStep(vec4<f32>(0.0), vec4<f32>(0.0, pc, v_new, f32(MCC_RETURN_APEX)), 0u);
+    }
+    if mcc_yield(m, p_tr, q_tr, pc) <= 0.0 {
+        let out = vec4<f32>(sd.xyz - vec3<f32>(p_tr), sd.w);
+        return MccStep(out, vec4<f32>(out.z, pc, v_new, 0.0), 0u);
+    }
+    // Closest point, scaled by p_c: P = e^y, Pc = e^z, w = Δγ p_c,n.
+    let m2 = m.m_cs * m.m_cs;
+    let a = v / m.kappa;
+    let b = v / (m.lambda - m.kappa);
+    let gn = g / pc;
+    let qn = q_tr / pc;
+    let yt = log(p_tr / pc);
+    var y = yt;
+    var z = 0.0;
+    var w = 0.0;
+    var ratio = 1.0;
+    var converged = false;
+    for (var it = 0u; it < MCC_MAX_ITER; it++) {
+        let pp = exp(y);
+        let pcc = exp(z);
+        let d = 2.0 * pp - pcc;
+        let den = 1.0 + 6.0 * gn * w / m2;
+        let qq = qn / den;
+        let r = vec3<f32>(y - yt + a * w * d, z - b * w * d, qq * qq / m2 + pp * (pp - pcc));
+        let res = max(abs(r.x), max(abs(r.y), abs(r.z)));
+        ratio = 1.0 / den;
+        if res <= MCC_RETURN_TOL {
+            converged = true;
+            break;
+        }
+        let dx = mcc_solve3(
+            vec3<f32>(1.0 + 2.0 * a * w * pp, -a * w * pcc, a * d),
+            vec3<f32>(-2.0 * b * w * pp, 1.0 + b * w * pcc, -b * d),
+            vec3<f32>(pp * d, -pp * pcc, -12.0 * gn * qq * qq / (m2 * m2 * den)),
+            r,
+        );
+        if dx.w == 0.0 {
+            break;
+        }
+        // Steps of at most one e-fold in p′ and p_c; Δγ stays ≥ 0.
+        let big = max(abs(dx.x), abs(dx.y));
+        var t = 1.0;
+        if big > 1.0 {
+            t = 1.0 / big;
+        }
+        y -= t * dx.x;
+        z -= t * dx.y;
+        let w_new = w - t * dx.z;
+        if w_new < 0.0 {
+            w = 0.5 * w;
+        } else {
+            w = w_new;
+        }
+    }
+    if !converged {
+        return MccStep(s, q, MCC_FAULT_NOT_CONVERGED);
+    }
+    let p = exp(y) * pc;
+    let pc_new = exp(z) * pc;
+    let out = vec4<f32>(ratio * sd.xyz - vec3<f32>(p), ratio * sd.w);
+    return MccStep(out, vec4<f32>(out.z, pc_new, v_new, f32(MCC_RETURN_ELLIPSE)), 0u);
+}
+
+// One step: Jaumann rotation, plane-strain increment, mcc_step (twin of
+// ModifiedCamClay::update). l = velocity gradient (xx, xy, yx, yy).
+fn mcc_update(m: MccParams, l: vec4<f32>, dt: f32, s: vec3<f32>, q: vec4<f32>) -> MccUpdate {
+    var r = MccUpdate(s, q, 1.0 + dt * (l.x + l.w), 0u);
+    if !is_finite(r.j) {
+        r.fault = FAULT_NON_FINITE_STRAIN;
+        return r;
+    }
+    if r.j <= 0.0 {
+        r.fault = FAULT_DENSITY;
+        return r;
+    }
+    // σ + Δt (Wσ − σW), W = skew(L); σzz is not turned.
+    let w = 0.5 * dt * (l.y - l.z);
+    let rot = vec4<f32>(s.x + 2.0 * w * s.z, s.y - 2.0 * w * s.z, q.x, s.z + w * (s.y - s.x));
+    let de = vec4<f32>(dt * l.x, dt * l.w, 0.0, 0.5 * dt * (l.y + l.z));
+    let st = mcc_step(m, rot, de, q);
+    r.fault = st.fault;
+    if st.fault == 0u {
+        r.s = vec3<f32>(st.s.x, st.s.y, st.s.w);
+        r.q = st.q;
+    }
+    return r;
+}
+
+// Fastest elastic wave at density rho (m/s): p′ ≤ exp((N₁ − v)/λ) Pa at
+// v = ρ0 v0 / ρ (twin of ModifiedCamClay::wave_speed).
+fn mcc_wave_speed(m: MccParams, rho: f32) -> f32 {
+    let v = m.rho_v0 / rho;
+    let p_max = exp((m.n_pa - v) / m.lambda);
+    let k = mcc_bulk(m, p_max, v);
+    return sqrt((k + 4.0 / 3.0 * mcc_shear_at(m, k)) / rho);
+}
+
+// ½ σ : C⁻¹ : σ at the current moduli, with σzz = q.x (twin of
+// ModifiedCamClay::energy).
+fn mcc_energy(m: MccParams, s: vec3<f32>, q: vec4<f32>) -> f32 {
+    let p = -(s.x + s.y + q.x) / 3.0;
+    let k = mcc_bulk(m, p, q.z);
+    let g = mcc_shear_at(m, k);
+    let d = vec3<f32>(s.x, s.y, q.x) + vec3<f32>(p);
+    return (dot(d, d) + 2.0 * s.z * s.z) / (4.0 * g) + p * p / (2.0 * k);
+}
