@@ -12,6 +12,8 @@
 const MCC_RETURN_TOL: f32 = 1e-5;
 // Newton iterations before a fault (MAX_ITER).
 const MCC_MAX_ITER: u32 = 40u;
+// The splits of a step tried in turn (SUBSTEPS).
+const MCC_SUBSTEPS: array<u32, 3> = array<u32, 3>(1u, 8u, 64u);
 // Returns recorded in q.w: the ellipse and the tension apex (the values of
 // ACTIVE_MAIN and ACTIVE_T1 | ACTIVE_T2 | ACTIVE_T3 in material_plastic.wgsl,
 // which this file does not include).
@@ -94,8 +96,38 @@ fn mcc_solve3(r0: vec3<f32>, r1: vec3<f32>, r2: vec3<f32>, b: vec3<f32>) -> vec4
 }
 
 // One step from the rotated stress s with the strain increment de (both
-// xx, yy, zz, xy): the twin of ModifiedCamClay::step.
+// xx, yy, zz, xy), split into 8 then 64 parts (volume ratios multiplying
+// to 1 + tr Δε) should the return not converge: the twin of
+// ModifiedCamClay::step.
 fn mcc_step(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep {
+    var r = MccStep(s, q, MCC_FAULT_NOT_CONVERGED);
+    for (var k = 0u; k < 3u; k++) {
+        let n = MCC_SUBSTEPS[k];
+        let ev = de.x + de.y + de.z;
+        // Diagonal scale c: (1 + c ev / n)^n = 1 + ev.
+        var c = 1.0 / f32(n);
+        if ev != 0.0 && n > 1u {
+            c = (pow(1.0 + ev, 1.0 / f32(n)) - 1.0) / ev;
+        }
+        let d = vec4<f32>(c * de.xyz, de.w / f32(n));
+        r = MccStep(s, q, 0u);
+        for (var i = 0u; i < n; i++) {
+            let st = mcc_step_once(m, r.s, d, r.q);
+            if st.fault != 0u {
+                r = MccStep(s, q, st.fault);
+                break;
+            }
+            r = st;
+        }
+        if r.fault != MCC_FAULT_NOT_CONVERGED {
+            return r;
+        }
+    }
+    return r;
+}
+
+// One step without substeps (twin of ModifiedCamClay::step_once).
+fn mcc_step_once(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep {
     let v = q.z;
     let pc = q.y;
     let p_n = -(s.x + s.y + s.z) / 3.0;
@@ -103,8 +135,13 @@ fn mcc_step(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep 
     let g = mcc_shear_at(m, mcc_bulk(m, p_n, v));
     let ev = de.x + de.y + de.z;
     let v_new = v * (1.0 + ev);
-    // Elastic trial: p′ exact along the unloading line, s by 2G Δe.
-    let p_tr = p_n + pb * (exp(-v * ev / m.kappa) - 1.0);
+    // Elastic trial: p′ exact along the unloading line (from p_floor below
+    // it), s by 2G Δe; p_n e^x does not cancel to 0 in a large extension.
+    let ex = exp(-v * ev / m.kappa);
+    var p_tr = p_n + pb * (ex - 1.0);
+    if p_n >= m.p_floor {
+        p_tr = p_n * ex;
+    }
     let sd = vec4<f32>(s.xyz + vec3<f32>(p_n) + 2.0 * g * (de.xyz - vec3<f32>(ev / 3.0)), s.w + 2.0 * g * de.w);
     let q_tr = sqrt(1.5 * (dot(sd.xyz, sd.xyz) + 2.0 * sd.w * sd.w));
     if !(is_finite(p_tr) && is_finite(q_tr)) {
@@ -136,7 +173,15 @@ fn mcc_step(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep 
         let d = 2.0 * pp - pcc;
         let den = 1.0 + 6.0 * gn * w / m2;
         let qq = qn / den;
-        let r = vec3<f32>(y - yt + a * w * d, z - b * w * d, qq * qq / m2 + pp * (pp - pcc));
+        let f = qq * qq / m2 + pp * (pp - pcc);
+        // f over max(p_c, p_c,n)²: the current p_c where the step hardens.
+        var e2 = 1.0;
+        var dz = 0.0;
+        if pcc > 1.0 {
+            e2 = 1.0 / (pcc * pcc);
+            dz = 2.0 * f;
+        }
+        let r = vec3<f32>(y - yt + a * w * d, z - b * w * d, f * e2);
         let res = max(abs(r.x), max(abs(r.y), abs(r.z)));
         ratio = 1.0 / den;
         if res <= MCC_RETURN_TOL {
@@ -146,7 +191,7 @@ fn mcc_step(m: MccParams, s: vec4<f32>, de: vec4<f32>, q: vec4<f32>) -> MccStep 
         let dx = mcc_solve3(
             vec3<f32>(1.0 + 2.0 * a * w * pp, -a * w * pcc, a * d),
             vec3<f32>(-2.0 * b * w * pp, 1.0 + b * w * pcc, -b * d),
-            vec3<f32>(pp * d, -pp * pcc, -12.0 * gn * qq * qq / (m2 * m2 * den)),
+            vec3<f32>(pp * d * e2, -(pp * pcc + dz) * e2, -12.0 * gn * qq * qq / (m2 * m2 * den) * e2),
             r,
         );
         if dx.w == 0.0 {

@@ -42,8 +42,8 @@ pub const P_REF: f64 = 1.0e3;
 /// Default floor of the pressure in the elastic stiffness (Pa): K = v
 /// max(p′, p_floor) / κ, so a particle at zero stress can be loaded again.
 pub const P_FLOOR: f64 = 1.0;
-/// Newton converges when every scaled residual (ln p′, ln p_c, f / p_c²)
-/// is below this: the f64 round-off of the residuals is ~1e-15 · a Δγ
+/// Newton converges when every scaled residual (ln p′, ln p_c, and
+/// f / max(p_c, p_c at the step's start)²) is below this: the f64 round-off of the residuals is ~1e-15 · a Δγ
 /// (2p′ − p_c) with a = v/κ ≤ ~1e3.
 pub const RETURN_TOL_F64: f64 = 1e-11;
 /// The same in the WGSL twin (`MCC_RETURN_TOL`): f32 residuals round off at
@@ -52,6 +52,10 @@ pub const RETURN_TOL_F64: f64 = 1e-11;
 pub const RETURN_TOL_F32: f64 = 1e-5;
 /// Newton iterations before the return is declared not converged.
 pub const MAX_ITER: u32 = 40;
+/// The splits of a step tried in turn when the return does not converge
+/// (one part: the plain step; all returns converge up to 20 % strain per
+/// step without a split, see `large_steps_converge`).
+pub const SUBSTEPS: [u32; 3] = [1, 8, 64];
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModifiedCamClay {
@@ -231,10 +235,51 @@ impl ModifiedCamClay {
     /// One step from the (already rotated) stress `s` = [xx, yy, zz, xy]
     /// with the strain increment `de` = [xx, yy, zz, xy] (tensor shear):
     /// the new stress and plastic state. Plane strain passes de[2] = 0;
-    /// the full 3D increment is there for isotropic compression.
-    // Index loops on purpose: they mirror mcc_step in the WGSL twin.
-    #[allow(clippy::needless_range_loop)]
+    /// the full 3D increment is there for isotropic compression. Should
+    /// the return not converge, the increment is split into `SUBSTEPS[k]`
+    /// equal parts (their volume ratios multiplying to 1 + tr Δε, so v
+    /// stays v0 ρ0/ρ) and tried again.
     pub fn step(
+        &self,
+        s: [f64; 4],
+        de: [f64; 4],
+        q: &PlasticState,
+    ) -> Result<([f64; 4], PlasticState), FaultKind> {
+        let mut last = FaultKind::ReturnNotConverged {
+            residual: f64::INFINITY,
+        };
+        for n in SUBSTEPS {
+            let ev = de[0] + de[1] + de[2];
+            // Diagonal scale c: (1 + c ev / n)^n = 1 + ev.
+            let mut c = 1.0 / n as f64;
+            if ev != 0.0 && n > 1 {
+                c = ((1.0 + ev).powf(1.0 / n as f64) - 1.0) / ev;
+            }
+            let d = [c * de[0], c * de[1], c * de[2], de[3] / n as f64];
+            let (mut sk, mut qk) = (s, *q);
+            let mut failed = None;
+            for _ in 0..n {
+                match self.step_once(sk, d, &qk) {
+                    Ok((s1, q1)) => (sk, qk) = (s1, q1),
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
+                    }
+                }
+            }
+            match failed {
+                None => return Ok((sk, qk)),
+                Some(e @ FaultKind::ReturnNotConverged { .. }) => last = e,
+                Some(e) => return Err(e),
+            }
+        }
+        Err(last)
+    }
+
+    /// One step without substeps (`step`'s attempt with one part).
+    // Index loops on purpose: they mirror mcc_step_once in the WGSL twin.
+    #[allow(clippy::needless_range_loop)]
+    pub fn step_once(
         &self,
         s: [f64; 4],
         de: [f64; 4],
@@ -247,8 +292,15 @@ impl ModifiedCamClay {
         let g = self.shear_at(self.bulk(p_n, v));
         let ev = de[0] + de[1] + de[2];
         let v_new = v * (1.0 + ev);
-        // Elastic trial: p′ exact along the unloading line, s by 2G Δe.
-        let p_tr = p_n + pb * ((-v * ev / self.kappa).exp() - 1.0);
+        // Elastic trial: p′ exact along the unloading line (from p_floor
+        // below it), s by 2G Δe. p_n e^x, not p_n + p_n (e^x − 1): a large
+        // extension must not cancel to 0 in f32.
+        let ex = (-v * ev / self.kappa).exp();
+        let p_tr = if p_n >= self.p_floor {
+            p_n * ex
+        } else {
+            p_n + pb * (ex - 1.0)
+        };
         let mut sd = [0.0; 4];
         for k in 0..3 {
             sd[k] = s[k] + p_n + 2.0 * g * (de[k] - ev / 3.0);
@@ -285,11 +337,15 @@ impl ModifiedCamClay {
             let d = 2.0 * pp - pcc;
             let den = 1.0 + 6.0 * gn * w / m2;
             let qq = qn / den;
-            let r = [
-                y - yt + a * w * d,
-                z - b * w * d,
-                qq * qq / m2 + pp * (pp - pcc),
-            ];
+            let f = qq * qq / m2 + pp * (pp - pcc);
+            // f over max(p_c, p_c,n)²: relative to the current p_c where
+            // the step hardens (f64 and f32 then converge at any
+            // hardening), to the start one where it softens (p_c → 0
+            // would blow the residual up).
+            let hard = pcc > 1.0;
+            let e2 = if hard { 1.0 / (pcc * pcc) } else { 1.0 };
+            let dz = if hard { 2.0 * f } else { 0.0 };
+            let r = [y - yt + a * w * d, z - b * w * d, f * e2];
             res = r[0].abs().max(r[1].abs()).max(r[2].abs());
             ratio = 1.0 / den;
             if res <= RETURN_TOL_F64 {
@@ -299,7 +355,11 @@ impl ModifiedCamClay {
             let jac = [
                 [1.0 + 2.0 * a * w * pp, -a * w * pcc, a * d],
                 [-2.0 * b * w * pp, 1.0 + b * w * pcc, -b * d],
-                [pp * d, -pp * pcc, -12.0 * gn * qq * qq / (m2 * m2 * den)],
+                [
+                    pp * d * e2,
+                    -(pp * pcc + dz) * e2,
+                    -12.0 * gn * qq * qq / (m2 * m2 * den) * e2,
+                ],
             ];
             let Some(dx) = super::mohr_coulomb::solve3(jac, r) else {
                 break;
@@ -936,6 +996,56 @@ mod tests {
             println!("wave speed: state / bound up to {tight:.4}");
             // On the NCL (the NC sample) the bound is reached; it is not loose elsewhere.
             assert!(tight > reach, "{tight}");
+        }
+    }
+
+    #[test]
+    fn large_steps_converge() {
+        // Random states inside the ellipse and velocity gradients with
+        // steps up to `emax` strain: the plain return (`step_once`)
+        // converges for all up to 20 %; `step` (split when needed) for all
+        // up to 50 % (save volumes that would vanish, J ≤ 0).
+        let mut seed = 99u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let m = clay(1.0e5, 1.0);
+        for (emax, split) in [(0.2, false), (0.5, true)] {
+            let (mut runs, mut worst_f) = (0, 0.0f64);
+            for _ in 0..20000 {
+                let pc = 1.0e5;
+                let p = pc * (0.01 + 0.98 * rnd());
+                let qm = m.m_cs * (p * (pc - p)).sqrt() * rnd();
+                let r = qm / 3f64.sqrt();
+                let s = [-p - r, -p + r, -p, 0.0];
+                let q = [s[2], pc, 1.6, 0.0];
+                let dt = emax * rnd();
+                let l = [
+                    rnd() * 2.0 - 1.0,
+                    rnd() * 2.0 - 1.0,
+                    rnd() * 2.0 - 1.0,
+                    rnd() * 2.0 - 1.0,
+                ];
+                if plastic::volume_ratio(l, dt).is_err() {
+                    continue;
+                }
+                let de = [dt * l[0], dt * l[3], 0.0, 0.5 * dt * (l[1] + l[2])];
+                let (out, q1) = if split {
+                    m.step(s, de, &q)
+                } else {
+                    m.step_once(s, de, &q)
+                }
+                .unwrap_or_else(|e| panic!("{s:?} {de:?}: {e:?}"));
+                let (p1, qd) = p_q(out);
+                worst_f = worst_f.max(m.yield_fn(p1, qd, q1[PC]) / (q1[PC] * q1[PC]));
+                assert!((q1[VOLUME] - 1.6 * (1.0 + de[0] + de[1])).abs() < 1e-12);
+                runs += 1;
+            }
+            println!("steps up to {emax}: {runs} converged, worst f/p_c² {worst_f:.1e}");
+            assert!(worst_f < 1e-10, "{worst_f}");
         }
     }
 
