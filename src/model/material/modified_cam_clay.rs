@@ -14,12 +14,17 @@
 //!   v + λ ln p_c = const along virgin loading). With Δv = v_n tr Δε and
 //!   v_{n+1} = v_n (1 + tr Δε), the state keeps v + κ ln p′ + (λ − κ) ln p_c
 //!   constant exactly (up to the return's tolerance), on any path.
-//! - Return: closest point (backward Euler on the flow rule), Newton on
-//!   (ln p′, ln p_c, Δγ) with the hardening (Borja & Lee 1990, in the log
-//!   form of Borja 1991), variables scaled by p_c at the step's start. A
-//!   return that does not converge is `FaultKind::ReturnNotConverged`.
-//! - Tension: the stiffness uses max(p′, p_floor); a trial with p′ ≤ 0 goes
-//!   to the apex of the ellipse, σ = 0 (p_c kept), flagged `ACTIVE_APEX`.
+//! - Return: closest point (backward Euler on the flow rule) with the
+//!   exact nonlinear elastic predictor, after Borja & Lee (1990, CMAME 78)
+//!   and Borja (1991, CMAME 88): here a 3×3 Newton on (ln p′, ln p_c, Δγ)
+//!   scaled by p_c, steps limited to one e-fold in p′ and p_c. A step whose
+//!   return does not converge in `MAX_ITER` is split into 8, then 64 parts
+//!   (`SUBSTEPS`); past that it is `FaultKind::ReturnNotConverged`, never
+//!   a NaN.
+//! - Tension: the stiffness uses max(p′, p_floor). From p′ ≥ p_floor the
+//!   trial p′ stays positive (p′ e^x); from below (a particle at zero
+//!   stress) a trial with p′ ≤ 0 goes to the apex of the ellipse, σ = 0
+//!   (p_c kept, v still v ρ_old/ρ), flagged `ACTIVE_APEX`.
 //!
 //! Plastic state `[σzz (Pa), p_c (Pa), v, return]`: the out-of-plane
 //! stress, the preconsolidation pressure (compression positive), the
