@@ -370,6 +370,8 @@ impl GpuBackend {
                 residual: None,
             }),
             FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+            // The shader does not report its residual.
+            FAULT_RETURN_NOT_CONVERGED => FaultKind::ReturnNotConverged { residual: f64::NAN },
             code => FaultKind::NonFinite {
                 field: if code == 0 {
                     "unknown (fault code 0)"

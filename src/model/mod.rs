@@ -232,7 +232,6 @@ impl Model {
         });
         // A manufactured solution sets each particle's initial velocity.
         let manufactured = AlignedVibration::from_scene(scene);
-        let mut particles = particles;
         if let Some(m) = &manufactured {
             for i in 0..particles.len() {
                 particles.v[i] = m.velocity(particles.x0[i], 0.0);

@@ -431,7 +431,7 @@ impl Section<'_> {
                         .collect()
                 };
                 let at_t = at(&|r| final_errors(r).map(pick));
-                let at_p = at(&|r| period_errors(r, &exact).map(|e| pick(&e)));
+                let at_p = at(&|r| period_errors(r, exact).map(|e| pick(&e)));
                 let (rt, rp) = (rates(&at_t), rates(&at_p));
                 if label == "bspline2-mls" && name == "displacement" {
                     goal = Some((rt.clone(), rp.clone()));

@@ -139,6 +139,7 @@ register! {
     NeoHookean(neo_hookean::NeoHookean),
     MohrCoulomb(mohr_coulomb::MohrCoulomb),
     DruckerPrager(drucker_prager::DruckerPrager),
+    ModifiedCamClay(modified_cam_clay::ModifiedCamClay),
 }
 
 impl Material {
