@@ -402,6 +402,12 @@ impl ModifiedCamClay {
         stress: &mut [f64; 3],
         q: &mut PlasticState,
     ) -> Result<f64, FaultKind> {
+        debug_assert!(
+            q[PC] > 0.0 && q[VOLUME] > 0.0,
+            "modified Cam-clay state not initialised (p_c, v = {}, {}): seed it from initial_state()",
+            q[PC],
+            q[VOLUME]
+        );
         let j = plastic::volume_ratio(l, dt)?;
         // σ + Δt (Wσ − σW), W = skew(L); σzz is not turned.
         let w = 0.5 * dt * (l[1] - l[2]);
