@@ -1,7 +1,8 @@
 // Modified Cam-clay, plane strain, tension positive: exact integration of
 // the unloading line (K = v p′/κ) and of the hardening (λ), associated
 // ellipse f = q²/M² + p′(p′ − p_c), closest-point return by Newton on
-// (ln p′, ln p_c, Δγ), tension to the apex σ = 0. Plastic state
+// (ln p′, ln p_c, Δγ) (a step split into 8, then 64 parts when it does not
+// converge), tension to the apex σ = 0. Plastic state
 // q = (σzz, p_c, v, return). Stresses with σzz are (xx, yy, zz, xy).
 // Needs only shared/common.wgsl (FAULT_* codes, Material, is_finite).
 // CPU twin: src/model/material/modified_cam_clay.rs.

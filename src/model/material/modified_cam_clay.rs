@@ -231,6 +231,14 @@ impl ModifiedCamClay {
             .unwrap_or(1.5 * k * (1.0 - 2.0 * self.nu) / (1.0 + self.nu))
     }
 
+    /// Lamé λ and shear modulus G (Pa) at p′ (Pa) and v: the tangent
+    /// moduli there (`moduli(p0, v0)` for a scale of the initial state).
+    pub fn moduli(&self, p: f64, v: f64) -> (f64, f64) {
+        let k = self.bulk(p, v);
+        let g = self.shear_at(k);
+        (k - 2.0 * g / 3.0, g)
+    }
+
     /// The yield function f = q²/M² + p′(p′ − p_c) (Pa²).
     #[inline]
     pub fn yield_fn(&self, p: f64, q: f64, pc: f64) -> f64 {
@@ -402,6 +410,12 @@ impl ModifiedCamClay {
         stress: &mut [f64; 3],
         q: &mut PlasticState,
     ) -> Result<f64, FaultKind> {
+        debug_assert!(
+            q[PC] > 0.0 && q[VOLUME] > 0.0,
+            "modified Cam-clay state not initialised (p_c, v = {}, {}): seed it from initial_state()",
+            q[PC],
+            q[VOLUME]
+        );
         let j = plastic::volume_ratio(l, dt)?;
         // σ + Δt (Wσ − σW), W = skew(L); σzz is not turned.
         let w = 0.5 * dt * (l[1] - l[2]);
@@ -1219,6 +1233,8 @@ mod tests {
             "{} vs {want}",
             m.energy(&s, &q)
         );
+        let (lame, g0) = m.moduli(1.0e5, 1.7);
+        assert!((lame + 2.0 * g0 - (kb + 4.0 / 3.0 * g)).abs() < 1e-6 && (g0 - g).abs() < 1e-6);
         // Faults, not NaN: a non-finite strain, a vanishing volume.
         let (mut s, mut q) = m.initial_state();
         let e = m.update([f64::NAN, 0.0, 0.0, 0.0], 1e-3, &mut s, &mut q);
