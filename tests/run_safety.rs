@@ -787,3 +787,45 @@ fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
         "particles differ after resume"
     );
 }
+
+#[test]
+fn a_second_signal_long_after_the_first_ends_a_long_step_with_the_folder_saying_so() {
+    // One static Newton step of the cantilever at h = 2.5 cm takes about
+    // 10 s (5e4 particles): the first SIGTERM waits for its end; a second
+    // one past the grace of 2 s ends the process at once, and the folder
+    // must then say `interrupted` and hold no lock. Before: the second
+    // signal ended it with summary.json `running` and a stale lock.
+    let out = tmp("late-second");
+    let mut child = bin()
+        .args(["run", "--backend", "cpu", "--quiet", "--out"])
+        .arg(&out)
+        .arg(common::case("cantilever.toml"))
+        .args(["--set", "grid.h=0.025"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !std::fs::read_to_string(out.join("summary.json")).is_ok_and(|t| t.contains("running")) {
+        assert!(started.elapsed().as_secs() < 120, "the run never started");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    signal(child.id(), &["-TERM"]);
+    std::thread::sleep(std::time::Duration::from_millis(2500));
+    let sent = std::time::Instant::now();
+    signal(child.id(), &["-TERM"]);
+    let status = child.wait().unwrap();
+    let waited = sent.elapsed().as_secs_f64();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert_eq!(status.code(), Some(143), "{err}");
+    let s = summary(&out);
+    assert_eq!(s["status"], "interrupted", "{s}");
+    assert!(
+        s["reason"].as_str().unwrap().contains("repeated signal"),
+        "the step ended before the second signal ({waited:.2} s to exit): {s}"
+    );
+    assert!(waited < 2.0, "{waited} s to exit after the second signal");
+    assert!(!out.join("lme-mpm.lock").exists(), "the lock outlives the run");
+    no_tmp_files(&out);
+}
