@@ -56,8 +56,9 @@ enum Command {
         limits: LimitArgs,
     },
     /// Continue the run in DIR from its checkpoint (checkpoint.lmeck: written
-    /// when a run is interrupted, and every output.checkpoint_interval), into
-    /// the same folder: the CSV files keep their rows up to the checkpoint.
+    /// when a run is interrupted, every output.checkpoint_interval, and at
+    /// the end of a completed run: extend it with --set solver.t_end=LATER),
+    /// into the same folder: the CSV files keep their rows up to the checkpoint.
     Resume {
         /// The run's output folder.
         dir: PathBuf,
@@ -68,7 +69,8 @@ enum Command {
         #[arg(long)]
         adapter: Option<String>,
         /// Change a key: solver.t_end (to run further), output.checkpoint_interval,
-        /// output.vtk_interval, output.vtk_final, output.particles_csv (repeatable).
+        /// output.vtk_interval, output.vtk_final, output.particles_csv,
+        /// output.final_checkpoint (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// No progress and no result line.

@@ -391,7 +391,15 @@ fn memory(
     } else {
         0.0
     };
-    let end = n * (particle + cache + csv) + nodes * per_node + mls + sample_rows;
+    // (c) A checkpoint (at t_end by default): a copy of the particles and
+    // the samples, and their encoding, about as large again.
+    let checkpoint = if f.output.final_checkpoint || f.output.checkpoint_interval.is_some() {
+        2.0 * (n * particle + sample_rows)
+    } else {
+        0.0
+    };
+    let end =
+        n * (particle + cache) + (n * csv).max(checkpoint) + nodes * per_node + mls + sample_rows;
     BASELINE_BYTES + build.max(end)
 }
 

@@ -104,8 +104,8 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     let ck_path = folder.path(checkpoint::FILE);
     if !ck_path.is_file() {
         return Err(Error::Checkpoint(format!(
-            "{}: none in this folder (a run writes one when interrupted, or every \
-             output.checkpoint_interval)",
+            "{}: none in this folder (a run writes one when interrupted, every \
+             output.checkpoint_interval, and at t_end unless output.final_checkpoint = false)",
             ck_path.display()
         )));
     }

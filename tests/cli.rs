@@ -859,7 +859,10 @@ fn small_input_holes_exit_2_naming_what_is_wrong() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     let err = stderr(&o);
     assert!(err.contains("constraints.fixed_end"), "{err}");
-    assert!(err.contains("10000000") && !err.contains("not NaN"), "{err}");
+    assert!(
+        err.contains("10000000") && !err.contains("not NaN"),
+        "{err}"
+    );
 
     // A body wholly behind its wall (normal of the wrong sign) never moves.
     let out = tmp("behind");

@@ -826,6 +826,9 @@ fn a_second_signal_long_after_the_first_ends_a_long_step_with_the_folder_saying_
         "the step ended before the second signal ({waited:.2} s to exit): {s}"
     );
     assert!(waited < 2.0, "{waited} s to exit after the second signal");
-    assert!(!out.join("lme-mpm.lock").exists(), "the lock outlives the run");
+    assert!(
+        !out.join("lme-mpm.lock").exists(),
+        "the lock outlives the run"
+    );
     no_tmp_files(&out);
 }

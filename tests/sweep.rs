@@ -421,7 +421,12 @@ fn sweeps_check_memory_together_and_flag_folders_of_another_plan() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--max-memory"), "{}", stderr(&o));
-    assert!(!out.join("runs").join("00-5e-7").join("summary.json").exists());
+    assert!(
+        !out.join("runs")
+            .join("00-5e-7")
+            .join("summary.json")
+            .exists()
+    );
 
     // Room for one run at a time: two jobs asked, one at once.
     let plan_out = dir.join("plan");
@@ -488,7 +493,11 @@ fn sweeps_check_memory_together_and_flag_folders_of_another_plan() {
     );
 
     // Summary garbage and a cut summary: both failed, both unreadable.
-    std::fs::write(local.join("runs/00-5e-7/summary.json"), [0xffu8, 0xfe, 0, 7]).unwrap();
+    std::fs::write(
+        local.join("runs/00-5e-7/summary.json"),
+        [0xffu8, 0xfe, 0, 7],
+    )
+    .unwrap();
     std::fs::write(foreign.join("summary.json"), "{\"status\": \"compl").unwrap();
     collect(&local);
     for r in table(&local) {
@@ -500,14 +509,24 @@ fn sweeps_check_memory_together_and_flag_folders_of_another_plan() {
     let o = bin()
         .arg("sweep")
         .arg(&scene)
-        .args(["--vary", "solver.dt=1e-7", "--backend", "cpu", "--emit-jobs"])
+        .args([
+            "--vary",
+            "solver.dt=1e-7",
+            "--backend",
+            "cpu",
+            "--emit-jobs",
+        ])
         .arg(dir.join("other-jobs.txt"))
         .arg("--out")
         .arg(&plan_out)
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("another sweep's plan"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("another sweep's plan"),
+        "{}",
+        stderr(&o)
+    );
     let o = bin()
         .arg("sweep")
         .arg(&scene)

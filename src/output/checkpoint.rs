@@ -1,7 +1,8 @@
 //! `checkpoint.lmeck`: everything a run needs to continue exactly where it
 //! stopped (the particles with every per-particle state, the time, the step
-//! count, the driver's counters, the resolved scene, and the samples and
-//! snapshots written so far). Binary, little-endian:
+//! count, the driver's counters, the resolved scene, the samples and
+//! snapshots written so far, and the implicit integrator's Newton counters
+//! and held wall contact states). Binary, little-endian:
 //!
 //! ```text
 //! "LMEMPMCK"  magic (8 bytes)
