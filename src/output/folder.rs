@@ -418,7 +418,8 @@ fn try_flock(file: &std::fs::File) -> std::io::Result<bool> {
     }
 }
 
-/// Without flock, the lock file's presence is the lock (not reclaimed).
+/// Without flock (not unix) no lock is taken: the folder is not guarded
+/// against a second run.
 #[cfg(not(unix))]
 fn try_flock(_file: &std::fs::File) -> std::io::Result<bool> {
     Ok(true)
