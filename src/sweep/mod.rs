@@ -49,6 +49,10 @@ pub struct SweepOptions {
     pub max_memory: Option<u64>,
 }
 
+fn mib(bytes: u64) -> f64 {
+    bytes as f64 / 1048576.0
+}
+
 /// How many runs may run at once: at most `jobs`, and no more than the
 /// largest of them fit together in `budget` bytes (the `k` largest
 /// estimates summed), at least one. A run that alone exceeds the budget
@@ -134,6 +138,21 @@ pub fn check_metric(plan: &Plan, metric: &str) -> Result<()> {
 /// then writes the table and charts. A run that fails is a row with its
 /// reason; only a folder that cannot be used ends the sweep.
 pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written> {
+    // A run that alone exceeds --max-memory: refused before anything is written.
+    if let (Some(b), Some(big)) = (
+        opts.max_memory,
+        plan.runs.iter().max_by_key(|r| r.memory_bytes),
+    ) {
+        if big.memory_bytes > b {
+            return Err(Error::Scene(SceneError::Sweep {
+                arg: format!("run {} and --max-memory {b}", big.id),
+                message: format!(
+                    "the run alone needs about {:.1} MiB, more than --max-memory",
+                    mib(big.memory_bytes)
+                ),
+            }));
+        }
+    }
     prepare(dir)?;
     plan.write(dir)?;
     let choice = plan.backend_choice();
@@ -149,33 +168,19 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
     // Runs at once: what --jobs asks, as far as the memory allows.
     let estimates: Vec<u64> = plan.runs.iter().map(|r| r.memory_bytes).collect();
     let budget = opts.max_memory.or_else(crate::preflight::memory_available);
-    if let (Some(b), Some(big)) = (
-        opts.max_memory,
-        plan.runs.iter().max_by_key(|r| r.memory_bytes),
-    ) {
-        if big.memory_bytes > b {
-            return Err(Error::Scene(SceneError::Sweep {
-                arg: format!("run {} and --max-memory {b}", big.id),
-                message: format!(
-                    "the run alone needs about {} MiB, more than --max-memory",
-                    big.memory_bytes >> 20
-                ),
-            }));
-        }
-    }
     let jobs = if on_gpu { 1 } else { opts.jobs.max(1) };
     let at_once = concurrent_runs(&estimates, budget, jobs);
     if at_once < jobs.min(plan.runs.len()) {
         crate::say!(
-            "sweep: running {at_once} at once, not {jobs}: the {} largest runs need about {} MiB \
-             together, more than the {} MiB {}",
+            "sweep: running {at_once} at once, not {jobs}: the {} largest runs need about {:.1} \
+             MiB together, more than the {:.1} MiB {}",
             at_once + 1,
             {
                 let mut e = estimates.clone();
                 e.sort_unstable_by(|a, b| b.cmp(a));
-                e.iter().take(at_once + 1).sum::<u64>() >> 20
+                mib(e.iter().take(at_once + 1).sum::<u64>())
             },
-            budget.unwrap_or(0) >> 20,
+            mib(budget.unwrap_or(0)),
             if opts.max_memory.is_some() {
                 "of --max-memory"
             } else {
