@@ -481,8 +481,8 @@ fn saved_and_unlocked(dir: &Path) {
     assert_eq!(s["status"], "interrupted", "{s}");
     let t = s["t"].as_f64().unwrap();
     for f in ["probes.csv", "energy.csv", "reactions.csv"] {
-        // The CSV's 17 significant digits against JSON's shortest
-        // round-trip: equal to a unit in the 16th digit.
+        // serde_json (without its float_roundtrip feature) parses a
+        // 17-digit number to within an ulp: seen 1 ulp apart.
         let last = last_t(&dir.join(f));
         assert!(
             (last - t).abs() <= CSV_DIGITS * t,
@@ -497,7 +497,9 @@ fn saved_and_unlocked(dir: &Path) {
     no_tmp_files(dir);
 }
 
-/// Relative difference of a time written to a CSV file and to summary.json.
+/// Relative difference allowed between a CSV file's time and summary.json's
+/// `t` as this test reads them (serde_json's float parsing is within 1 ulp,
+/// 1.1e-16 relative; the files hold the same shortest round-trip digits).
 const CSV_DIGITS: f64 = 1e-15;
 
 /// A run long enough to be interrupted (about 30 s alone on one core).
