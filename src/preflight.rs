@@ -168,6 +168,22 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
     Ok(bytes as u64)
 }
 
+/// `--max-hours H`: a positive, finite number of hours (NaN or infinity
+/// would turn the limit off without saying so).
+pub fn parse_hours(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of hours"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "`{s}` is not a positive, finite number of hours (leave --max-hours out for no limit)"
+        ))
+    }
+}
+
 /// Lattice coordinate of `v` through `anchor`, snapped within round-off
 /// (the rule of `scene::seed`).
 fn lattice(v: f64, anchor: f64, h: f64) -> f64 {
@@ -373,7 +389,15 @@ fn memory(
     } else {
         0.0
     };
-    let end = n * (particle + cache + csv) + nodes * per_node + mls + sample_rows;
+    // (c) A checkpoint (at t_end by default): a copy of the particles and
+    // the samples, and their encoding, about as large again.
+    let checkpoint = if f.output.final_checkpoint || f.output.checkpoint_interval.is_some() {
+        2.0 * (n * particle + sample_rows)
+    } else {
+        0.0
+    };
+    let end =
+        n * (particle + cache) + (n * csv).max(checkpoint) + nodes * per_node + mls + sample_rows;
     BASELINE_BYTES + build.max(end)
 }
 

@@ -41,8 +41,9 @@ pub trait Observer {
     fn snapshot(&mut self, backend: &mut dyn Backend) -> Result<()>;
     /// Progress: time reached, t_end (s), steps taken.
     fn progress(&mut self, _t: f64, _t_end: f64, _steps: u64) {}
-    /// A checkpoint is due (every `Schedule::checkpoint_interval`, and when
-    /// interrupted): `cursor` is what `drive_from` needs to continue.
+    /// A checkpoint is due (every `Schedule::checkpoint_interval`, when
+    /// interrupted, and at t_end with `Schedule::final_checkpoint`):
+    /// `cursor` is what `drive_from` needs to continue.
     fn checkpoint(&mut self, _backend: &mut dyn Backend, _cursor: &Cursor) -> Result<()> {
         Ok(())
     }
@@ -74,6 +75,9 @@ pub struct Schedule {
     pub snapshot_times: Vec<f64>,
     /// Checkpoints every this often (s). Default: none.
     pub checkpoint_interval: Option<f64>,
+    /// A checkpoint at t_end too, so a completed run can be extended
+    /// (`lme-mpm resume DIR --set solver.t_end=LATER`). Default: false.
+    pub final_checkpoint: bool,
     /// Raised to stop at the next step boundary (`RunStatus::Interrupted`).
     pub stop: Option<Arc<AtomicBool>>,
 }
@@ -177,6 +181,9 @@ pub fn drive_from(
     loop {
         let t = backend.time();
         if t >= t_end {
+            if schedule.final_checkpoint {
+                obs.checkpoint(backend, &c)?;
+            }
             return Ok(RunStatus::Completed);
         }
         if crate::backend::stop_requested(stop) {

@@ -175,6 +175,7 @@ impl CpuBackend {
             t: self.t,
             dt: self.dt,
             newton: None,
+            held_contacts: Vec::new(),
         }
     }
 

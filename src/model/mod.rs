@@ -225,6 +225,7 @@ impl Model {
 
         let constraints = build_constraints(scene, &grid)?;
         let walls = Walls::new(scene, &grid)?;
+        check_not_behind_walls(&walls, &seeds, &body_names)?;
         let gravity = f.gravity.as_ref().map(|g| Gravity {
             g: g.g,
             ramp: g.ramp,
@@ -397,6 +398,36 @@ fn check_not_empty(seeds: &[seed::Seed], body_names: &[String], h: f64) -> Resul
                     "is empty: its shapes hold no particle point at h = {h} (shapes smaller than a cell?)"
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// No body lies wholly behind a wall (on the side its normal points
+/// away from): the wall would hold every node the body maps to, so the
+/// body could never move; almost surely a normal of the wrong sign.
+fn check_not_behind_walls(
+    walls: &Walls,
+    seeds: &[seed::Seed],
+    body_names: &[String],
+) -> Result<(), SceneError> {
+    for w in &walls.list {
+        let behind = |x: [f64; 2]| {
+            (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1] < 0.0
+        };
+        for (b, name) in body_names.iter().enumerate() {
+            let mut of_body = seeds.iter().filter(|s| s.body as usize == b).peekable();
+            if of_body.peek().is_some() && of_body.all(|s| behind(s.x)) {
+                return Err(SceneError::invalid(
+                    format!("walls.{}", w.name),
+                    format!(
+                        "body `{name}` lies wholly behind the wall (its normal {:?} points away \
+                         from the body): the normal points into the material's side; flip it, \
+                         or move the wall",
+                        w.normal
+                    ),
+                ));
+            }
         }
     }
     Ok(())

@@ -510,6 +510,11 @@ pub struct OutputSpec {
     /// Write `particles.csv` at the end. Default true.
     #[serde(default = "default_true")]
     pub particles_csv: bool,
+    /// Leave `checkpoint.lmeck` at t_end when the run completes, so
+    /// `lme-mpm resume DIR --set solver.t_end=LATER` can extend it (about
+    /// 190 bytes per particle on disk). Default true.
+    #[serde(default = "default_true")]
+    pub final_checkpoint: bool,
     /// Named points (m); the particle nearest to each at t = 0 is tracked.
     #[serde(default)]
     pub probes: BTreeMap<String, [f64; 2]>,
@@ -523,6 +528,7 @@ impl Default for OutputSpec {
             checkpoint_interval: None,
             vtk_final: true,
             particles_csv: true,
+            final_checkpoint: true,
             probes: BTreeMap::new(),
         }
     }

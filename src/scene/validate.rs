@@ -465,7 +465,7 @@ fn check_constraints(file: &SceneFile) -> Result<(), SceneError> {
                 return Err(SceneError::invalid(
                     format!("constraints.{cname}"),
                     format!(
-                        "min/max must be ±inf or within ±{:e} m, not NaN",
+                        "min/max must be ±inf or within ±{:e} m, got {v}",
                         limits::COORD_MAX
                     ),
                 ));

@@ -201,7 +201,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::All => unreachable!(),
         };
         if opts.progress {
-            eprintln!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
+            crate::say!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
         let results = runner::run_jobs(jobs, opts.jobs, opts.progress);
         let records: Vec<Record> = results.iter().map(Record::from_job).collect();
