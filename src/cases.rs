@@ -9,6 +9,7 @@ pub const ROLLING_DISK: &str = include_str!("../cases/rolling_disk.toml");
 pub const COLUMN_COLLAPSE: &str = include_str!("../cases/column_collapse.toml");
 pub const GRANULAR_COLLAPSE: &str = include_str!("../cases/granular_collapse.toml");
 pub const CANTILEVER: &str = include_str!("../cases/cantilever.toml");
+pub const CLAY_BIAXIAL: &str = include_str!("../cases/clay_biaxial.toml");
 
 /// Dyka's bar length (m), as in `cases/dyka_bar.toml`.
 pub const DYKA_L: f64 = 0.1333;

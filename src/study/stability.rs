@@ -5,7 +5,9 @@
 
 use super::runner::{Job, JobResult};
 use super::{backend_slug, image, sig, table};
-use crate::cases::{COLUMN_COLLAPSE, DYKA_BAR, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK};
+use crate::cases::{
+    CLAY_BIAXIAL, COLUMN_COLLAPSE, DYKA_BAR, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK,
+};
 use crate::error::Result;
 use crate::exact::Errors;
 use crate::simulation::BackendChoice;
@@ -40,6 +42,7 @@ impl Column {
             "elastic_block" => ("block", format!("{} m", sig(self.h))),
             "rolling_disk" => ("disk", format!("{} m", sig(self.h))),
             "column_collapse" => ("column", format!("{} m", sig(self.h))),
+            "clay_biaxial" => ("Cam-clay", format!("{} m", sig(self.h))),
             _ => ("plate", format!("{} m", sig(self.h))),
         };
         if self.perturb > 0.0 {
@@ -62,6 +65,7 @@ pub fn columns(quick: bool) -> Vec<Column> {
             c("plate_impact", 2.0, 0.2),
             c("rolling_disk", 0.04, 0.0),
             c("column_collapse", 0.1, 0.0),
+            c("clay_biaxial", 0.25, 0.0),
         ]
     } else {
         vec![
@@ -77,6 +81,7 @@ pub fn columns(quick: bool) -> Vec<Column> {
             c("plate_impact", 1.0, 0.2),
             c("rolling_disk", 0.02, 0.0),
             c("column_collapse", 0.05, 0.0),
+            c("clay_biaxial", 0.125, 0.0),
         ]
     }
 }
@@ -91,6 +96,7 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
                     "elastic_block" => (ELASTIC_BLOCK, "elastic_block"),
                     "rolling_disk" => (ROLLING_DISK, "rolling_disk"),
                     "column_collapse" => (COLUMN_COLLAPSE, "column_collapse"),
+                    "clay_biaxial" => (CLAY_BIAXIAL, "clay_biaxial"),
                     _ => (PLATE_IMPACT, "plate_impact"),
                 };
                 let mut j = Job::new(
