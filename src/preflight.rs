@@ -269,6 +269,15 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         f64::INFINITY
     };
     let steps = steps.max(1.0);
+    // A static implicit run takes its load steps, whatever the wave speed.
+    let (dt, steps) = if matches!(f.solver.integrator, crate::scene::IntegratorKind::Implicit)
+        && f.solver.static_analysis
+    {
+        let n = f64::from(f.solver.load_steps.max(1));
+        (t_end / n, n)
+    } else {
+        (dt, steps)
+    };
     let samples = (t_end / scene.sample_interval.max(dt)).floor() + 1.0;
     let snapshots = f
         .output
