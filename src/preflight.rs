@@ -567,6 +567,17 @@ mod tests {
     }
 
     #[test]
+    fn a_static_implicit_run_takes_its_load_steps() {
+        // cases/cantilever.toml: static, one load step (issue 26 saw about
+        // 12,000, from the wave speed an explicit run would need).
+        let scene =
+            Scene::from_str(crate::cases::CANTILEVER, "cantilever", "cantilever", &[]).unwrap();
+        let est = plan(&scene, &Limits::default(), 1).unwrap().estimate;
+        assert_eq!(est.steps, f64::from(scene.file.solver.load_steps));
+        assert_eq!(est.dt, scene.file.solver.t_end / est.steps);
+    }
+
+    #[test]
     fn rect_cells_follow_the_seeder() {
         // [0, 1] on h = 0.25 from 0: 4 cells; a sliver past a node line adds none.
         assert_eq!(cells_overlapped(0.0, 1.0, 0.0, 0.25), 4.0);

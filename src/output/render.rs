@@ -262,7 +262,7 @@ impl Palette {
         rgb.truncate(256);
         let lut = (0..32 * 32 * 32)
             .map(|k| {
-                let q = [(k >> 10) & 31, (k >> 5) & 31, k & 31].map(|v| (v * 255 / 31) as i32);
+                let q = [(k >> 10) & 31, (k >> 5) & 31, k & 31].map(|v| v * 255 / 31);
                 rgb.iter()
                     .enumerate()
                     .min_by_key(|(_, c)| {

@@ -394,8 +394,8 @@ pub fn picture(
     {
         let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
         let (left, right) = root.split_horizontally(HISTORY_WIDTH);
-        chart.draw(&left).map_err(|e| draw_error(e))?;
-        image.draw(&right, 1).map_err(|e| draw_error(e))?;
+        chart.draw(&left).map_err(draw_error)?;
+        image.draw(&right, 1).map_err(draw_error)?;
         root.present().map_err(|e| draw_error(e.to_string()))?;
     }
     crate::chart::png_bytes(&buf, SIZE)
