@@ -45,6 +45,10 @@ pub struct State {
     /// The implicit integrator's Newton statistics so far, so a resumed
     /// run's `summary.json` covers the whole run (None otherwise).
     pub newton: Option<NewtonStats>,
+    /// The implicit integrator's wall contact states of the last converged
+    /// step, per node then wall (`held_contact_code`), where the next step
+    /// starts its active set; empty for the explicit integrators.
+    pub held_contacts: Vec<u8>,
 }
 
 /// State of one probe particle.
@@ -171,6 +175,11 @@ pub trait Backend {
     /// Newton statistics (the implicit integrator only).
     fn newton(&self) -> Option<&NewtonStats> {
         None
+    }
+    /// The implicit integrator's held wall contact states (see
+    /// `State::held_contacts`); empty for the others.
+    fn held_contacts(&self) -> Vec<u8> {
+        Vec::new()
     }
 }
 

@@ -533,7 +533,7 @@ fn process_cpu_seconds() -> f64 {
 /// timed on its own (`CpuBackend::run_stage`), after one warm-up step.
 pub fn profile_cpu(particles: usize, case: &Case, steps: u64) -> Result<Vec<StageTime>> {
     use crate::cpu::CpuBackend;
-    use crate::solver::STEP;
+    use crate::step::STEP;
     let model = Model::new(&scene(particles, case)?)?;
     let n = model.particles.len() as f64;
     let mut cpu = CpuBackend::new(model);
@@ -577,7 +577,7 @@ pub fn profile_gpu(
     })?;
     let mut gpu = GpuBackend::with_options(ctx, model, case.gpu)?;
     gpu.advance_steps(1).map_err(halted)?;
-    let passes: Vec<Pass> = crate::gpu::pipelines::Pipelines::step_passes(gpu.plan()).collect();
+    let passes: Vec<Pass> = gpu.plan().gpu_step.clone();
     // Cost of a submission and wait alone.
     let start = Instant::now();
     let cpu_start = process_cpu_seconds();

@@ -7,14 +7,15 @@
 //! Layers, bottom up (`tests/layers.rs` keeps them pointing one way):
 //! `limits`, `scene` (the file, validated) → `model` (grid, particles,
 //! shape functions, materials, loads, energy, the time-step rule) →
-//! `backend` (the contract) → `cpu`, `gpu` (the two backends, never
-//! importing each other) → `solver` (the step as a stage list, the driver)
+//! `step` (the step plan: stages, fusion, GPU passes) → `backend` (the
+//! contract) → `cpu`, `gpu` (the two backends, never importing each
+//! other) → `solver` (the driver)
 //! → `simulation` (scene + backend + drive + score: one run) → `exact`
 //! (scoring), `output`, `run`, `study`, `bench` (the commands).
 //!
 //! A run: `scene::Scene::load` → `simulation::Simulation::new` (builds the
 //! `model::Model`, opens a `backend::Backend`) → `Simulation::drive` (the
-//! stages of `solver::STEP`, sampled by an `solver::Observer`) →
+//! stages of `step::StepPlan`, sampled by an `solver::Observer`) →
 //! `Simulation::score` → `output`.
 
 pub mod backend;
@@ -35,6 +36,7 @@ pub mod run;
 pub mod scene;
 pub mod simulation;
 pub mod solver;
+pub mod step;
 pub mod study;
 pub mod sweep;
 

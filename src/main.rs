@@ -1,7 +1,7 @@
 //! The `lme-mpm` command line: run, resume, check, info, study, sweep, bench.
 //! Exit codes: 0 completed, 2 invalid input (or a folder or checkpoint
-//! that cannot be used), 3 unstable run, 130/143 interrupted by
-//! SIGINT/SIGTERM, 1 anything else.
+//! that cannot be used), 3 unstable run, 129/130/143 interrupted by
+//! SIGHUP/SIGINT/SIGTERM, 1 anything else.
 
 use clap::{Parser, Subcommand};
 use lme_mpm::run::{self, BackendChoice, RunOptions};
@@ -30,8 +30,8 @@ enum Command {
     /// there are removed first (only those: lme-mpm.manifest lists them), a
     /// second run into a folder in use is refused (lme-mpm.lock), and a
     /// non-empty folder that is not an lme-mpm output folder is refused.
-    /// SIGINT/SIGTERM stop the run at the next step boundary with every
-    /// output written and a checkpoint (exit 130/143); `resume` continues it.
+    /// SIGINT/SIGTERM/SIGHUP stop the run at the next step boundary with every
+    /// output written and a checkpoint (exit 130/143/129); `resume` continues it.
     Run {
         /// Scene file (TOML), e.g. cases/dyka_bar.toml.
         scene: PathBuf,
@@ -58,8 +58,9 @@ enum Command {
         limits: LimitArgs,
     },
     /// Continue the run in DIR from its checkpoint (checkpoint.lmeck: written
-    /// when a run is interrupted, and every output.checkpoint_interval), into
-    /// the same folder: the CSV files keep their rows up to the checkpoint.
+    /// when a run is interrupted, every output.checkpoint_interval, and at
+    /// the end of a completed run: extend it with --set solver.t_end=LATER),
+    /// into the same folder: the CSV files keep their rows up to the checkpoint.
     Resume {
         /// The run's output folder.
         dir: PathBuf,
@@ -72,7 +73,8 @@ enum Command {
         #[arg(long)]
         adapter: Option<String>,
         /// Change a key: solver.t_end (to run further), output.checkpoint_interval,
-        /// output.vtk_interval, output.vtk_final, output.particles_csv (repeatable).
+        /// output.vtk_interval, output.vtk_final, output.particles_csv,
+        /// output.final_checkpoint (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// No progress and no result line.
@@ -218,7 +220,7 @@ struct LimitArgs {
     max_steps: u64,
     /// Refuse a run estimated to take more than H hours at a conservative
     /// speed of the CPU path. Default: no limit (runs over 1 h only warn).
-    #[arg(long, value_name = "H")]
+    #[arg(long, value_name = "H", value_parser = lme_mpm::preflight::parse_hours)]
     max_hours: Option<f64>,
     /// Allow more than 1000 VTK snapshots (output.vtk_interval).
     #[arg(long)]
@@ -254,8 +256,24 @@ fn load(path: &std::path::Path, set: &[String]) -> Result<Scene, SceneError> {
     Scene::load(path, &overrides)
 }
 
+/// Writes `text` to stdout: a reader that closed the pipe took what it
+/// wanted (exit 0); any other failure (a full disk) is an error (exit 1),
+/// never a panic.
+fn write_stdout(text: &str) -> ExitCode {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            lme_mpm::say!("error: cannot write to standard output: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
 fn fail(e: &Error) -> ExitCode {
-    eprintln!("error: {e}");
+    lme_mpm::say!("error: {e}");
     ExitCode::from(e.exit_code() as u8)
 }
 
@@ -385,13 +403,13 @@ fn main() -> ExitCode {
                 Err(e) => return fail(&Error::Scene(e)),
             };
             for w in &plan.warnings {
-                eprintln!("warning: {w}");
+                lme_mpm::say!("warning: {w}");
             }
             match lme_mpm::model::Model::new(&plan.scene) {
                 Ok(model) => {
-                    print!("{}", lme_mpm::run::describe(&plan.scene, &model));
-                    print!("{}", lme_mpm::preflight::describe(&plan.estimate));
-                    ExitCode::SUCCESS
+                    let text = lme_mpm::run::describe(&plan.scene, &model)
+                        + &lme_mpm::preflight::describe(&plan.estimate);
+                    write_stdout(&text)
                 }
                 Err(e) => fail(&Error::Scene(e)),
             }
@@ -399,36 +417,68 @@ fn main() -> ExitCode {
     }
 }
 
-/// SIGINT and SIGTERM raise `stop` (the run ends at the next step
-/// boundary) and record which came; a second one ends the process at once.
+/// SIGINT, SIGTERM and SIGHUP raise `stop` (the run ends at the next step
+/// boundary with every output and a checkpoint) and record which came
+/// first. A repeat is ignored within `REPEAT_GRACE` of the first (GNU
+/// `timeout` signals the process and then its group: two at once) and
+/// while a run saves; later, it ends the process at once, each run folder
+/// saying `interrupted` and holding no lock (`output::folder::abandon_all`).
 struct Signals {
     stop: Arc<AtomicBool>,
     which: Arc<AtomicUsize>,
 }
 
+/// A repeated signal this soon after the first is the same request.
+const REPEAT_GRACE: std::time::Duration = std::time::Duration::from_secs(2);
+
 impl Signals {
     fn install() -> std::io::Result<Signals> {
-        use signal_hook::consts::{SIGINT, SIGTERM};
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
         let stop = Arc::new(AtomicBool::new(false));
         let which = Arc::new(AtomicUsize::new(0));
-        for sig in [SIGINT, SIGTERM] {
-            // Order matters: the shutdown checks the flag before it is raised.
-            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&stop))?;
-            signal_hook::flag::register_usize(sig, Arc::clone(&which), sig as usize)?;
-            signal_hook::flag::register(sig, Arc::clone(&stop))?;
-        }
+        let mut incoming = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])?;
+        let (flag, first_sig) = (Arc::clone(&stop), Arc::clone(&which));
+        std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                let mut first: Option<std::time::Instant> = None;
+                for sig in incoming.forever() {
+                    let Some(at) = first else {
+                        first_sig.store(sig as usize, Ordering::SeqCst);
+                        flag.store(true, Ordering::SeqCst);
+                        first = Some(std::time::Instant::now());
+                        continue;
+                    };
+                    if at.elapsed() < REPEAT_GRACE {
+                        continue;
+                    }
+                    if lme_mpm::output::folder::abandon_all() {
+                        lme_mpm::say!(
+                            "error: signal {sig} again before the run reached a step boundary: \
+                             ended at once; summary.json says interrupted"
+                        );
+                        let code = 128 + first_sig.load(Ordering::SeqCst).clamp(1, 127);
+                        std::process::exit(code as i32);
+                    }
+                    lme_mpm::say!(
+                        "signal {sig} again: still saving, the run ends when it is saved"
+                    );
+                }
+            })?;
         Ok(Signals { stop, which })
     }
 
     fn install_or_say() -> Option<Signals> {
         Signals::install()
-            .map_err(|e| eprintln!("error: cannot install the SIGINT/SIGTERM handlers: {e}"))
+            .map_err(|e| {
+                lme_mpm::say!("error: cannot install the SIGINT/SIGTERM/SIGHUP handlers: {e}")
+            })
             .ok()
     }
 
-    /// 130 for SIGINT, 143 for SIGTERM.
+    /// 128 + the first signal: 129 SIGHUP, 130 SIGINT, 143 SIGTERM.
     fn exit_code(&self) -> ExitCode {
-        let sig = self.which.load(Ordering::Relaxed);
+        let sig = self.which.load(Ordering::SeqCst);
         ExitCode::from((128 + sig.clamp(1, 127)) as u8)
     }
 }
@@ -466,20 +516,25 @@ fn report(
     };
     let s = &outcome.summary;
     if !quiet {
-        eprintln!(
+        lme_mpm::say!(
             "{}: t = {:.6e} s, {} steps, {} particles, {:.3e} particle-steps/s on {}",
-            s.status, s.t, s.steps, s.particles, s.particle_steps_per_second, s.backend
+            s.status,
+            s.t,
+            s.steps,
+            s.particles,
+            s.particle_steps_per_second,
+            s.backend
         );
         if let Some(r) = &s.reason {
-            eprintln!("reason: {r}");
+            lme_mpm::say!("reason: {r}");
         }
         if let Some(e) = &s.errors {
-            eprintln!("errors: {}", serde_json::to_string(e).unwrap_or_default());
+            lme_mpm::say!("errors: {}", serde_json::to_string(e).unwrap_or_default());
         }
         if let Some(words) = lme_mpm::output::result::text(s) {
-            eprintln!("result: {words}");
+            lme_mpm::say!("result: {words}");
         }
-        eprintln!("outputs: {}", opts.out.display());
+        lme_mpm::say!("outputs: {}", opts.out.display());
     }
     match outcome.status {
         RunStatus::Completed => ExitCode::SUCCESS,
@@ -521,9 +576,15 @@ struct SweepArgs {
     /// CPU path (a software adapter counts as none; --backend gpu uses it).
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
-    /// Runs at once (default: one per core; each run gets cores / jobs threads).
+    /// Runs at once (default: one per core; each run gets cores / jobs threads),
+    /// fewer when their estimated memory together exceeds --max-memory.
     #[arg(long)]
     jobs: Option<usize>,
+    /// Memory the runs running at once may take together (bytes, or with
+    /// K/M/G/T); a run needing more alone is refused. Default: the memory
+    /// available at the start (MemAvailable).
+    #[arg(long, value_name = "SIZE", value_parser = lme_mpm::preflight::parse_size)]
+    max_memory: Option<u64>,
     /// Sweep folder. Default: out/sweep/<scene name>.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -536,7 +597,7 @@ struct SweepArgs {
     exe: Option<String>,
     /// Build sweep.csv, the charts and sweep.md of the sweep in DIR from
     /// its finished run folders (missing or interrupted runs listed as such).
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "vary", "set", "resolution", "emit_jobs", "jobs", "out"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "vary", "set", "resolution", "emit_jobs", "jobs", "max_memory", "out"])]
     collect: Option<PathBuf>,
     /// No progress bar and no closing lines.
     #[arg(long, short)]
@@ -656,6 +717,7 @@ fn sweep(a: SweepArgs) -> ExitCode {
         progress_lines: !a.quiet && !std::io::stderr().is_terminal(),
         stop: Some(Arc::clone(&signals.stop)),
         metric: a.metric.clone(),
+        max_memory: a.max_memory,
     };
     match sweep::run_local(&plan, &out, &opts) {
         Ok(w) => {

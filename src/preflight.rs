@@ -168,6 +168,22 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
     Ok(bytes as u64)
 }
 
+/// `--max-hours H`: a positive, finite number of hours (NaN or infinity
+/// would turn the limit off without saying so).
+pub fn parse_hours(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of hours"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "`{s}` is not a positive, finite number of hours (leave --max-hours out for no limit)"
+        ))
+    }
+}
+
 /// Lattice coordinate of `v` through `anchor`, snapped within round-off
 /// (the rule of `scene::seed`).
 fn lattice(v: f64, anchor: f64, h: f64) -> f64 {
@@ -238,8 +254,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
     let mut c_max = 0.0f64;
     let mut c_key = String::from("solver.cfl");
     for (_, b) in scene.bodies() {
-        let m = Material::new(&f.materials[&b.material]);
-        let c = m.wave_speed(m.density());
+        let m = Material::from_spec(&b.material, &f.materials[&b.material])?;
+        let c = m.wave_speed(m.density(), &[0.0; 3], &[0.0; 4]);
         let v = b.velocity[0].hypot(b.velocity[1]);
         let s = c.max(v);
         if s > c_max || s.is_nan() {
@@ -321,12 +337,10 @@ fn memory(
 ) -> f64 {
     let f = &scene.file;
     let nodes = nx as f64 * ny as f64;
-    let needs_f = scene
-        .materials()
-        .any(|(_, m)| Material::new(m).needs_deformation_gradient());
-    let needs_plastic = scene
-        .materials()
-        .any(|(_, m)| Material::new(m).needs_plastic_state());
+    // `estimate` has checked the materials before this is called.
+    let materials = crate::model::material::check(&scene.file).unwrap_or_default();
+    let needs_f = materials.iter().any(Material::needs_deformation_gradient);
+    let needs_plastic = materials.iter().any(Material::needs_plastic_state);
     let npc = f.solver.integrator == crate::scene::IntegratorKind::Npc;
     // Particle fields (model::Particles): x, v, x0, mass, rho, stress, body.
     let mut particle = 16.0 * 3.0 + 8.0 * 2.0 + 24.0 + 4.0;
@@ -384,7 +398,15 @@ fn memory(
     } else {
         0.0
     };
-    let end = n * (particle + cache + csv) + nodes * per_node + mls + sample_rows;
+    // (c) A checkpoint (at t_end by default): a copy of the particles and
+    // the samples, and their encoding, about as large again.
+    let checkpoint = if f.output.final_checkpoint || f.output.checkpoint_interval.is_some() {
+        2.0 * (n * particle + sample_rows)
+    } else {
+        0.0
+    };
+    let end =
+        n * (particle + cache) + (n * csv).max(checkpoint) + nodes * per_node + mls + sample_rows;
     BASELINE_BYTES + build.max(end)
 }
 

@@ -56,6 +56,7 @@ pub const RESUME_KEYS: &[&str] = &[
     "output.vtk_interval",
     "output.vtk_final",
     "output.particles_csv",
+    "output.final_checkpoint",
 ];
 
 /// Runs `scene` and writes its outputs to `opts.out`, which it takes for
@@ -77,7 +78,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome> {
 fn preflight(scene: &Scene, opts: &RunOptions) -> Result<crate::preflight::Plan> {
     let plan = crate::preflight::plan(scene, &opts.limits, rayon::current_num_threads())?;
     for w in &plan.warnings {
-        eprintln!("warning: {w}");
+        crate::say!("warning: {w}");
     }
     Ok(plan)
 }
@@ -103,8 +104,8 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     let ck_path = folder.path(checkpoint::FILE);
     if !ck_path.is_file() {
         return Err(Error::Checkpoint(format!(
-            "{}: none in this folder (a run writes one when interrupted, or every \
-             output.checkpoint_interval)",
+            "{}: none in this folder (a run writes one when interrupted, every \
+             output.checkpoint_interval, and at t_end unless output.final_checkpoint = false)",
             ck_path.display()
         )));
     }
@@ -129,6 +130,7 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
         t: ck.t,
         dt: ck.dt,
         newton: ck.newton.clone(),
+        held_contacts: ck.held_contacts.clone(),
     };
     sim.backend().restore(&state, ck.steps)?;
     // What the run wrote after its checkpoint goes; the snapshots up to it stay.
@@ -144,6 +146,7 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     writer.samples = ck.samples.clone();
     writer.snapshots = ck.snapshots.clone();
     writer.resumed_from = Some(ck.t);
+    writer.set_last_words();
     writer.flush()?;
     writer.write_pvd()?;
     execute(&mut sim, writer, Some(ck.cursor), start, opts, &plan)
@@ -188,10 +191,13 @@ fn finish(
     let steps0 = sim.backend_ref().steps();
     let mut schedule = sim.schedule();
     schedule.stop = opts.stop.clone();
+    schedule.final_checkpoint = scene.file.output.final_checkpoint;
     let t_drive = Instant::now();
     writer.started = Some((t_drive, sim.backend_ref().time(), steps0));
     let driven = sim.drive_from(schedule, writer, cursor);
     writer.finish_progress();
+    // From here to summary.json no signal ends the process.
+    let _saving = writer.folder.saving();
     let status = driven?;
     let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
 
@@ -402,6 +408,7 @@ impl Writer {
                 .map_err(|e| Error::io("cannot create snapshot folder", &vdir, e))?;
         }
         w.status_summary("running", None)?;
+        w.set_last_words();
         let resolved = toml::to_string(&scene.file).expect("a scene file serialises to TOML");
         w.write("scene.resolved.toml", resolved.as_bytes())?;
         Ok(w)
@@ -426,6 +433,24 @@ impl Writer {
         });
         let text = serde_json::to_string_pretty(&json).expect("json serialises");
         self.write("summary.json", text.as_bytes())
+    }
+
+    /// What summary.json says if a repeated signal ends the process in the
+    /// middle of a step (`output::folder::abandon_all`).
+    fn set_last_words(&self) {
+        let json = serde_json::json!({
+            "status": "interrupted",
+            "error": null,
+            "reason": "ended by a repeated signal in the middle of a step: the CSV files hold \
+                       the rows of their last rewrite, and checkpoint.lmeck (when there is one) \
+                       the state of the last periodic checkpoint, which `lme-mpm resume` continues",
+            "scene": self.scene_name,
+            "pid": std::process::id(),
+            "resumed_from": self.resumed_from,
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        let text = serde_json::to_string_pretty(&json).expect("json serialises");
+        self.folder.set_last_words(text);
     }
 
     fn flush(&mut self) -> Result<()> {
@@ -482,7 +507,7 @@ impl Writer {
         } else {
             "unknown".to_string()
         };
-        eprintln!(
+        crate::say!(
             "progress: {:>3.0} %  t = {t:.4e} s of {t_end:.4e} s, {steps} steps, \
              {rate:.3e} particle-steps/s, eta {eta}",
             100.0 * t / t_end
@@ -506,6 +531,7 @@ impl Observer for Writer {
     }
 
     fn checkpoint(&mut self, backend: &mut dyn Backend, cursor: &Cursor) -> Result<()> {
+        let _saving = self.folder.saving();
         let t0 = Instant::now();
         let ck = Checkpoint {
             scene_name: self.scene_name.clone(),
@@ -519,6 +545,7 @@ impl Observer for Writer {
             samples: self.samples.clone(),
             snapshots: self.snapshots.clone(),
             newton: backend.newton().cloned(),
+            held_contacts: backend.held_contacts(),
         };
         self.write(checkpoint::FILE, &ck.encode())?;
         // The CSV files as of the checkpoint, so a kill leaves them consistent with it.
@@ -582,13 +609,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let step_rule = match model.fixed_dt {
         Some(fixed) => {
             // Courant number of the fixed step at t = 0.
-            let c = crate::model::time_step::max_speed(
-                &model.particles.v,
-                &model.particles.rho,
-                &model.particles.body,
-                &model.materials,
-                &model.body_material,
-            );
+            let c = crate::model::time_step::max_speed(model);
             format!(
                 "dt = {fixed} s fixed (Courant number {:.3} at t = 0)",
                 c * fixed / g.min_spacing()
@@ -600,23 +621,23 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         .file
         .materials
         .iter()
-        .map(|(n, m)| {
-            let model = serde_json::to_value(m.model)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default();
-            let mut plastic = String::new();
-            if let (Some(c), Some(phi)) = (m.cohesion, m.friction_angle) {
-                plastic = format!(
-                    ", c = {c} Pa, phi = {phi} deg, psi = {} deg, tension cutoff {}",
-                    m.dilation_angle.unwrap_or(0.0),
-                    m.tension_cutoff
-                        .map_or("at the apex".to_string(), |t| format!("{t} Pa"))
-                );
-            }
+        .zip(&model.materials)
+        .map(|((n, m), mat)| {
+            // Each key with its unit, in the model's own order.
+            let keys: Vec<String> = mat
+                .entry()
+                .keys
+                .iter()
+                .filter_map(|k| {
+                    m.get(k.name)
+                        .map(|v| format!("{} = {v} {}", k.name, k.unit))
+                })
+                .collect();
             format!(
-                "{n} ({model}, E = {} Pa, nu = {}, rho = {} kg/m^3{plastic})",
-                m.youngs_modulus, m.nu, m.density
+                "{n} ({}, density = {} kg/m^3, {})",
+                m.model,
+                m.density,
+                keys.join(", ")
             )
         })
         .collect::<Vec<_>>()

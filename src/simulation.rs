@@ -83,7 +83,7 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             BackendChoice::Cpu | BackendChoice::Auto => {
                 let b = ImplicitBackend::new(model)?;
                 if spec.verbose && spec.choice() == BackendChoice::Auto {
-                    eprintln!(
+                    crate::say!(
                         "backend: {} (auto: the implicit integrator runs on the CPU only)",
                         b.name()
                     );
@@ -98,7 +98,7 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             let ctx = gpu::context::open(&req(true))?;
             let b = GpuBackend::with_options(ctx, model, spec.gpu)?;
             if spec.verbose {
-                eprintln!("backend: {}", b.name());
+                crate::say!("backend: {}", b.name());
             }
             Ok(Box::new(b))
         }
@@ -106,7 +106,7 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             Ok(ctx) => {
                 let b = GpuBackend::with_options(ctx, model, spec.gpu)?;
                 if spec.verbose {
-                    eprintln!("backend: {} (auto: a GPU adapter was found)", b.name());
+                    crate::say!("backend: {} (auto: a GPU adapter was found)", b.name());
                 }
                 Ok(Box::new(b))
             }
@@ -116,7 +116,7 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
                         Error::NoAdapter(m) => m.clone(),
                         other => other.to_string(),
                     };
-                    eprintln!(
+                    crate::say!(
                         "backend: CPU path (f64, {} threads); auto found no usable GPU: {why}",
                         rayon::current_num_threads()
                     );
@@ -157,6 +157,7 @@ impl Simulation {
             vtk_interval: self.scene.file.output.vtk_interval,
             snapshot_times: Vec::new(),
             checkpoint_interval: self.scene.file.output.checkpoint_interval,
+            final_checkpoint: false,
             stop: None,
         }
     }

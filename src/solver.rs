@@ -1,14 +1,7 @@
-//! The step as the paper writes it (Algorithm 1), as an ordered list of
-//! stages that every backend executes, and the run driver that advances a
-//! backend from output time to output time.
-//!
-//! FE and NPC share the stage list; they differ in parameters only:
-//! NPC predicts with (1 − γ)Δt a_p in `p2g` and corrects with γΔt f/m,
-//! FE has no acceleration term and corrects with Δt f/m (the nodal
-//! momentum update of Zhang et al.). MUSL (the B-spline paper's update)
-//! orders the stages differently, `STEP_MUSL`: forces from the stress at
-//! the step's start, the particle update, a remap of the new velocities
-//! to the nodes, and the stress last.
+//! The run driver: advances a backend from output time to output time
+//! (`drive`), checks the energy, and hands samples, snapshots and
+//! checkpoints to an `Observer`. What one step runs is the step plan
+//! (`crate::step`), which the backends execute.
 
 use crate::backend::{Backend, Halt, Sample};
 use crate::error::Result;
@@ -16,72 +9,6 @@ use crate::model::energy::Energy;
 use crate::model::fault::{Fault, FaultKind};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-
-/// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
-/// WGSL twin `shaders/<name>.wgsl` of the same name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
-    /// Δt from the Courant condition (eq. 43).
-    Cfl,
-    /// Zero nodal accumulators.
-    ClearGrid,
-    /// N, ∇N at every particle (LME: Newton on λ).
-    ShapeEval,
-    /// Scatter mass and (predicted) momentum.
-    P2g,
-    /// Nodal velocities and Dirichlet conditions.
-    GridPredict,
-    /// Strain increment, density and stress.
-    Stress,
-    /// Internal and external nodal forces.
-    Forces,
-    /// Reactions, fixed components, corrector.
-    GridCorrect,
-    /// Particle update.
-    G2p,
-    /// MUSL: the updated particle velocities mapped back to the nodes with
-    /// the step's start weights (by MLS with `solver.mls`, eqs. 31–33),
-    /// then the nodal velocities and Dirichlet conditions as in `GridPredict`.
-    Remap,
-}
-
-/// The stages of one step, in order.
-pub const STEP: &[Stage] = &[
-    Stage::Cfl,
-    Stage::ClearGrid,
-    Stage::ShapeEval,
-    Stage::P2g,
-    Stage::GridPredict,
-    Stage::Stress,
-    Stage::Forces,
-    Stage::GridCorrect,
-    Stage::G2p,
-];
-
-/// The stages of one MUSL step (B-spline paper eqs. 18–37), in order:
-/// projection at t (18–25), forces from σ^t, nodal momentum update (28),
-/// FLIP velocity and position (29–30), remap (31–33), and the velocity
-/// gradient, F, density and stress from the remapped velocity (34–37).
-pub const STEP_MUSL: &[Stage] = &[
-    Stage::Cfl,
-    Stage::ClearGrid,
-    Stage::ShapeEval,
-    Stage::P2g,
-    Stage::GridPredict,
-    Stage::Forces,
-    Stage::GridCorrect,
-    Stage::G2p,
-    Stage::Remap,
-    Stage::Stress,
-];
-
-/// The stage list of `integrator`.
-pub fn stages(integrator: crate::model::Integrator) -> &'static [Stage] {
-    match integrator {
-        crate::model::Integrator::Musl => STEP_MUSL,
-        _ => STEP,
-    }
-}
 
 /// A run stops as unstable when kinetic + strain energy exceeds this many
 /// times the energy the run could have received (initial energy plus the
@@ -114,8 +41,9 @@ pub trait Observer {
     fn snapshot(&mut self, backend: &mut dyn Backend) -> Result<()>;
     /// Progress: time reached, t_end (s), steps taken.
     fn progress(&mut self, _t: f64, _t_end: f64, _steps: u64) {}
-    /// A checkpoint is due (every `Schedule::checkpoint_interval`, and when
-    /// interrupted): `cursor` is what `drive_from` needs to continue.
+    /// A checkpoint is due (every `Schedule::checkpoint_interval`, when
+    /// interrupted, and at t_end with `Schedule::final_checkpoint`):
+    /// `cursor` is what `drive_from` needs to continue.
     fn checkpoint(&mut self, _backend: &mut dyn Backend, _cursor: &Cursor) -> Result<()> {
         Ok(())
     }
@@ -147,6 +75,9 @@ pub struct Schedule {
     pub snapshot_times: Vec<f64>,
     /// Checkpoints every this often (s). Default: none.
     pub checkpoint_interval: Option<f64>,
+    /// A checkpoint at t_end too, so a completed run can be extended
+    /// (`lme-mpm resume DIR --set solver.t_end=LATER`). Default: false.
+    pub final_checkpoint: bool,
     /// Raised to stop at the next step boundary (`RunStatus::Interrupted`).
     pub stop: Option<Arc<AtomicBool>>,
 }
@@ -250,6 +181,9 @@ pub fn drive_from(
     loop {
         let t = backend.time();
         if t >= t_end {
+            if schedule.final_checkpoint {
+                obs.checkpoint(backend, &c)?;
+            }
             return Ok(RunStatus::Completed);
         }
         if crate::backend::stop_requested(stop) {
@@ -324,7 +258,13 @@ fn energy_floor(backend: &mut dyn Backend) -> f64 {
     let m = backend.model();
     let p = &m.particles;
     let mc2: f64 = (0..p.len())
-        .map(|i| p.mass[i] * m.material_of(i).wave_speed(p.rho[i]).powi(2))
+        .map(|i| {
+            let q = p.plastic.get(i).unwrap_or(&[0.0; 4]);
+            p.mass[i]
+                * m.material_of(i)
+                    .wave_speed(p.rho[i], &p.stress[i], q)
+                    .powi(2)
+        })
         .sum();
     1e-12 * mc2
 }

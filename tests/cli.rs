@@ -845,3 +845,57 @@ fn bench_runs_a_named_peer_after_ours_and_prints_the_ratio() {
         "{csv}"
     );
 }
+
+/// Issue 25, item 10: input that was silently dropped, turned a limit off,
+/// or was called the wrong thing.
+#[test]
+fn small_input_holes_exit_2_naming_what_is_wrong() {
+    let dyka = common::case("dyka_bar.toml");
+    // A --set value over several lines: the rest was dropped unsaid.
+    let out = tmp("multiline");
+    let o = run_with(&dyka, &out, &["solver.t_end=1e-5\n[grid]\nh=5"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("newline"), "{}", stderr(&o));
+    assert!(!out.exists());
+
+    // --max-hours nan (or inf, or not positive) turned the limit off.
+    for v in ["nan", "inf", "0", "-1"] {
+        let o = bin()
+            .arg("check")
+            .arg(&dyka)
+            .arg(format!("--max-hours={v}"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "--max-hours {v}: {}", stderr(&o));
+        assert!(stderr(&o).contains("--max-hours"), "{}", stderr(&o));
+    }
+
+    // A bound out of range is named with its value, not called NaN.
+    let o = run_with(
+        &dyka,
+        &tmp("inf-bound"),
+        &["constraints.fixed_end.min=[1e7,-inf]"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("constraints.fixed_end"), "{err}");
+    assert!(
+        err.contains("10000000") && !err.contains("not NaN"),
+        "{err}"
+    );
+
+    // A body wholly behind its wall (normal of the wrong sign) never moves.
+    let out = tmp("behind");
+    let o = run_with(
+        &common::case("sliding_block.toml"),
+        &out,
+        &["walls.floor.normal=[0, -1]"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("walls.floor") && err.contains("wholly behind"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

@@ -7,7 +7,7 @@ use lme_mpm::backend::Backend;
 use lme_mpm::bench::{Case, scene};
 use lme_mpm::cpu::CpuBackend;
 use lme_mpm::model::Model;
-use lme_mpm::solver::STEP;
+use lme_mpm::step::STEP;
 
 #[test]
 fn fused_step_equals_the_stages_one_by_one() {

@@ -42,6 +42,7 @@ impl Observer for Stopper {
             t: b.time(),
             dt: 0.0,
             newton: None,
+            held_contacts: Vec::new(),
         };
         self.saved = Some((state, b.steps(), *cursor));
         Ok(())

@@ -7,6 +7,7 @@ use lme_mpm::gpu::layout::{GpuConstraint, GpuMaterial, GpuWall, Params, Sim};
 use lme_mpm::gpu::pipelines::{self, Pass, Variant};
 use lme_mpm::gpu::preprocess::SOURCES;
 use lme_mpm::model::Integrator;
+use lme_mpm::model::material::StateKind;
 use lme_mpm::scene::{NpcPosition, ShapeKind};
 use std::mem::{offset_of, size_of};
 use std::path::Path;
@@ -74,22 +75,25 @@ fn variants() -> Vec<Variant> {
                             if lme_stored && shape != ShapeKind::Lme {
                                 continue;
                             }
-                            // Linear elastic, Neo-Hookean, Mohr–Coulomb, Drucker–Prager
-                            // alone, or several (with several materials).
-                            for (linear_elastic, neo_hookean, mohr_coulomb, drucker_prager) in [
-                                (true, false, false, false),
-                                (false, true, false, false),
-                                (true, true, false, false),
-                                (false, false, true, false),
-                                (false, false, false, true),
-                                (true, true, true, true),
-                            ] {
-                                let models =
-                                    [linear_elastic, neo_hookean, mohr_coulomb, drucker_prager]
+                            // Every registered model alone, linear elastic with
+                            // Neo-Hookean, and all of them (with several materials).
+                            let registry = lme_mpm::model::material::registry();
+                            let code = |name: &str| {
+                                1u32 << registry.iter().find(|e| e.name == name).unwrap().code
+                            };
+                            let all = registry.iter().fold(0, |b, e| b | 1 << e.code);
+                            let sets = registry
+                                .iter()
+                                .map(|e| 1u32 << e.code)
+                                .chain([code("linear_elastic") | code("neo_hookean"), all]);
+                            for materials in sets {
+                                let has = |state: StateKind| {
+                                    registry
                                         .iter()
-                                        .filter(|m| **m)
-                                        .count();
-                                if models > 1 && !multi_material {
+                                        .any(|e| materials & 1 << e.code != 0 && e.state == state)
+                                };
+                                let neo_hookean = materials == code("neo_hookean");
+                                if materials.count_ones() > 1 && !multi_material {
                                     continue;
                                 }
                                 // MLS (linear and B-splines on regular grids), and the
@@ -116,12 +120,9 @@ fn variants() -> Vec<Variant> {
                                         atomics,
                                         lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
                                         lme_stored,
-                                        linear_elastic,
-                                        neo_hookean,
-                                        mohr_coulomb,
-                                        drucker_prager,
-                                        def_grad: neo_hookean,
-                                        plastic: mohr_coulomb || drucker_prager,
+                                        materials,
+                                        def_grad: has(StateKind::DefGrad),
+                                        plastic: has(StateKind::Plastic),
                                         mms,
                                         mls,
                                         // Walls and loads in every shape and
@@ -168,7 +169,7 @@ fn every_pass_validates_in_every_variant() {
     for v in variants() {
         let d = v.defines();
         for pass in Pass::ALL {
-            if !v.uses(pass) {
+            if !v.plan().gpu_uses(pass) {
                 continue;
             }
             let src = pipelines::expand(pass, &d).unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
@@ -297,8 +298,7 @@ fn shared_structs_match_rust_layouts() {
     assert_eq!(wgsl_struct(&module, "Params"), params);
     let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
-    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model, bulk, cohesion,
-        sin_phi, cos_phi, sin_psi, tension, dp_alpha, dp_alpha_psi, dp_k);
+    let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model, bulk, p);
     assert_eq!(wgsl_struct(&module, "Material"), mat);
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix, vx, vy, ramp_time);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
@@ -336,7 +336,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     let all = variants();
     let mls = all
         .iter()
-        .find(|v| v.mls && v.multi_material && v.mohr_coulomb && v.shape == ShapeKind::Bspline2)
+        .find(|v| v.mls && v.multi_material && v.plastic && v.shape == ShapeKind::Bspline2)
         .unwrap();
     let lme = all
         .iter()
@@ -352,7 +352,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     for v in [mls, lme, musl(true), musl(false)] {
         let d = v.defines();
         for pass in Pass::ALL {
-            if v.uses(pass) {
+            if v.plan().gpu_uses(pass) {
                 let src = pipelines::expand(pass, &d).unwrap();
                 out.push((
                     pass,
@@ -384,16 +384,16 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("FAULT_LME_NOT_CONVERGED", u(l::FAULT_LME_NOT_CONVERGED)),
         ("FAULT_LME_SINGULAR", u(l::FAULT_LME_SINGULAR)),
         ("FAULT_MLS_SINGULAR", u(l::FAULT_MLS_SINGULAR)),
-        ("MODEL_LINEAR_ELASTIC", u(l::MODEL_LINEAR_ELASTIC)),
-        ("MODEL_NEO_HOOKEAN", u(l::MODEL_NEO_HOOKEAN)),
+        (
+            "FAULT_RETURN_NOT_CONVERGED",
+            u(l::FAULT_RETURN_NOT_CONVERGED),
+        ),
         ("CONTACT_STICK", u(lme_mpm::model::walls::CONTACT_STICK)),
         ("CONTACT_SLIP", u(lme_mpm::model::walls::CONTACT_SLIP)),
         (
             "CONTACT_FRICTION",
             u(lme_mpm::model::walls::CONTACT_FRICTION),
         ),
-        ("MODEL_MOHR_COULOMB", u(l::MODEL_MOHR_COULOMB)),
-        ("MODEL_DRUCKER_PRAGER", u(l::MODEL_DRUCKER_PRAGER)),
         ("ACTIVE_MAIN", u(plastic::ACTIVE_MAIN)),
         ("ACTIVE_EDGE_12", u(plastic::ACTIVE_EDGE_12)),
         ("ACTIVE_EDGE_23", u(plastic::ACTIVE_EDGE_23)),
@@ -407,6 +407,16 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("MLS_SUPPORT", f(lme_mpm::cpu::mls::SUPPORT_CELLS)),
     ];
     let modules = every_pass_module();
+    // Every model's code, generated from the registry.
+    let registry = lme_mpm::model::material::registry();
+    let models: Vec<(String, Value)> = registry
+        .iter()
+        .map(|e| (e.model_const(), u(e.code)))
+        .collect();
+    let expected: Vec<(&str, Value)> = expected
+        .into_iter()
+        .chain(models.iter().map(|(n, v)| (n.as_str(), *v)))
+        .collect();
     for (name, want) in &expected {
         let mut seen = 0;
         for (pass, m) in &modules {

@@ -173,9 +173,16 @@ fn layers_point_one_way() {
             "the driver steps any backend",
         ),
         (
-            "model",
+            "step",
             &[
                 "cpu", "gpu", "backend", "solver", "exact", "run", "output", "study",
+            ],
+            "the step plan is read by both backends and built from the model alone",
+        ),
+        (
+            "model",
+            &[
+                "cpu", "gpu", "backend", "solver", "exact", "run", "output", "study", "step",
             ],
             "the model layer is the bottom",
         ),

@@ -13,7 +13,7 @@ use lme_mpm::gpu::preprocess::{Defines, expand_text};
 use lme_mpm::model::material::drucker_prager::p_sqrt_j2;
 use lme_mpm::model::material::plastic::{RETURN, SZZ};
 use lme_mpm::model::material::{Material, PlasticState};
-use lme_mpm::scene::{MaterialModel, MaterialSpec};
+use lme_mpm::scene::MaterialSpec;
 
 /// Test kernel: case i = (l, (σxx, σyy, σxy, dt), q, (material, ...)) in,
 /// ((σxx, σyy, σxy, V ratio), q') out.
@@ -58,29 +58,29 @@ struct Case {
     q: PlasticState,
 }
 
-fn spec(model: MaterialModel, phi: f64, psi: f64, t: Option<f64>) -> MaterialSpec {
-    MaterialSpec {
-        model,
-        density: 1800.0,
-        youngs_modulus: 2.0e7,
-        nu: 0.3,
-        cohesion: Some(1.0e4),
-        friction_angle: Some(phi),
-        dilation_angle: Some(psi),
-        tension_cutoff: t,
+fn spec(model: &str, phi: f64, psi: f64, t: Option<f64>) -> MaterialSpec {
+    let s = MaterialSpec::new(model, 1800.0)
+        .with("E", 2.0e7)
+        .with("nu", 0.3)
+        .with("cohesion", 1.0e4)
+        .with("friction_angle", phi)
+        .with("dilation_angle", psi);
+    match t {
+        Some(t) => s.with("tension_cutoff", t),
+        None => s,
     }
 }
 
 fn materials() -> Vec<Material> {
     [
-        spec(MaterialModel::MohrCoulomb, 30.0, 0.0, None),
-        spec(MaterialModel::MohrCoulomb, 30.0, 30.0, Some(4.0e3)),
-        spec(MaterialModel::MohrCoulomb, 0.0, 0.0, Some(2.0e3)),
-        spec(MaterialModel::DruckerPrager, 30.0, 0.0, None),
-        spec(MaterialModel::DruckerPrager, 30.0, 30.0, Some(5.0e3)),
+        spec("mohr_coulomb", 30.0, 0.0, None),
+        spec("mohr_coulomb", 30.0, 30.0, Some(4.0e3)),
+        spec("mohr_coulomb", 0.0, 0.0, Some(2.0e3)),
+        spec("drucker_prager", 30.0, 0.0, None),
+        spec("drucker_prager", 30.0, 30.0, Some(5.0e3)),
     ]
     .iter()
-    .map(Material::new)
+    .map(|s| Material::from_spec("m", s).unwrap())
     .collect()
 }
 
@@ -151,11 +151,13 @@ fn gpu_run(
     cases: &[Case],
 ) -> Vec<([f64; 4], [f64; 4])> {
     let mut d = Defines::default();
-    d.flag("MAT_MOHR_COULOMB", true)
-        .flag("MAT_DRUCKER_PRAGER", true)
-        .value("B_PARAMS", 0)
-        .value("B_SIM", 1)
-        .value("B_MATERIALS", 2);
+    d.generate(
+        "generated/materials.wgsl",
+        lme_mpm::model::material::wgsl_of(&materials()),
+    )
+    .value("B_PARAMS", 0)
+    .value("B_SIM", 1)
+    .value("B_MATERIALS", 2);
     let src = expand_text(KERNEL, "material_returns", &d).unwrap();
     let dev = &ctx.device;
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -10,7 +10,7 @@ use lme_mpm::model::shape::Shape;
 use lme_mpm::model::shape::bspline::{Bspline, greville};
 use lme_mpm::model::{Grid, Model};
 use lme_mpm::scene::{Override, Scene};
-use lme_mpm::solver::Stage;
+use lme_mpm::step::Stage;
 
 /// A free unit square that fills its grid (open knots at all four edges),
 /// stress-free, no loads, the paper's update.
@@ -403,7 +403,7 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
     let (mut before, mut vi, mut fi) = ((0.0, 0.0), Vec::new(), Vec::new());
     let mut t = 0.0;
     while t < t_end - 1e-12 {
-        for &stage in lme_mpm::solver::STEP_MUSL {
+        for &stage in lme_mpm::step::STEP_MUSL {
             match stage {
                 Stage::GridCorrect => {
                     vi = cpu.mv.clone();

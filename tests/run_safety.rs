@@ -3,7 +3,11 @@
 //! output at the same time and a checkpoint (exit 143); `resume` continues
 //! it so that the CPU path's particles.csv is byte-identical to an
 //! uninterrupted run; a damaged checkpoint is refused; progress lines
-//! appear on a non-terminal stderr unless --quiet.
+//! appear on a non-terminal stderr unless --quiet. Issue 25: two signals
+//! at once, SIGHUP and GNU timeout still save everything; a closed or full
+//! stderr costs nothing; the lock is an OS lock; planted links are not
+//! followed; leftover `.tmp` files go; a completed run can be extended; an
+//! implicit run with a wall resumes bit for bit.
 
 mod common;
 
@@ -155,21 +159,11 @@ fn a_foreign_folder_a_folder_in_use_and_an_unwritable_one_are_refused_before_ste
     assert_eq!(read(&legacy.join("mine.txt")), "keep");
     no_tmp_files(&legacy);
 
-    // A folder held by a live process (this test): exit 2, pid named.
+    // A folder held by a live run: see
+    // a_lock_is_the_os_lock_of_a_live_run_not_a_pid_in_a_file.
+    // The lock file of a process that has ended is taken over.
     let busy = tmp("busy");
     std::fs::create_dir_all(&busy).unwrap();
-    let me = std::process::id();
-    std::fs::write(busy.join("lme-mpm.lock"), format!("{me}\n")).unwrap();
-    let o = run("dyka_bar.toml", &busy, DYKA_SHORT);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains(&format!("process {me}")),
-        "{}",
-        stderr(&o)
-    );
-    assert!(!busy.join("summary.json").exists());
-
-    // The lock of a process that has ended is taken over.
     let mut gone = Command::new("true").spawn().unwrap();
     let dead = gone.id();
     gone.wait().unwrap();
@@ -318,7 +312,12 @@ fn sigterm_stops_at_a_step_boundary_and_resume_matches_an_uninterrupted_run_bit_
 #[test]
 fn resume_from_a_periodic_checkpoint_gives_the_same_particles_on_the_block() {
     let out = tmp("block");
-    let sets = &["solver.t_end=3", "output.checkpoint_interval=1.1"];
+    // No checkpoint at t_end: the one at 2.2 s is what resume continues.
+    let sets = &[
+        "solver.t_end=3",
+        "output.checkpoint_interval=1.1",
+        "output.final_checkpoint=false",
+    ];
     let o = run("elastic_block.toml", &out, sets);
     assert!(o.status.success(), "{}", stderr(&o));
     let whole = read(&out.join("particles.csv"));
@@ -353,6 +352,7 @@ fn a_resumed_implicit_run_reports_the_whole_runs_newton_statistics() {
         "solver.t_end=2e-5",
         "output.sample_interval=2e-6",
         "output.checkpoint_interval=1.1e-5",
+        "output.final_checkpoint=false",
     ];
     let o = run("dyka_bar.toml", &out, sets);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -427,4 +427,410 @@ fn progress_lines_on_a_pipe_unless_quiet() {
     assert!(lines.last().unwrap().contains("100 %"), "{err}");
     let quiet = run("dyka_bar.toml", &out, &["solver.t_end=1e-5"]);
     assert!(!stderr(&quiet).contains("progress:"));
+}
+
+// ---- issue 25: a run never dies without a word ----
+
+/// Starts a CPU run with progress lines on a pipe and waits for its first
+/// progress line (it is stepping, its folder taken); returns the child and
+/// the rest of its stderr lines.
+fn started(
+    case: &str,
+    out: &Path,
+    sets: &[&str],
+) -> (
+    std::process::Child,
+    std::io::Lines<BufReader<std::process::ChildStderr>>,
+) {
+    let mut c = bin();
+    c.args(["run", "--backend", "cpu", "--out"])
+        .arg(out)
+        .arg(common::case(case));
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    let mut child = c
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    for line in lines.by_ref() {
+        if line.unwrap().starts_with("progress:") {
+            break;
+        }
+    }
+    (child, lines)
+}
+
+/// Sends `signals` (e.g. "-TERM") to `pid` from one shell, back to back.
+fn signal(pid: u32, signals: &[&str]) {
+    let script: Vec<String> = signals.iter().map(|s| format!("kill {s} {pid}")).collect();
+    let ok = Command::new("sh")
+        .arg("-c")
+        .arg(script.join("; "))
+        .status()
+        .unwrap();
+    assert!(ok.success());
+}
+
+/// What an interrupted run must leave: `interrupted`, CSV files ending at
+/// the time reached, a checkpoint `resume` accepts, no lock, no `.tmp`.
+fn saved_and_unlocked(dir: &Path) {
+    let s = summary(dir);
+    assert_eq!(s["status"], "interrupted", "{s}");
+    let t = s["t"].as_f64().unwrap();
+    for f in ["probes.csv", "energy.csv", "reactions.csv"] {
+        // serde_json (without its float_roundtrip feature) parses a
+        // 17-digit number to within an ulp: seen 1 ulp apart.
+        let last = last_t(&dir.join(f));
+        assert!(
+            (last - t).abs() <= CSV_DIGITS * t,
+            "{f}: {last} against {t}"
+        );
+    }
+    assert!(dir.join("checkpoint.lmeck").is_file(), "no checkpoint");
+    assert!(
+        !dir.join("lme-mpm.lock").exists(),
+        "the lock outlives the run"
+    );
+    no_tmp_files(dir);
+}
+
+/// Relative difference allowed between a CSV file's time and summary.json's
+/// `t` as this test reads them (serde_json's float parsing is within 1 ulp,
+/// 1.1e-16 relative; the files hold the same shortest round-trip digits).
+const CSV_DIGITS: f64 = 1e-15;
+
+/// A run long enough to be interrupted (about 30 s alone on one core).
+const DYKA_LONG: &[&str] = &["solver.t_end=1e-3"];
+
+#[test]
+fn two_signals_at_once_and_sighup_stop_the_run_with_everything_saved() {
+    // Two SIGTERMs back to back (what GNU timeout and a process group's
+    // kill send): the second must not cut the save short. Before issue
+    // 25 the second ended the process at once with summary.json `running`.
+    for k in 0..4 {
+        let out = tmp(&format!("twice-{k}"));
+        let (mut child, lines) = started("dyka_bar.toml", &out, DYKA_LONG);
+        signal(child.id(), &["-TERM", "-TERM"]);
+        let rest: Vec<String> = lines.map_while(|l| l.ok()).collect();
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(143), "try {k}: {}", rest.join("\n"));
+        saved_and_unlocked(&out);
+        let o = resume(&out, &["solver.t_end=2e-5"]);
+        assert!(
+            o.status.code() == Some(2) || o.status.success(),
+            "{}",
+            stderr(&o)
+        );
+    }
+    // SIGHUP (a closed terminal, a dropped SSH session) is a stop like
+    // SIGTERM: exit 129, everything saved. Before: exit 129 at once.
+    let out = tmp("hup");
+    let (mut child, lines) = started("dyka_bar.toml", &out, DYKA_LONG);
+    signal(child.id(), &["-HUP"]);
+    let rest: Vec<String> = lines.map_while(|l| l.ok()).collect();
+    assert_eq!(
+        child.wait().unwrap().code(),
+        Some(129),
+        "{}",
+        rest.join("\n")
+    );
+    saved_and_unlocked(&out);
+    assert!(resume(&out, &["solver.t_end=3e-5"]).status.code().is_some());
+}
+
+#[test]
+fn gnu_timeout_leaves_an_interrupted_resumable_run() {
+    // `timeout` signals the process, then its process group: two at once.
+    let has_timeout = Command::new("timeout").arg("--version").output();
+    if has_timeout.is_err() {
+        println!("skipped: no `timeout` command");
+        return;
+    }
+    for k in 0..2 {
+        let out = tmp(&format!("timeout-{k}"));
+        let o = Command::new("timeout")
+            .arg("3")
+            .arg(env!("CARGO_BIN_EXE_lme-mpm"))
+            .args(["run", "--backend", "cpu", "--quiet", "--out"])
+            .arg(&out)
+            .arg(common::case("dyka_bar.toml"))
+            .args(["--set", DYKA_LONG[0]])
+            .env("NODEVICE_SELECT", "1")
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(124), "{}", stderr(&o));
+        saved_and_unlocked(&out);
+    }
+}
+
+#[test]
+fn a_closed_or_full_stderr_costs_nothing() {
+    // `run … 2>&1 | head -1`: the reader goes after one line; the run
+    // goes on to the end and exits 0. Before: exit 101 at the next
+    // progress line, nothing written.
+    let out = tmp("closed-pipe");
+    let mut child = bin()
+        .args(["run", "--backend", "cpu", "--out"])
+        .arg(&out)
+        .arg(common::case("dyka_bar.toml"))
+        .args(["--set", "solver.t_end=2e-5"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        let mut first = String::new();
+        BufReader::new(child.stderr.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        assert!(!first.is_empty());
+    } // the read end closes here
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(0));
+    assert_eq!(summary(&out)["status"], "completed");
+    assert!(out.join("particles.csv").is_file());
+
+    // 2>/dev/full: every write to stderr fails with ENOSPC.
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = tmp("dev-full");
+        let o = bin()
+            .args(["run", "--backend", "cpu", "--out"])
+            .arg(&out)
+            .arg(common::case("dyka_bar.toml"))
+            .args(["--set", "solver.t_end=2e-5"])
+            .stderr(Stdio::from(full.try_clone().unwrap()))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0));
+        assert_eq!(summary(&out)["status"], "completed");
+        // `check > /dev/full`: its product cannot be written: exit 1 and
+        // a message, not a panic (101).
+        let o = bin()
+            .arg("check")
+            .arg(common::case("dyka_bar.toml"))
+            .stdout(Stdio::from(full))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("cannot write to standard output"));
+        assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_planted_in_the_folder_is_never_followed() {
+    let out = tmp("symlink");
+    let o = run("dyka_bar.toml", &out, &["solver.t_end=2e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let victim = tmp("symlink-victim.txt");
+    std::fs::write(&victim, "not yours").unwrap();
+    for name in ["lme-mpm.manifest.tmp", "summary.json.tmp", "probes.csv.tmp"] {
+        std::os::unix::fs::symlink(&victim, out.join(name)).unwrap();
+    }
+    let o = run("dyka_bar.toml", &out, &["solver.t_end=2e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        read(&victim),
+        "not yours",
+        "a file outside the folder was written"
+    );
+    assert_eq!(summary(&out)["status"], "completed");
+    no_tmp_files(&out);
+    let _ = std::fs::remove_file(&victim);
+}
+
+#[test]
+fn a_lock_is_the_os_lock_of_a_live_run_not_a_pid_in_a_file() {
+    // A lock file naming a live process that is not a run (this test: pid
+    // reuse) does not block the folder. Before: refused, exit 2.
+    let out = tmp("pid-reuse");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(
+        out.join("lme-mpm.lock"),
+        format!("{}\n", std::process::id()),
+    )
+    .unwrap();
+    let o = run("dyka_bar.toml", &out, &["solver.t_end=2e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("lme-mpm.lock").exists());
+
+    // A live run holds its folder: a second run there is refused, naming it.
+    let busy = tmp("held");
+    let (mut child, _lines) = started("dyka_bar.toml", &busy, DYKA_LONG);
+    let o = run("dyka_bar.toml", &busy, &["solver.t_end=2e-6"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("process {}", child.id())),
+        "{}",
+        stderr(&o)
+    );
+    let o = resume(&busy, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    signal(child.id(), &["-TERM"]);
+    assert_eq!(child.wait().unwrap().code(), Some(143));
+    saved_and_unlocked(&busy);
+}
+
+#[test]
+fn leftover_tmp_files_of_a_killed_write_are_removed_by_the_next_run() {
+    // A kill during a checkpoint write leaves checkpoint.lmeck.tmp; a
+    // completed run without a checkpoint does not list it. Before: kept forever.
+    let out = tmp("leftovers");
+    let sets = &["solver.t_end=2e-6", "output.final_checkpoint=false"];
+    let o = run("dyka_bar.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("checkpoint.lmeck").exists());
+    std::fs::write(out.join("checkpoint.lmeck.tmp"), vec![7u8; 1 << 20]).unwrap();
+    std::fs::write(out.join("lme-mpm.manifest.tmp"), "half").unwrap();
+    std::fs::create_dir_all(out.join("vtk")).unwrap();
+    std::fs::write(out.join("vtk/particles_00009.vtu.tmp"), "half").unwrap();
+    std::fs::write(out.join("notes.tmp"), "mine").unwrap();
+    let o = run("dyka_bar.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("checkpoint.lmeck.tmp").exists());
+    assert!(!out.join("lme-mpm.manifest.tmp").exists());
+    assert!(!out.join("vtk/particles_00009.vtu.tmp").exists());
+    assert_eq!(
+        read(&out.join("notes.tmp")),
+        "mine",
+        "a user's file was touched"
+    );
+    // And a resume removes them too.
+    let o = run("dyka_bar.toml", &out, &["solver.t_end=4e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::write(out.join("checkpoint.lmeck.tmp"), "half").unwrap();
+    let o = resume(&out, &["solver.t_end=6e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("checkpoint.lmeck.tmp").exists());
+}
+
+#[test]
+fn a_completed_run_can_be_extended_and_the_key_turns_it_off() {
+    // The README's Use list: run, then resume with a later t_end. Before:
+    // no checkpoint at the end, exit 2.
+    let sets = &["solver.t_end=2e-5"];
+    let out = tmp("extend");
+    let o = run("dyka_bar.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.join("checkpoint.lmeck").is_file());
+    let rows = read(&out.join("probes.csv")).lines().count();
+    let o = resume(&out, &["solver.t_end=3e-5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    assert_eq!(
+        (s["t"].as_f64(), s["resumed_from"].as_f64()),
+        (Some(3e-5), Some(2e-5))
+    );
+    assert!(read(&out.join("probes.csv")).lines().count() > rows);
+    assert_eq!(last_t(&out.join("probes.csv")), 3e-5);
+    // Resuming a completed run without a later t_end says how to extend it.
+    let o = resume(&out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("solver.t_end=LATER"), "{}", stderr(&o));
+
+    // A checkpoint interval equal to t_end: one checkpoint, at the end.
+    let at_end = tmp("extend-interval");
+    let o = run(
+        "dyka_bar.toml",
+        &at_end,
+        &["solver.t_end=2e-5", "output.checkpoint_interval=2e-5"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(resume(&at_end, &["solver.t_end=2.5e-5"]).status.success());
+
+    // output.final_checkpoint = false: none, and resume says so.
+    let off = tmp("extend-off");
+    let o = run(
+        "dyka_bar.toml",
+        &off,
+        &["solver.t_end=2e-5", "output.final_checkpoint=false"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!off.join("checkpoint.lmeck").exists());
+    assert_eq!(resume(&off, &["solver.t_end=3e-5"]).status.code(), Some(2));
+}
+
+#[test]
+fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
+    // The rolling disk (a friction wall, Newton's held contact states),
+    // coarse: the checkpoint at 0.02 s must carry the contact states, or
+    // the resumed steps start Newton elsewhere and end 1e-13 apart.
+    let sets = &[
+        "solver.integrator=implicit",
+        "grid.h=0.1",
+        "solver.dt=0.005",
+        "solver.t_end=0.04",
+        "output.sample_interval=0.005",
+        "output.vtk_interval=0.04",
+        "output.checkpoint_interval=0.02",
+        "output.final_checkpoint=false",
+    ];
+    let whole = tmp("disk-whole");
+    let o = run("rolling_disk.toml", &whole, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let particles = read(&whole.join("particles.csv"));
+    let probes = read(&whole.join("probes.csv"));
+    let o = resume(&whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&whole);
+    assert_eq!(s["resumed_from"].as_f64(), Some(0.02), "{s}");
+    assert_eq!(
+        read(&whole.join("probes.csv")),
+        probes,
+        "probes differ after resume"
+    );
+    assert_eq!(
+        read(&whole.join("particles.csv")),
+        particles,
+        "particles differ after resume"
+    );
+}
+
+#[test]
+fn a_second_signal_long_after_the_first_ends_a_long_step_with_the_folder_saying_so() {
+    // One static Newton step of the cantilever at h = 2.5 cm takes about
+    // 10 s (5e4 particles): the first SIGTERM waits for its end; a second
+    // one past the grace of 2 s ends the process at once, and the folder
+    // must then say `interrupted` and hold no lock. Before: the second
+    // signal ended it with summary.json `running` and a stale lock.
+    let out = tmp("late-second");
+    let mut child = bin()
+        .args(["run", "--backend", "cpu", "--quiet", "--out"])
+        .arg(&out)
+        .arg(common::case("cantilever.toml"))
+        .args(["--set", "grid.h=0.025"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !std::fs::read_to_string(out.join("summary.json")).is_ok_and(|t| t.contains("running")) {
+        assert!(started.elapsed().as_secs() < 120, "the run never started");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    signal(child.id(), &["-TERM"]);
+    std::thread::sleep(std::time::Duration::from_millis(2500));
+    let sent = std::time::Instant::now();
+    signal(child.id(), &["-TERM"]);
+    let status = child.wait().unwrap();
+    let waited = sent.elapsed().as_secs_f64();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert_eq!(status.code(), Some(143), "{err}");
+    let s = summary(&out);
+    assert_eq!(s["status"], "interrupted", "{s}");
+    assert!(
+        s["reason"].as_str().unwrap().contains("repeated signal"),
+        "the step ended before the second signal ({waited:.2} s to exit): {s}"
+    );
+    assert!(waited < 2.0, "{waited} s to exit after the second signal");
+    assert!(
+        !out.join("lme-mpm.lock").exists(),
+        "the lock outlives the run"
+    );
+    no_tmp_files(&out);
 }

@@ -139,9 +139,16 @@ fn emitted_lines_run_by_sh_collect_to_the_local_table() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    // Nothing ran: only the plan (and the empty runs/ folder) exists.
+    // Nothing ran: only the plan and each run's plan entry exist.
     assert!(!remote.join("sweep.csv").exists());
-    assert_eq!(std::fs::read_dir(remote.join("runs")).unwrap().count(), 0);
+    for e in std::fs::read_dir(remote.join("runs")).unwrap() {
+        let names: Vec<_> = std::fs::read_dir(e.unwrap().path())
+            .unwrap()
+            .map(|f| f.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["sweep-run.json"]);
+    }
+    assert_eq!(std::fs::read_dir(remote.join("runs")).unwrap().count(), 8);
     let text = std::fs::read_to_string(&jobs).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 8, "one line per run:\n{text}");
@@ -381,5 +388,150 @@ fn bad_sweep_input_exits_2_naming_the_key_and_value_before_any_run() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("not empty"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 25, item 4: the runs running at once fit in memory together; a
+/// folder written by another plan is flagged, not tabled as this plan's;
+/// `--emit-jobs` refuses a folder holding another plan; an unreadable
+/// summary.json is `failed`, garbage or cut alike.
+#[test]
+fn sweeps_check_memory_together_and_flag_folders_of_another_plan() {
+    let dir = tmp("safety");
+    let scene = bar_without_exact(&dir);
+    let small = [
+        "--vary",
+        "solver.dt=5e-7,2.5e-7",
+        "--set",
+        "grid.h=0.01",
+        "--set",
+        "solver.t_end=2e-5",
+        "--backend",
+        "cpu",
+    ];
+    // --max-memory below one run: refused before anything runs.
+    let out = dir.join("tiny");
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args(small)
+        .args(["--max-memory", "1K", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-memory"), "{}", stderr(&o));
+    assert!(!out.exists(), "written before refusing");
+
+    // Room for one run at a time: two jobs asked, one at once.
+    let plan_out = dir.join("plan");
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args(small)
+        .args(["--emit-jobs"])
+        .arg(dir.join("probe-jobs.txt"))
+        .arg("--out")
+        .arg(&plan_out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(plan_out.join("sweep-plan.json")).unwrap())
+            .unwrap();
+    let one = plan["runs"][0]["memory_bytes"].as_u64().unwrap();
+    assert!(one > 0, "{plan}");
+    let local = dir.join("local");
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args(small)
+        .args(["--jobs", "2", "--max-memory"])
+        .arg(format!("{}", one * 3 / 2))
+        .arg("--out")
+        .arg(&local)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("running 1 at once, not 2"),
+        "{}",
+        stderr(&o)
+    );
+    let rows = table(&local);
+    assert!(rows.iter().all(|r| r["status"] == "completed"), "{rows:?}");
+    // Each run folder records its plan entry.
+    let entry = std::fs::read_to_string(local.join("runs/00-5e-7/sweep-run.json")).unwrap();
+    assert!(entry.contains("solver.dt=5e-7"), "{entry}");
+
+    // A folder another plan wrote (another value of a --set key): flagged.
+    let foreign = local.join("runs/01-2.5e-7");
+    let o = bin()
+        .arg("run")
+        .arg(&scene)
+        .args(["--backend", "cpu", "--quiet", "--out"])
+        .arg(&foreign)
+        .args(["--set", "grid.h=0.02", "--set", "solver.t_end=2e-5"])
+        .args(["--set", "solver.dt=2.5e-7"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(foreign.join("sweep-run.json")).unwrap();
+    collect(&local);
+    let rows = table(&local);
+    assert_eq!(rows[0]["status"], "completed", "{:?}", rows[0]);
+    assert_eq!(rows[1]["status"], "failed", "{:?}", rows[1]);
+    assert!(
+        rows[1]["reason"].contains("not this plan's run") && rows[1]["reason"].contains("grid.h"),
+        "{:?}",
+        rows[1]
+    );
+
+    // Summary garbage and a cut summary: both failed, both unreadable.
+    std::fs::write(
+        local.join("runs/00-5e-7/summary.json"),
+        [0xffu8, 0xfe, 0, 7],
+    )
+    .unwrap();
+    std::fs::write(foreign.join("summary.json"), "{\"status\": \"compl").unwrap();
+    collect(&local);
+    for r in table(&local) {
+        assert_eq!(r["status"], "failed", "{r:?}");
+        assert!(r["reason"].contains("unreadable"), "{r:?}");
+    }
+
+    // --emit-jobs into the folder of another plan: refused; the same plan: fine.
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args([
+            "--vary",
+            "solver.dt=1e-7",
+            "--backend",
+            "cpu",
+            "--emit-jobs",
+        ])
+        .arg(dir.join("other-jobs.txt"))
+        .arg("--out")
+        .arg(&plan_out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("another sweep's plan"),
+        "{}",
+        stderr(&o)
+    );
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args(small)
+        .args(["--emit-jobs"])
+        .arg(dir.join("again-jobs.txt"))
+        .arg("--out")
+        .arg(&plan_out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -25,9 +25,9 @@ struct McReturn {
 
 // 0: main plane, 1: edge σ1 = σ2, 2: edge σ2 = σ3, 3–5: σ1, σ2, σ3 ≤ t.
 fn mc_plane(m: Material, i: u32) -> McPlane {
-    let sf = m.sin_phi;
-    let sp = m.sin_psi;
-    let k = 2.0 * m.cohesion * m.cos_phi;
+    let sf = m.p[MOHR_COULOMB_SIN_PHI];
+    let sp = m.p[MOHR_COULOMB_SIN_PSI];
+    let k = 2.0 * m.p[MOHR_COULOMB_COHESION] * m.p[MOHR_COULOMB_COS_PHI];
     if i == 0u {
         return McPlane(vec3<f32>(1.0 + sf, 0.0, -(1.0 - sf)), k, vec3<f32>(1.0 + sp, 0.0, -(1.0 - sp)));
     }
@@ -39,7 +39,7 @@ fn mc_plane(m: Material, i: u32) -> McPlane {
     }
     var a = vec3<f32>(0.0);
     a[i - 3u] = 1.0;
-    return McPlane(a, m.tension, a);
+    return McPlane(a, m.p[MOHR_COULOMB_TENSION], a);
 }
 
 fn mc_f(p: McPlane, s: vec3<f32>) -> f32 {
@@ -54,12 +54,12 @@ fn mc_d_times(m: Material, n: vec3<f32>) -> vec3<f32> {
 // Return of sorted principal trial stresses v (twin of
 // MohrCoulomb::return_principal, same candidates in the same order).
 fn mc_return(m: Material, v: vec3<f32>) -> McReturn {
-    let has_t = m.tension >= 0.0;
+    let has_t = m.p[MOHR_COULOMB_TENSION] >= 0.0;
     let n_planes = select(3u, 6u, has_t);
     if mc_f(mc_plane(m, 0u), v) <= 0.0 && (!has_t || mc_f(mc_plane(m, 3u), v) <= 0.0) {
         return McReturn(v, 0u);
     }
-    let scale = m.cohesion + max(abs(v.x), max(abs(v.y), abs(v.z)));
+    let scale = m.p[MOHR_COULOMB_COHESION] + max(abs(v.x), max(abs(v.y), abs(v.z)));
     let tol = MC_RETURN_TOL_F32 * scale;
     // (mask, planes) and the number of planes of each candidate.
     var cands = array<vec4<u32>, 10>(
@@ -204,4 +204,14 @@ fn mohr_coulomb_update(m: Material, l: vec4<f32>, dt: f32, s: vec3<f32>, f: vec4
     r.s = vec3<f32>(out.x, out.y, out.w);
     r.q = plastic_record(m, q, t, out, ret.surfaces);
     return r;
+}
+
+// The elastic part of the stored energy, with σzz = q.x.
+fn mohr_coulomb_energy(m: Material, s: vec3<f32>, f: vec4<f32>, q: vec4<f32>) -> f32 {
+    return elastic_energy_3d(m, vec4<f32>(s.x, s.y, q.x, s.z));
+}
+
+// The elastic P-wave speed bounds the elastoplastic one.
+fn mohr_coulomb_wave_speed(m: Material, rho: f32, s: vec3<f32>, q: vec4<f32>) -> f32 {
+    return sqrt(m.p_modulus / rho);
 }

@@ -2,7 +2,7 @@
 // F ← (I + Δt L) F, σ = λ ln J / J I + μ / J (F Fᵀ − I).
 // CPU twin: src/material/neo_hookean.rs.
 
-fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, f: vec4<f32>, q: vec4<f32>) -> MatUpdate {
+fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, s: vec3<f32>, f: vec4<f32>, q: vec4<f32>) -> MatUpdate {
     let g = vec4<f32>(1.0 + dt * l.x, dt * l.y, dt * l.z, 1.0 + dt * l.w);
     let nf = vec4<f32>(
         g.x * f.x + g.y * f.z,
@@ -32,9 +32,14 @@ fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, f: vec4<f32>, q: vec4<
     return r;
 }
 
-fn neo_hookean_energy(m: Material, f: vec4<f32>) -> f32 {
+fn neo_hookean_energy(m: Material, s: vec3<f32>, f: vec4<f32>, q: vec4<f32>) -> f32 {
     let j = f.x * f.w - f.y * f.z;
     let tr_c = dot(f, f) + 1.0;
     let lj = log(j);
     return (0.5 * m.shear * (tr_c - 3.0) - m.shear * lj + 0.5 * m.lame * lj * lj) / j;
+}
+
+// Small-strain P-wave speed sqrt((λ + 2μ)/ρ).
+fn neo_hookean_wave_speed(m: Material, rho: f32, s: vec3<f32>, q: vec4<f32>) -> f32 {
+    return sqrt(m.p_modulus / rho);
 }

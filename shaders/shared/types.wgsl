@@ -16,6 +16,8 @@ const FAULT_LME_NOT_CONVERGED: u32 = 7u;
 const FAULT_LME_SINGULAR: u32 = 8u;
 // MLS moment matrix singular; the index is the Gauss point's, not a particle's.
 const FAULT_MLS_SINGULAR: u32 = 9u;
+// A material's implicit stress return did not converge (Cam-clay's Newton).
+const FAULT_RETURN_NOT_CONVERGED: u32 = 10u;
 
 // Scene constants (uniform), fixed for a run.
 struct Params {
@@ -112,22 +114,13 @@ struct Material {
     p_modulus: f32,
     youngs: f32,
     nu: f32,
-    // MODEL_* (shared/material.wgsl).
+    // The model's code, MODEL_* (generated from the registry).
     model: u32,
-    // Plastic models: bulk modulus K, cohesion c (Pa).
+    // Bulk modulus K = λ + 2μ/3 (Pa).
     bulk: f32,
-    cohesion: f32,
-    // Mohr–Coulomb: sin φ, cos φ, sin ψ.
-    sin_phi: f32,
-    cos_phi: f32,
-    sin_psi: f32,
-    // Plastic models: tension cutoff t (Pa); negative: none.
-    tension: f32,
-    // Drucker–Prager: α, ᾱ, k (Pa) of the plane-strain match.
-    dp_alpha: f32,
-    dp_alpha_psi: f32,
-    dp_k: f32,
-    _pad: f32,
+    // The model's own parameters, read as p[<MODEL>_<PARAM>] (the
+    // constants are generated from its registry entry).
+    p: array<f32, 9>,
 }
 
 // Nodes with i0 <= i <= i1 and j0 <= j <= j1 are fixed in the `fix` bits

@@ -20,7 +20,7 @@ use crate::backend::{Backend, Halt, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
-use crate::solver::{Stage, stages};
+use crate::step::{CpuWork, Stage, StepPlan};
 use scatter::Scatter;
 use std::sync::atomic::AtomicBool;
 
@@ -56,6 +56,8 @@ impl ShapeCache {
 /// Runs a `Model` on the CPU.
 pub struct CpuBackend {
     pub model: Model,
+    /// What a step runs (`StepPlan::cpu`).
+    pub plan: StepPlan,
     pub cache: ShapeCache,
     /// Per node: [mass, momentum or velocity x, y].
     pub mv: Vec<[f64; 3]>,
@@ -98,6 +100,7 @@ impl CpuBackend {
             steps: 0,
             dt: 0.0,
             final_step: false,
+            plan: StepPlan::of(&model, false, false),
             model,
         }
     }
@@ -172,6 +175,7 @@ impl CpuBackend {
             t: self.t,
             dt: self.dt,
             newton: None,
+            held_contacts: Vec::new(),
         }
     }
 
@@ -181,20 +185,15 @@ impl CpuBackend {
         self.t = t;
     }
 
-    /// One step: the stages of `solver::STEP` in order. The time advances
-    /// only when every stage succeeded.
+    /// One step: the plan's work in order (`StepPlan::cpu`: the stages,
+    /// some fused in one pass over the particles). The time advances only
+    /// when every stage succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
-        // Without MLS, shape_eval and p2g run as one pass, and stress and
-        // forces as another where they follow each other (not in MUSL), as
-        // on the GPU.
-        let fuse = self.mls.is_none() && self.model.integrator != Integrator::Musl;
-        for stage in stages(self.model.integrator) {
-            match stage {
-                Stage::ShapeEval if self.mls.is_none() => self.shape_eval_p2g()?,
-                Stage::P2g if self.mls.is_none() => {}
-                Stage::Stress if fuse => self.stress_forces()?,
-                Stage::Forces if fuse => {}
-                _ => self.run_stage(*stage)?,
+        for i in 0..self.plan.cpu.len() {
+            match self.plan.cpu[i] {
+                CpuWork::ShapeEvalP2g => self.shape_eval_p2g()?,
+                CpuWork::StressForces => self.stress_forces()?,
+                CpuWork::Stage(stage) => self.run_stage(stage)?,
             }
         }
         self.t = if self.final_step {

@@ -62,13 +62,17 @@ impl Cantilever {
         let m = scene.materials().next().expect("validated: one material").1;
         let g = scene.file.gravity.as_ref().map_or(0.0, |g| -g.g[1]);
         let (length, height) = (bb[2] - bb[0], bb[3] - bb[1]);
-        let timoshenko = timoshenko(length, height, m.density, m.youngs_modulus, m.nu, g);
+        let (e, nu) = (
+            m.get("E").expect("validated: E"),
+            m.get("nu").unwrap_or(0.0),
+        );
+        let timoshenko = timoshenko(length, height, m.density, e, nu, g);
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
         let paper = close(length, 8.0)
             && close(height, 1.0)
             && close(m.density, 1000.0)
-            && close(m.youngs_modulus, 90e6)
-            && m.nu == 0.0
+            && close(e, 90e6)
+            && nu == 0.0
             && close(g, 9.81);
         Cantilever {
             tip: [bb[2], 0.5 * (bb[1] + bb[3])],

@@ -57,7 +57,7 @@ impl ElasticColumn {
             base: bb[1],
             height: bb[3] - bb[1],
             density: m.density,
-            youngs: m.youngs_modulus,
+            youngs: m.get("E").expect("validated: E"),
             gravity: model.gravity.expect("validated: gravity present"),
             row: scene.file.grid.h / ppc as f64,
         }

@@ -56,8 +56,8 @@ impl DykaBar {
         DykaBar {
             x_free,
             x_fixed,
-            c: (m.youngs_modulus / m.density).sqrt(),
-            z: (m.youngs_modulus * m.density).sqrt(),
+            c: (m.get("E").expect("validated: E") / m.density).sqrt(),
+            z: (m.get("E").expect("validated: E") * m.density).sqrt(),
             segments,
         }
     }

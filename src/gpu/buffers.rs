@@ -7,8 +7,7 @@
 use super::GpuOptions;
 use super::context::GpuContext;
 use super::layout::{
-    GpuConstraint, GpuMaterial, GpuWall, MODEL_DRUCKER_PRAGER, MODEL_LINEAR_ELASTIC,
-    MODEL_MOHR_COULOMB, MODEL_NEO_HOOKEAN, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
+    GPU_PARAM_SLOTS, GpuConstraint, GpuMaterial, GpuWall, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
 };
 use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
@@ -201,51 +200,31 @@ pub fn gpu_materials(model: &Model) -> Vec<GpuMaterial> {
     model.materials.iter().map(gpu_material).collect()
 }
 
-/// One material as the shaders read it (plastic fields zero for the elastic models).
+/// One material as the shaders read it: the elastic header and the
+/// model's own parameters, packed by its registry entry.
 pub fn gpu_material(m: &Material) -> GpuMaterial {
     let (lame, shear) = m.lame_shear();
     let (youngs, nu) = m.youngs_nu();
-    let mut g = GpuMaterial {
+    let params = m.gpu_params();
+    assert!(
+        params.len() <= GPU_PARAM_SLOTS && params.len() == m.entry().gpu_params.len(),
+        "{}: {} GPU parameters packed for {} names (at most {GPU_PARAM_SLOTS})",
+        m.entry().name,
+        params.len(),
+        m.entry().gpu_params.len()
+    );
+    let mut p = [0.0f32; GPU_PARAM_SLOTS];
+    p[..params.len()].copy_from_slice(&params);
+    GpuMaterial {
         lame: lame as f32,
         shear: shear as f32,
         p_modulus: (lame + 2.0 * shear) as f32,
         youngs: youngs as f32,
         nu: nu as f32,
-        model: MODEL_LINEAR_ELASTIC,
-        bulk: 0.0,
-        cohesion: 0.0,
-        sin_phi: 0.0,
-        cos_phi: 0.0,
-        sin_psi: 0.0,
-        tension: -1.0,
-        dp_alpha: 0.0,
-        dp_alpha_psi: 0.0,
-        dp_k: 0.0,
-        _pad: 0.0,
-    };
-    match m {
-        Material::LinearElastic(_) => {}
-        Material::NeoHookean(_) => g.model = MODEL_NEO_HOOKEAN,
-        Material::MohrCoulomb(mc) => {
-            g.model = MODEL_MOHR_COULOMB;
-            g.bulk = mc.elastic.bulk as f32;
-            g.cohesion = mc.cohesion as f32;
-            g.sin_phi = mc.sin_phi as f32;
-            g.cos_phi = mc.cos_phi as f32;
-            g.sin_psi = mc.sin_psi as f32;
-            g.tension = mc.tension.map_or(-1.0, |t| t as f32);
-        }
-        Material::DruckerPrager(dp) => {
-            g.model = MODEL_DRUCKER_PRAGER;
-            g.bulk = dp.elastic.bulk as f32;
-            g.cohesion = dp.cohesion as f32;
-            g.tension = dp.tension.map_or(-1.0, |t| t as f32);
-            g.dp_alpha = dp.alpha as f32;
-            g.dp_alpha_psi = dp.alpha_psi as f32;
-            g.dp_k = dp.k as f32;
-        }
+        model: m.entry().code,
+        bulk: (lame + 2.0 * shear / 3.0) as f32,
+        p,
     }
-    g
 }
 
 /// Initial contents of the per-particle buffers.

@@ -80,30 +80,17 @@ pub struct GpuMaterial {
     pub p_modulus: f32,
     pub youngs: f32,
     pub nu: f32,
-    /// `MODEL_*`.
+    /// The model's code: its place in the registry (`MODEL_*`, generated
+    /// by `model::material::registry::wgsl`).
     pub model: u32,
-    /// Plastic models: bulk modulus K (Pa).
+    /// Bulk modulus K = λ + 2μ/3 (Pa).
     pub bulk: f32,
-    /// Plastic models: cohesion c (Pa).
-    pub cohesion: f32,
-    /// Mohr–Coulomb: sin φ, cos φ, sin ψ.
-    pub sin_phi: f32,
-    pub cos_phi: f32,
-    pub sin_psi: f32,
-    /// Plastic models: tension cutoff t (Pa); negative: none.
-    pub tension: f32,
-    /// Drucker–Prager: α, ᾱ and k (Pa) of the plane-strain match.
-    pub dp_alpha: f32,
-    pub dp_alpha_psi: f32,
-    pub dp_k: f32,
-    pub _pad: f32,
+    /// The model's own parameters (`Constitutive::gpu_params`), read in
+    /// WGSL as `m.p[<MODEL>_<PARAM>]`; unused slots are zero.
+    pub p: [f32; GPU_PARAM_SLOTS],
 }
 
-/// Material model codes (shared/material.wgsl).
-pub const MODEL_LINEAR_ELASTIC: u32 = 0;
-pub const MODEL_NEO_HOOKEAN: u32 = 1;
-pub const MODEL_MOHR_COULOMB: u32 = 2;
-pub const MODEL_DRUCKER_PRAGER: u32 = 3;
+pub use crate::model::material::registry::GPU_PARAM_SLOTS;
 const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 64);
 
 #[repr(C)]
@@ -157,6 +144,8 @@ pub const FAULT_LME_NOT_CONVERGED: u32 = 7;
 pub const FAULT_LME_SINGULAR: u32 = 8;
 /// The index field holds the Gauss point, not a particle.
 pub const FAULT_MLS_SINGULAR: u32 = 9;
+/// A material's implicit stress return did not converge.
+pub const FAULT_RETURN_NOT_CONVERGED: u32 = 10;
 
 /// Splits an f64 into a two-float sum hi + lo (for times in f32).
 pub fn split_f64(v: f64) -> (f32, f32) {

@@ -1,4 +1,4 @@
-//! The GPU path: every stage of `solver::STEP` as a wgpu compute pass over
+//! The GPU path: every stage of the step plan (`crate::step`) as a wgpu compute pass over
 //! f32 buffers, many steps per submission, with Δt computed on the device
 //! and the state read back only at sample and output times.
 //!
@@ -156,13 +156,13 @@ impl GpuBackend {
     }
 
     /// How this scene's stages map onto passes.
-    pub fn plan(&self) -> pipelines::StepPlan {
-        self.pipelines.plan
+    pub fn plan(&self) -> &crate::step::StepPlan {
+        &self.pipelines.plan
     }
 
-    /// The passes of one stage (`Pass::for_stage` for this scene).
-    pub fn stage_passes(&self, stage: crate::solver::Stage) -> &'static [Pass] {
-        Pass::for_stage(stage, self.pipelines.plan)
+    /// The passes of one stage (`StepPlan::passes_for` for this scene).
+    pub fn stage_passes(&self, stage: crate::step::Stage) -> &'static [Pass] {
+        self.pipelines.plan.passes_for(stage)
     }
 
     /// Runs one pass on its own (per-stage parity tests).
@@ -370,6 +370,8 @@ impl GpuBackend {
                 residual: None,
             }),
             FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+            // The shader does not report its residual.
+            FAULT_RETURN_NOT_CONVERGED => FaultKind::ReturnNotConverged { residual: f64::NAN },
             code => FaultKind::NonFinite {
                 field: if code == 0 {
                     "unknown (fault code 0)"

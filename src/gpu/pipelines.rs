@@ -11,57 +11,9 @@ use crate::error::{Error, Result};
 use crate::model::shape::Shape;
 use crate::model::{Integrator, Model};
 use crate::scene::NpcPosition;
-use crate::solver::Stage;
+use crate::step::{PlanInputs, StepPlan};
 
-/// One GPU pass: a WGSL file and entry point, run over a domain.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Pass {
-    Cfl,
-    StepBegin,
-    ClearGrid,
-    LmeNewton,
-    /// Particles binned by cell (shared/bins.wgsl): for MLS in `p2g`, for
-    /// the gather passes in `shape_eval`.
-    BinClear,
-    BinCount,
-    BinScan,
-    BinFill,
-    /// p2g.wgsl as a scatter with float atomics, or built with GATHER as
-    /// one invocation per node over the binned particles (no atomics).
-    P2g,
-    P2gGather,
-    /// p2g.wgsl built with PATCH: one invocation per bin of particles that
-    /// share a stencil (linear and B-splines on a regular grid, LME), summing
-    /// their contributions in registers, then one atomic per node and
-    /// component of the stencil.
-    P2gPatch,
-    MlsP2g,
-    GridPredict,
-    Stress,
-    /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
-    /// what a whole step runs without MLS. Not in `ALL`, which lists the
-    /// passes of the stages one by one.
-    StressForces,
-    /// `StressForces` built with PATCH: per bin, as `P2gPatch`. Not in `ALL`.
-    StressForcesPatch,
-    /// forces.wgsl as a scatter, or built with GATHER as `P2gGather` is.
-    Forces,
-    ForcesGather,
-    /// forces.wgsl built with PATCH, as `P2gPatch`.
-    ForcesPatch,
-    MlsForces,
-    GridCorrect,
-    G2p,
-    /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
-    /// then scatter the new velocities from particles (`Remap`) or Gauss
-    /// points (`MlsRemap`).
-    RemapClear,
-    Remap,
-    MlsRemap,
-    StepEnd,
-    Probes,
-    Energy,
-}
+pub use crate::step::Pass;
 
 /// What a pass's invocations run over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -77,126 +29,23 @@ enum Domain {
     GaussPoints,
 }
 
-impl Pass {
-    pub const ALL: [Pass; 26] = [
-        Pass::Cfl,
-        Pass::StepBegin,
-        Pass::ClearGrid,
-        Pass::LmeNewton,
-        Pass::BinClear,
-        Pass::BinCount,
-        Pass::BinScan,
-        Pass::BinFill,
-        Pass::P2g,
-        Pass::P2gGather,
-        Pass::P2gPatch,
-        Pass::MlsP2g,
-        Pass::GridPredict,
-        Pass::Stress,
-        Pass::Forces,
-        Pass::ForcesGather,
-        Pass::ForcesPatch,
-        Pass::MlsForces,
-        Pass::GridCorrect,
-        Pass::G2p,
-        Pass::RemapClear,
-        Pass::Remap,
-        Pass::MlsRemap,
-        Pass::StepEnd,
-        Pass::Probes,
-        Pass::Energy,
-    ];
-
-    /// The WGSL file (under shaders/).
-    pub fn file(self) -> &'static str {
-        match self {
-            Pass::Cfl => "cfl.wgsl",
-            Pass::StepBegin => "step_begin.wgsl",
-            Pass::ClearGrid => "clear_grid.wgsl",
-            Pass::LmeNewton => "lme_newton.wgsl",
-            Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
-            Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
-            Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
-            Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
-            Pass::G2p => "g2p.wgsl",
-            Pass::StepEnd => "step_end.wgsl",
-            Pass::Probes => "probes.wgsl",
-            Pass::Energy => "energy.wgsl",
-            Pass::BinClear => "bin_clear.wgsl",
-            Pass::BinCount => "bin_count.wgsl",
-            Pass::BinScan => "bin_scan.wgsl",
-            Pass::BinFill => "bin_fill.wgsl",
-            Pass::MlsP2g => "mls_p2g.wgsl",
-            Pass::MlsForces => "mls_forces.wgsl",
-            Pass::RemapClear | Pass::Remap => "remap.wgsl",
-            Pass::MlsRemap => "mls_remap.wgsl",
+/// What `pass`'s invocations run over.
+fn domain(pass: Pass) -> Domain {
+    match pass {
+        Pass::StepBegin | Pass::StepEnd | Pass::BinScan => Domain::One,
+        Pass::BinClear | Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => {
+            Domain::Cells
         }
+        Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
+        Pass::ClearGrid
+        | Pass::GridPredict
+        | Pass::GridCorrect
+        | Pass::RemapClear
+        | Pass::P2gGather
+        | Pass::ForcesGather => Domain::Nodes,
+        Pass::Probes => Domain::Probes,
+        _ => Domain::Particles,
     }
-
-    fn domain(self) -> Domain {
-        match self {
-            Pass::StepBegin | Pass::StepEnd | Pass::BinScan => Domain::One,
-            Pass::BinClear | Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => {
-                Domain::Cells
-            }
-            Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
-            Pass::ClearGrid
-            | Pass::GridPredict
-            | Pass::GridCorrect
-            | Pass::RemapClear
-            | Pass::P2gGather
-            | Pass::ForcesGather => Domain::Nodes,
-            Pass::Probes => Domain::Probes,
-            _ => Domain::Particles,
-        }
-    }
-
-    /// The GPU passes that do a solver stage. `Cfl` is the reduction plus
-    /// the one-invocation Δt/stop pass; shape evaluation is LME's Newton
-    /// solve and, for the gather passes, the binning (the weights
-    /// themselves are evaluated inline where used). With MLS, `p2g` and
-    /// `forces` work at Gauss points.
-    pub fn for_stage(stage: Stage, plan: StepPlan) -> &'static [Pass] {
-        const BINS: [Pass; 4] = [Pass::BinClear, Pass::BinCount, Pass::BinScan, Pass::BinFill];
-        match stage {
-            Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
-            Stage::ClearGrid => &[Pass::ClearGrid],
-            Stage::ShapeEval if (plan.gather || plan.patch) && plan.lme => {
-                &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
-            }
-            Stage::ShapeEval if plan.gather || plan.patch => &BINS,
-            Stage::ShapeEval if plan.lme => &[Pass::LmeNewton],
-            Stage::ShapeEval => &[],
-            Stage::P2g if plan.mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
-            Stage::P2g if plan.gather => &[Pass::P2gGather],
-            Stage::P2g if plan.patch => &[Pass::P2gPatch],
-            Stage::P2g => &[Pass::P2g],
-            Stage::Forces if plan.mls => &[Pass::MlsForces],
-            Stage::Forces if plan.gather => &[Pass::ForcesGather],
-            Stage::Forces if plan.patch => &[Pass::ForcesPatch],
-            Stage::GridPredict => &[Pass::GridPredict],
-            Stage::Stress => &[Pass::Stress],
-            Stage::Forces => &[Pass::Forces],
-            Stage::GridCorrect => &[Pass::GridCorrect],
-            Stage::G2p => &[Pass::G2p],
-            Stage::Remap if plan.mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
-            Stage::Remap => &[Pass::RemapClear, Pass::Remap, Pass::GridPredict],
-        }
-    }
-}
-
-/// How a scene's stages map onto passes (`Pass::for_stage`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StepPlan {
-    pub lme: bool,
-    pub mls: bool,
-    pub musl: bool,
-    /// `p2g` and `forces` gather at nodes over particles binned in
-    /// `shape_eval` (`Variant::gather`).
-    pub gather: bool,
-    /// `p2g` and `forces` scatter per bin of particles binned in
-    /// `shape_eval` (`Variant::patch`).
-    pub patch: bool,
 }
 
 /// Everything that selects a shader variant.
@@ -211,11 +60,8 @@ pub struct Variant {
     pub lme_side: u32,
     /// LME weights stored per slot (`GpuOptions::lme_stored`).
     pub lme_stored: bool,
-    /// Material models compiled in.
-    pub linear_elastic: bool,
-    pub neo_hookean: bool,
-    pub mohr_coulomb: bool,
-    pub drucker_prager: bool,
+    /// Material models compiled in: a bit per registry code.
+    pub materials: u32,
     /// Particles carry a deformation gradient F (`Particles::f`, the
     /// `DefGrad` buffer): some material needs it. Neo-Hookean does today;
     /// a finite-strain plastic model would too, which is why this is not
@@ -249,24 +95,11 @@ pub struct Variant {
 
 impl Variant {
     pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
-        use crate::model::material::Material;
         Variant {
-            linear_elastic: model
+            materials: model
                 .materials
                 .iter()
-                .any(|m| matches!(m, Material::LinearElastic(_))),
-            neo_hookean: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::NeoHookean(_))),
-            mohr_coulomb: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::MohrCoulomb(_))),
-            drucker_prager: model
-                .materials
-                .iter()
-                .any(|m| matches!(m, Material::DruckerPrager(_))),
+                .fold(0, |bits, m| bits | 1 << m.entry().code),
             def_grad: !model.particles.f.is_empty(),
             plastic: !model.particles.plastic.is_empty(),
             lme_stored: opts.lme_stored && matches!(model.shape, Shape::Lme(_)),
@@ -292,14 +125,15 @@ impl Variant {
         }
     }
 
+    /// The step plan of this variant (`crate::step`).
     pub fn plan(&self) -> StepPlan {
-        StepPlan {
+        StepPlan::new(PlanInputs {
             lme: self.shape == crate::scene::ShapeKind::Lme,
             mls: self.mls,
             musl: self.integrator == Integrator::Musl,
             gather: self.gather,
             patch: self.patch,
-        }
+        })
     }
 
     /// Flags and values the WGSL is expanded with.
@@ -320,10 +154,6 @@ impl Variant {
             .flag("MULTI_MATERIAL", self.multi_material)
             .flag("FLOAT_ATOMICS", self.atomics == AtomicMode::Float)
             .flag("LME_STORED", self.lme_stored)
-            .flag("MAT_LINEAR_ELASTIC", self.linear_elastic)
-            .flag("MAT_NEO_HOOKEAN", self.neo_hookean)
-            .flag("MAT_MOHR_COULOMB", self.mohr_coulomb)
-            .flag("MAT_DRUCKER_PRAGER", self.drucker_prager)
             .flag("DEF_GRAD", self.def_grad)
             .flag("PLASTIC", self.plastic)
             .flag("MMS", self.mms)
@@ -338,6 +168,13 @@ impl Variant {
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
                 .flag("NPC_POSITION_NEWMARK", position == NpcPosition::Newmark);
         }
+        d.generate(
+            "generated/materials.wgsl",
+            crate::model::material::registry::wgsl(
+                &crate::model::material::registry(),
+                self.materials,
+            ),
+        );
         d.value(
             "ATOMIC_T",
             match self.atomics {
@@ -355,28 +192,6 @@ impl Variant {
             },
         );
         d
-    }
-
-    /// Whether the scene needs this pass.
-    pub fn uses(&self, pass: Pass) -> bool {
-        match pass {
-            Pass::LmeNewton => self.shape == crate::scene::ShapeKind::Lme,
-            Pass::BinClear | Pass::BinCount | Pass::BinScan | Pass::BinFill => {
-                self.mls || self.gather || self.patch
-            }
-            Pass::MlsP2g | Pass::MlsForces => self.mls,
-            Pass::P2g | Pass::Forces => !self.mls && !self.gather && !self.patch,
-            Pass::P2gGather | Pass::ForcesGather => self.gather,
-            Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => self.patch,
-            // MUSL runs the stress last, apart from the forces.
-            Pass::StressForces => {
-                !self.mls && !self.gather && !self.patch && self.integrator != Integrator::Musl
-            }
-            Pass::RemapClear => self.integrator == Integrator::Musl,
-            Pass::Remap => self.integrator == Integrator::Musl && !self.mls,
-            Pass::MlsRemap => self.integrator == Integrator::Musl && self.mls,
-            _ => true,
-        }
     }
 }
 
@@ -512,13 +327,14 @@ impl Pipelines {
         opts: &super::GpuOptions,
     ) -> Result<Pipelines> {
         let variant = Variant::of(model, ctx.atomics, opts);
+        let plan = variant.plan();
         let d = variant.defines();
         let mut built = Vec::new();
         for pass in Pass::ALL
             .into_iter()
             .chain([Pass::StressForces, Pass::StressForcesPatch])
         {
-            if !variant.uses(pass) {
+            if !plan.gpu_uses(pass) {
                 continue;
             }
             let src = expand(pass, &d)?;
@@ -599,7 +415,7 @@ impl Pipelines {
                 pass,
                 pipeline,
                 bind_group,
-                domain: pass.domain(),
+                domain: domain(pass),
             });
         }
         Ok(Pipelines {
@@ -613,7 +429,7 @@ impl Pipelines {
             n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
             n_gauss: buffers.n_gauss as u32,
             max_groups: ctx.limits.max_compute_workgroups_per_dimension,
-            plan: variant.plan(),
+            plan,
         })
     }
 
@@ -635,31 +451,9 @@ impl Pipelines {
         cpass.dispatch_workgroups(x, y, 1);
     }
 
-    /// The passes of one whole step, in the order of the integrator's
-    /// stage list (`solver::stages`); scattering without MLS, and where
-    /// `forces` follows `stress` (not MUSL), the two run fused as
-    /// `StressForces`.
-    pub fn step_passes(plan: StepPlan) -> impl Iterator<Item = Pass> {
-        let fuse = !plan.mls && !plan.musl && !plan.gather;
-        let list = if plan.musl {
-            crate::solver::STEP_MUSL
-        } else {
-            crate::solver::STEP
-        };
-        list.iter()
-            .flat_map(move |stage| Pass::for_stage(*stage, plan).iter().copied())
-            .filter_map(move |pass| match pass {
-                Pass::Stress if fuse && plan.patch => Some(Pass::StressForcesPatch),
-                Pass::Stress if fuse => Some(Pass::StressForces),
-                Pass::Forces | Pass::ForcesPatch if fuse => None,
-                p => Some(p),
-            })
-            .chain([Pass::StepEnd])
-    }
-
     /// Records the passes of one whole step.
     pub fn encode_step(&self, cpass: &mut wgpu::ComputePass<'_>) {
-        for pass in Pipelines::step_passes(self.plan) {
+        for &pass in &self.plan.gpu_step {
             self.dispatch(cpass, pass);
         }
     }
@@ -714,10 +508,14 @@ mod tests {
                                 atomics,
                                 lme_side: if shape == ShapeKind::Lme { 5 } else { 1 },
                                 lme_stored: false,
-                                linear_elastic: !neo_hookean || multi_material,
-                                neo_hookean,
-                                mohr_coulomb: false,
-                                drucker_prager: false,
+                                // Registry codes: 0 linear elastic, 1 Neo-Hookean.
+                                materials: if neo_hookean && !multi_material {
+                                    2
+                                } else if neo_hookean {
+                                    3
+                                } else {
+                                    1
+                                },
                                 def_grad: neo_hookean,
                                 plastic: false,
                                 mms,

@@ -10,136 +10,18 @@
 //!   nestable: NAME is a flag that is set or not;
 //! - `{{NAME}}`: replaced by a value (binding numbers, stencil sizes).
 //!
-//! The sources are compiled into the binary (`include_str!`), so the
-//! executable needs no files at run time.
+//! The sources are compiled into the binary (`include_str!`, the list
+//! found by `build.rs`), so the executable needs no files at run time.
 
 use std::collections::{BTreeMap, BTreeSet};
 
-/// Every WGSL file, by path relative to `shaders/`.
-pub const SOURCES: &[(&str, &str)] = &[
-    (
-        "shared/types.wgsl",
-        include_str!("../../shaders/shared/types.wgsl"),
-    ),
-    (
-        "shared/common.wgsl",
-        include_str!("../../shaders/shared/common.wgsl"),
-    ),
-    (
-        "shared/shape_bindings.wgsl",
-        include_str!("../../shaders/shared/shape_bindings.wgsl"),
-    ),
-    (
-        "shared/material_bindings.wgsl",
-        include_str!("../../shaders/shared/material_bindings.wgsl"),
-    ),
-    (
-        "shared/atomics.wgsl",
-        include_str!("../../shaders/shared/atomics.wgsl"),
-    ),
-    (
-        "shared/shape.wgsl",
-        include_str!("../../shaders/shared/shape.wgsl"),
-    ),
-    (
-        "shared/shape_linear.wgsl",
-        include_str!("../../shaders/shared/shape_linear.wgsl"),
-    ),
-    (
-        "shared/shape_ugimp.wgsl",
-        include_str!("../../shaders/shared/shape_ugimp.wgsl"),
-    ),
-    (
-        "shared/shape_lme.wgsl",
-        include_str!("../../shaders/shared/shape_lme.wgsl"),
-    ),
-    (
-        "shared/shape_bspline.wgsl",
-        include_str!("../../shaders/shared/shape_bspline.wgsl"),
-    ),
-    (
-        "shared/material.wgsl",
-        include_str!("../../shaders/shared/material.wgsl"),
-    ),
-    (
-        "shared/body_force.wgsl",
-        include_str!("../../shaders/shared/body_force.wgsl"),
-    ),
-    (
-        "shared/mls.wgsl",
-        include_str!("../../shaders/shared/mls.wgsl"),
-    ),
-    (
-        "shared/bins.wgsl",
-        include_str!("../../shaders/shared/bins.wgsl"),
-    ),
-    (
-        "bin_clear.wgsl",
-        include_str!("../../shaders/bin_clear.wgsl"),
-    ),
-    (
-        "bin_count.wgsl",
-        include_str!("../../shaders/bin_count.wgsl"),
-    ),
-    ("bin_scan.wgsl", include_str!("../../shaders/bin_scan.wgsl")),
-    ("bin_fill.wgsl", include_str!("../../shaders/bin_fill.wgsl")),
-    ("mls_p2g.wgsl", include_str!("../../shaders/mls_p2g.wgsl")),
-    (
-        "mls_forces.wgsl",
-        include_str!("../../shaders/mls_forces.wgsl"),
-    ),
-    ("remap.wgsl", include_str!("../../shaders/remap.wgsl")),
-    (
-        "mls_remap.wgsl",
-        include_str!("../../shaders/mls_remap.wgsl"),
-    ),
-    (
-        "shared/material_linear_elastic.wgsl",
-        include_str!("../../shaders/shared/material_linear_elastic.wgsl"),
-    ),
-    (
-        "shared/material_neo_hookean.wgsl",
-        include_str!("../../shaders/shared/material_neo_hookean.wgsl"),
-    ),
-    (
-        "shared/material_plastic.wgsl",
-        include_str!("../../shaders/shared/material_plastic.wgsl"),
-    ),
-    (
-        "shared/material_mohr_coulomb.wgsl",
-        include_str!("../../shaders/shared/material_mohr_coulomb.wgsl"),
-    ),
-    (
-        "shared/material_drucker_prager.wgsl",
-        include_str!("../../shaders/shared/material_drucker_prager.wgsl"),
-    ),
-    (
-        "step_begin.wgsl",
-        include_str!("../../shaders/step_begin.wgsl"),
-    ),
-    ("cfl.wgsl", include_str!("../../shaders/cfl.wgsl")),
-    (
-        "clear_grid.wgsl",
-        include_str!("../../shaders/clear_grid.wgsl"),
-    ),
-    (
-        "lme_newton.wgsl",
-        include_str!("../../shaders/lme_newton.wgsl"),
-    ),
-    ("p2g.wgsl", include_str!("../../shaders/p2g.wgsl")),
-    (
-        "grid_update.wgsl",
-        include_str!("../../shaders/grid_update.wgsl"),
-    ),
-    ("stress.wgsl", include_str!("../../shaders/stress.wgsl")),
-    ("forces.wgsl", include_str!("../../shaders/forces.wgsl")),
-    ("g2p.wgsl", include_str!("../../shaders/g2p.wgsl")),
-    ("step_end.wgsl", include_str!("../../shaders/step_end.wgsl")),
-    ("probes.wgsl", include_str!("../../shaders/probes.wgsl")),
-    ("energy.wgsl", include_str!("../../shaders/energy.wgsl")),
-];
+include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 
-fn source(path: &str) -> Result<&'static str, String> {
+/// A file's text: generated (`Defines::generated`) or under `shaders/`.
+fn source<'a>(path: &str, d: &'a Defines) -> Result<&'a str, String> {
+    if let Some(text) = d.generated.get(path) {
+        return Ok(text);
+    }
     SOURCES
         .iter()
         .find(|(p, _)| *p == path)
@@ -152,6 +34,9 @@ fn source(path: &str) -> Result<&'static str, String> {
 pub struct Defines {
     pub flags: BTreeSet<String>,
     pub values: BTreeMap<String, String>,
+    /// Generated files by path (`generated/materials.wgsl`: the material
+    /// registry's dispatch), included like the files under `shaders/`.
+    pub generated: BTreeMap<String, String>,
 }
 
 impl Defines {
@@ -166,6 +51,12 @@ impl Defines {
 
     pub fn value(&mut self, name: &str, v: impl ToString) -> &mut Self {
         self.values.insert(name.to_string(), v.to_string());
+        self
+    }
+
+    /// Adds a generated file, included as `path`.
+    pub fn generate(&mut self, path: &str, text: String) -> &mut Self {
+        self.generated.insert(path.to_string(), text);
         self
     }
 }
@@ -214,13 +105,14 @@ fn expand_include(
         return Ok(());
     }
     if args.is_empty() {
-        return expand_source(source(path)?, path, d, out, seen);
+        return expand_source(source(path, d)?, path, d, out, seen);
     }
     let mut local = d.clone();
     for (k, v) in args {
         local.value(k, v);
     }
-    expand_source(source(path)?, path, &local, out, seen)
+    let text = source(path, d)?.to_string();
+    expand_source(&text, path, &local, out, seen)
 }
 
 fn expand_source(

@@ -21,6 +21,9 @@ pub enum FaultKind {
     /// iterations even after `cuts` halvings of Δt; `ratio` is the last
     /// residual norm over the step's reference norm.
     NewtonDiverged { cuts: u32, ratio: f64 },
+    /// A material's implicit stress return (modified Cam-clay's Newton)
+    /// did not converge; `residual` is its largest scaled residual.
+    ReturnNotConverged { residual: f64 },
 }
 
 /// The first problem a step found.
@@ -59,6 +62,7 @@ impl Fault {
             FaultKind::EnergyRunaway { .. } => "energy_runaway",
             FaultKind::MlsSingular { .. } => "mls_singular",
             FaultKind::NewtonDiverged { .. } => "newton_diverged",
+            FaultKind::ReturnNotConverged { .. } => "return_not_converged",
         }
     }
 }
@@ -85,6 +89,15 @@ impl std::fmt::Display for Fault {
                 "Newton did not converge (residual {ratio:.3e} of the step's reference) after {cuts} \
                  halvings of the time step: lower solver.cfl / solver.dt, raise solver.load_steps or \
                  solver.newton_max_iter"
+            )?,
+            FaultKind::ReturnNotConverged { residual } if residual.is_nan() => write!(
+                f,
+                "the material's stress return did not converge: lower solver.cfl / solver.dt"
+            )?,
+            FaultKind::ReturnNotConverged { residual } => write!(
+                f,
+                "the material's stress return did not converge (scaled residual {residual:.3e}): \
+                 lower solver.cfl / solver.dt"
             )?,
         }
         if let Some(p) = self.particle {

@@ -68,12 +68,13 @@ impl AlignedVibration {
         let spec = scene.file.manufactured.as_ref()?;
         let m = scene.materials().next()?.1;
         let bb = crate::scene::seed::bodies_bbox(scene);
+        let (e, nu) = (m.get("E")?, m.get("nu")?);
         Some(AlignedVibration {
             amplitude: spec.amplitude,
             length: bb[2] - bb[0],
-            c: (m.youngs_modulus / m.density).sqrt(),
+            c: (e / m.density).sqrt(),
             origin: [bb[0], bb[1]],
-            material: NeoHookean::new(m.youngs_modulus, m.nu, m.density),
+            material: NeoHookean::new(e, nu, m.density),
         })
     }
 

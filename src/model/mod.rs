@@ -5,6 +5,7 @@
 pub mod energy;
 pub mod fault;
 pub mod gauss;
+pub mod geostatic;
 mod grid;
 pub mod loads;
 pub mod material;
@@ -160,6 +161,8 @@ impl Model {
     /// that match no node.
     pub fn new(scene: &Scene) -> Result<Model, SceneError> {
         let f = &scene.file;
+        // The materials' own keys (the registry checks them, naming each).
+        let materials: Vec<Material> = material::check(f)?;
         let h = f.grid.h;
         let bbox = seed::bodies_bbox(scene);
         let anchor = f.grid.origin.unwrap_or([bbox[0], bbox[1]]);
@@ -176,7 +179,6 @@ impl Model {
 
         check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
 
-        let materials: Vec<Material> = scene.materials().map(|(_, m)| Material::new(m)).collect();
         let body_material: Vec<u32> = scene
             .bodies()
             .map(|(_, b)| scene.material_index(&b.material) as u32)
@@ -200,7 +202,7 @@ impl Model {
                 lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
             }),
         };
-        let particles = Particles::from_seeds(
+        let mut particles = Particles::from_seeds(
             &seeds,
             |b| materials[body_material[b as usize] as usize].density(),
             |b| velocities[b as usize],
@@ -209,9 +211,21 @@ impl Model {
             materials.iter().any(Material::needs_deformation_gradient),
             materials.iter().any(Material::needs_plastic_state),
         );
+        // Each model's initial state (zero stress and state unless the
+        // model starts elsewhere, as Cam-clay at p′0 on its unloading line).
+        for i in 0..particles.len() {
+            let m = &materials[body_material[particles.body[i] as usize] as usize];
+            let (s, q) = m.initial_state();
+            particles.stress[i] = s;
+            if let Some(p) = particles.plastic.get_mut(i) {
+                *p = q;
+            }
+        }
+        geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
         let constraints = build_constraints(scene, &grid)?;
         let walls = Walls::new(scene, &grid)?;
+        check_not_behind_walls(&walls, &seeds, &body_names)?;
         let gravity = f.gravity.as_ref().map(|g| Gravity {
             g: g.g,
             ramp: g.ramp,
@@ -219,7 +233,6 @@ impl Model {
         });
         // A manufactured solution sets each particle's initial velocity.
         let manufactured = AlignedVibration::from_scene(scene);
-        let mut particles = particles;
         if let Some(m) = &manufactured {
             for i in 0..particles.len() {
                 particles.v[i] = m.velocity(particles.x0[i], 0.0);
@@ -390,6 +403,36 @@ fn check_not_empty(seeds: &[seed::Seed], body_names: &[String], h: f64) -> Resul
     Ok(())
 }
 
+/// No body lies wholly behind a wall (on the side its normal points
+/// away from): the wall would hold every node the body maps to, so the
+/// body could never move; almost surely a normal of the wrong sign.
+fn check_not_behind_walls(
+    walls: &Walls,
+    seeds: &[seed::Seed],
+    body_names: &[String],
+) -> Result<(), SceneError> {
+    for w in &walls.list {
+        let behind = |x: [f64; 2]| {
+            (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1] < 0.0
+        };
+        for (b, name) in body_names.iter().enumerate() {
+            let mut of_body = seeds.iter().filter(|s| s.body as usize == b).peekable();
+            if of_body.peek().is_some() && of_body.all(|s| behind(s.x)) {
+                return Err(SceneError::invalid(
+                    format!("walls.{}", w.name),
+                    format!(
+                        "body `{name}` lies wholly behind the wall (its normal {:?} points away \
+                         from the body): the normal points into the material's side; flip it, \
+                         or move the wall",
+                        w.normal
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Every seeded particle lies inside the grid, `margin` (m) from its edge.
 fn check_inside(
     grid: &Grid,
@@ -538,4 +581,63 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         });
     }
     Ok(c)
+}
+
+/// Bodies with `initial_stress = "geostatic"`: σ_v from the overburden
+/// above each particle, σ_h = σ_zz = k0 σ_v (`geostatic`). Refused, naming
+/// the key, for a material that keeps F or starts at a state of its own.
+fn geostatic_start(
+    scene: &Scene,
+    materials: &[Material],
+    body_material: &[u32],
+    particles: &mut Particles,
+) -> Result<(), SceneError> {
+    use crate::scene::InitialStress;
+    let bodies: Vec<(&String, &crate::scene::BodySpec)> = scene.bodies().collect();
+    if bodies
+        .iter()
+        .all(|(_, b)| b.initial_stress != InitialStress::Geostatic)
+    {
+        return Ok(());
+    }
+    let density: Vec<f64> = body_material
+        .iter()
+        .map(|&m| materials[m as usize].density())
+        .collect();
+    let mut k0 = Vec::with_capacity(bodies.len());
+    for (bi, (name, b)) in bodies.iter().enumerate() {
+        let m = &materials[body_material[bi] as usize];
+        if b.initial_stress == InitialStress::Geostatic {
+            let own_start = m.initial_state() != ([0.0; 3], [0.0; 4]);
+            if m.needs_deformation_gradient() || own_start {
+                return Err(SceneError::invalid(
+                    format!("bodies.{name}.initial_stress"),
+                    format!(
+                        "= \"geostatic\" needs a material whose state is its stress (linear_elastic, mohr_coulomb, drucker_prager); model = \"{}\" {}",
+                        m.entry().name,
+                        if own_start {
+                            "starts at a stress of its own"
+                        } else {
+                            "keeps a deformation gradient"
+                        }
+                    ),
+                ));
+            }
+        }
+        let spec = &scene.file.materials[&b.material];
+        k0.push(b.k0.unwrap_or_else(|| geostatic::default_k0(spec)));
+    }
+    let g = scene.file.gravity.as_ref().map_or(0.0, |g| -g.g[1]);
+    for i in 0..particles.len() {
+        let b = particles.body[i] as usize;
+        if bodies[b].1.initial_stress != InitialStress::Geostatic {
+            continue;
+        }
+        let sv = -g * geostatic::overburden(scene, &density, particles.x[i]);
+        particles.stress[i] = [k0[b] * sv, sv, 0.0];
+        if let Some(q) = particles.plastic.get_mut(i) {
+            q[material::plastic::SZZ] = k0[b] * sv;
+        }
+    }
+    Ok(())
 }

@@ -6,7 +6,6 @@
 //! WGSL twins are `shaders/cfl.wgsl` and `shaders/step_begin.wgsl`.
 
 use crate::model::Model;
-use crate::model::material::Material;
 use rayon::prelude::*;
 
 /// A step of Δt ≥ (1 − LAST_STEP_REL) × (t_end − t) is the last one and
@@ -16,15 +15,7 @@ pub const LAST_STEP_REL: f64 = 1e-6;
 
 /// Δt of a step starting at `t` (s), and whether it is the last.
 pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
-    let p = &model.particles;
-    let c = max_speed(
-        &p.v,
-        &p.rho,
-        &p.body,
-        &model.materials,
-        &model.body_material,
-    );
-    step_of(model, c, t)
+    step_of(model, max_speed(model), t)
 }
 
 /// Δt (s) and whether it is the last, given the largest signal speed `c` (m/s).
@@ -40,19 +31,20 @@ pub fn step_of(model: &Model, c: f64, t: f64) -> (f64, bool) {
     }
 }
 
-/// Largest signal speed over all particles (m/s).
-pub fn max_speed(
-    v: &[[f64; 2]],
-    rho: &[f64],
-    body: &[u32],
-    materials: &[Material],
-    body_material: &[u32],
-) -> f64 {
-    (v, rho, body)
+/// Largest signal speed over all particles (m/s): |v_p| or the material's
+/// wave speed at the particle's density and state.
+pub fn max_speed(model: &Model) -> f64 {
+    let p = &model.particles;
+    (0..p.len())
         .into_par_iter()
         .with_min_len(1024)
-        .map(|(v, &r, &b)| {
-            let c = materials[body_material[b as usize] as usize].wave_speed(r);
+        .map(|i| {
+            let v = p.v[i];
+            let c = model.material_of(i).wave_speed(
+                p.rho[i],
+                &p.stress[i],
+                p.plastic.get(i).unwrap_or(&[0.0; 4]),
+            );
             (v[0] * v[0] + v[1] * v[1]).sqrt().max(c)
         })
         .reduce(|| 0.0, f64::max)

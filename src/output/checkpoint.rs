@@ -1,7 +1,8 @@
 //! `checkpoint.lmeck`: everything a run needs to continue exactly where it
 //! stopped (the particles with every per-particle state, the time, the step
-//! count, the driver's counters, the resolved scene, and the samples and
-//! snapshots written so far). Binary, little-endian:
+//! count, the driver's counters, the resolved scene, the samples and
+//! snapshots written so far, and the implicit integrator's Newton counters
+//! and held wall contact states). Binary, little-endian:
 //!
 //! ```text
 //! "LMEMPMCK"  magic (8 bytes)
@@ -25,8 +26,9 @@ use std::path::Path;
 pub const FILE: &str = "checkpoint.lmeck";
 const MAGIC: &[u8; 8] = b"LMEMPMCK";
 /// Bumped whenever the payload changes (2: the plastic state; 3: the
-/// implicit integrator's Newton statistics and per-sample Newton figures).
-pub const FORMAT: u32 = 3;
+/// implicit integrator's Newton statistics and per-sample Newton figures;
+/// 4: its held wall contact states).
+pub const FORMAT: u32 = 4;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -49,6 +51,9 @@ pub struct Checkpoint {
     /// The implicit integrator's Newton statistics so far (None for the
     /// explicit integrators).
     pub newton: Option<NewtonStats>,
+    /// The implicit integrator's held wall contact states, per node then
+    /// wall (`backend::State::held_contacts`); empty otherwise.
+    pub held_contacts: Vec<u8>,
 }
 
 impl Checkpoint {
@@ -116,6 +121,7 @@ impl Checkpoint {
                 e.f64(v);
             }
         });
+        e.list(&self.held_contacts, |e, c| e.u32(u32::from(*c)));
         let sum = fnv1a(&e.0);
         e.u64(sum);
         e.0
@@ -211,6 +217,8 @@ impl Checkpoint {
                 },
             })
         })?;
+        let held_contacts =
+            d.list(|d| u8::try_from(d.u32()?).map_err(|_| bad("holds an invalid contact state")))?;
         if !d.0.is_empty() {
             return Err(bad("has trailing bytes"));
         }
@@ -242,6 +250,7 @@ impl Checkpoint {
             samples,
             snapshots,
             newton,
+            held_contacts,
         })
     }
 
@@ -437,6 +446,7 @@ mod tests {
                     convect: 0.7,
                 },
             }),
+            held_contacts: vec![0, 1, 2, 3, 1],
         }
     }
 
@@ -457,6 +467,7 @@ mod tests {
         assert_eq!(d.snapshots, c.snapshots);
         assert_eq!(d.scene_toml, c.scene_toml);
         assert_eq!(d.newton, c.newton);
+        assert_eq!(d.held_contacts, c.held_contacts);
     }
 
     #[test]

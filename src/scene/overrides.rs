@@ -41,10 +41,18 @@ impl Override {
         if raw.is_empty() {
             return Err(err("the value after '=' is empty"));
         }
+        // One value on one line: a newline would start more TOML (a table
+        // header, another key) that the parse below would drop unsaid.
+        if arg.chars().any(char::is_control) {
+            return Err(err(
+                "holds a newline or another control character: give one key=value per --set",
+            ));
+        }
         let value = match format!("v = {raw}").parse::<Table>() {
-            Ok(mut t) => t
+            Ok(mut t) if t.len() == 1 => t
                 .remove("v")
                 .expect("parsed table holds the key it was given"),
+            Ok(_) => return Err(err("the value is more than one TOML value")),
             Err(_) => Value::String(raw.to_string()),
         };
         Ok(Override {

@@ -69,55 +69,84 @@ fn default_seed() -> u64 {
     1
 }
 
-/// Constitutive model of a material.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MaterialModel {
-    /// Small-strain increments, plane strain, Hooke's law.
-    LinearElastic,
-    /// Compressible Neo-Hookean on the deformation gradient (finite strain).
-    NeoHookean,
-    /// Elastic-perfectly plastic Mohr–Coulomb (plane strain, Jaumann rate),
-    /// with a Rankine tension cutoff.
-    MohrCoulomb,
-    /// Elastic-perfectly plastic Drucker–Prager matched to Mohr–Coulomb in
-    /// plane strain, with a tension cap on the mean stress.
-    DruckerPrager,
+/// A material as the scene writes it: the model's name, the density and
+/// the model's own keys (numbers; units and ranges per model). Each model
+/// registers its keys in `model::material` (the registry), which checks
+/// them, naming the key, before a model is built; here they are only read.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "toml::Table", into = "toml::Table")]
+pub struct MaterialSpec {
+    /// The constitutive model (`model = "..."`): a name in the registry.
+    pub model: String,
+    /// Initial mass density ρ0 (kg/m³).
+    pub density: f64,
+    /// The model's other keys, by name (TOML integers read as numbers).
+    pub values: BTreeMap<String, f64>,
 }
 
-impl MaterialModel {
-    /// The model has a yield surface (and the keys below).
-    pub fn is_plastic(self) -> bool {
-        matches!(
-            self,
-            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager
-        )
+impl MaterialSpec {
+    /// A material of `model` with density `rho` (kg/m³) and no other keys.
+    pub fn new(model: &str, rho: f64) -> MaterialSpec {
+        MaterialSpec {
+            model: model.to_string(),
+            density: rho,
+            values: BTreeMap::new(),
+        }
+    }
+
+    /// This material with `key = value` added.
+    pub fn with(mut self, key: &str, value: f64) -> MaterialSpec {
+        self.values.insert(key.to_string(), value);
+        self
+    }
+
+    /// The value of one of the model's keys, if given.
+    pub fn get(&self, key: &str) -> Option<f64> {
+        self.values.get(key).copied()
     }
 }
 
-#[derive(Debug, Clone, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialSpec {
-    pub model: MaterialModel,
-    /// Initial mass density ρ0 (kg/m³).
-    pub density: f64,
-    /// Young's modulus E (Pa).
-    #[serde(rename = "E")]
-    pub youngs_modulus: f64,
-    /// Poisson's ratio ν, in [0, 0.5).
-    pub nu: f64,
-    /// Plastic models only: cohesion c (Pa), ≥ 0. Required.
-    pub cohesion: Option<f64>,
-    /// Plastic models only: friction angle φ (degrees), in [0, 90). Required.
-    pub friction_angle: Option<f64>,
-    /// Plastic models only: dilation angle ψ (degrees), in [0, φ].
-    /// Default 0 (non-associated, no plastic volume change).
-    pub dilation_angle: Option<f64>,
-    /// Plastic models only: tension cutoff t (Pa), in [0, c / tan φ].
-    /// Mohr–Coulomb: the largest principal stress σ1 ≤ t (Rankine);
-    /// Drucker–Prager: the mean stress p ≤ t. Default: the apex c / tan φ
-    /// (no cutoff when φ = 0).
-    pub tension_cutoff: Option<f64>,
+impl TryFrom<toml::Table> for MaterialSpec {
+    type Error = String;
+
+    fn try_from(mut t: toml::Table) -> Result<MaterialSpec, String> {
+        let model = match t.remove("model") {
+            Some(toml::Value::String(s)) => s,
+            Some(v) => return Err(format!("model must be a string, got {v}")),
+            None => return Err("missing field `model`".to_string()),
+        };
+        let number = |k: &str, v: toml::Value| match v {
+            toml::Value::Float(x) => Ok(x),
+            toml::Value::Integer(i) => Ok(i as f64),
+            v => Err(format!("`{k}` must be a number, got {v}")),
+        };
+        let density = number(
+            "density",
+            t.remove("density")
+                .ok_or_else(|| "missing field `density`".to_string())?,
+        )?;
+        let values = t
+            .into_iter()
+            .map(|(k, v)| number(&k, v).map(|x| (k, x)))
+            .collect::<Result<_, _>>()?;
+        Ok(MaterialSpec {
+            model,
+            density,
+            values,
+        })
+    }
+}
+
+impl From<MaterialSpec> for toml::Table {
+    fn from(m: MaterialSpec) -> toml::Table {
+        let mut t = toml::Table::new();
+        t.insert("model".into(), toml::Value::String(m.model));
+        t.insert("density".into(), toml::Value::Float(m.density));
+        for (k, v) in m.values {
+            t.insert(k, toml::Value::Float(v));
+        }
+        t
+    }
 }
 
 /// How particles are placed inside each grid cell.
@@ -152,6 +181,24 @@ pub struct BodySpec {
     /// Simple polygons, each a list of `[x, y]` vertices (m).
     #[serde(default)]
     pub polygons: Vec<Vec<[f64; 2]>>,
+    /// The stress the body starts with. Default `none` (stress-free).
+    #[serde(default)]
+    pub initial_stress: InitialStress,
+    /// With `initial_stress = "geostatic"`: σ_h / σ_v (> 0). Default
+    /// 1 − sin φ for a material with a friction angle, ν/(1 − ν) otherwise.
+    pub k0: Option<f64>,
+}
+
+/// A body's initial stress.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialStress {
+    /// Stress-free (the model's own initial state).
+    #[default]
+    None,
+    /// At rest under gravity: σ_v from the weight of the material above
+    /// each particle, σ_h = σ_zz = k0 σ_v (`model::geostatic`).
+    Geostatic,
 }
 
 fn default_ppc() -> u32 {
@@ -463,6 +510,11 @@ pub struct OutputSpec {
     /// Write `particles.csv` at the end. Default true.
     #[serde(default = "default_true")]
     pub particles_csv: bool,
+    /// Leave `checkpoint.lmeck` at t_end when the run completes, so
+    /// `lme-mpm resume DIR --set solver.t_end=LATER` can extend it (about
+    /// 190 bytes per particle on disk). Default true.
+    #[serde(default = "default_true")]
+    pub final_checkpoint: bool,
     /// Named points (m); the particle nearest to each at t = 0 is tracked.
     #[serde(default)]
     pub probes: BTreeMap<String, [f64; 2]>,
@@ -476,6 +528,7 @@ impl Default for OutputSpec {
             checkpoint_interval: None,
             vtk_final: true,
             particles_csv: true,
+            final_checkpoint: true,
             probes: BTreeMap::new(),
         }
     }

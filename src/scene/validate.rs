@@ -287,7 +287,10 @@ fn check_grid(file: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// `[materials]`: at least one, with density, E and ν in range.
+/// `[materials]`: at least one, each with a positive density. The model's
+/// name and its own keys are checked by the material registry
+/// (`model::material::check`, run by `preflight` and `Model::new`), which
+/// knows each model's keys; a scene is validated without the model layer.
 fn check_materials(file: &SceneFile) -> Result<(), SceneError> {
     if file.materials.is_empty() {
         return Err(SceneError::invalid(
@@ -296,93 +299,7 @@ fn check_materials(file: &SceneFile) -> Result<(), SceneError> {
         ));
     }
     for (mname, m) in &file.materials {
-        let key = |k: &str| format!("materials.{mname}.{k}");
-        positive(&key("density"), m.density)?;
-        positive(&key("E"), m.youngs_modulus)?;
-        finite(&key("nu"), m.nu)?;
-        if !(m.nu > -1.0 && m.nu < 0.5) {
-            return Err(SceneError::invalid(
-                key("nu"),
-                format!("must be in (-1, 0.5), got {}", m.nu),
-            ));
-        }
-        check_plastic_keys(m, &key)?;
-    }
-    Ok(())
-}
-
-/// The yield keys: required by the plastic models (cohesion, friction
-/// angle), in range, and refused on the elastic ones.
-fn check_plastic_keys(m: &MaterialSpec, key: &dyn Fn(&str) -> String) -> Result<(), SceneError> {
-    let given = [
-        ("cohesion", m.cohesion),
-        ("friction_angle", m.friction_angle),
-        ("dilation_angle", m.dilation_angle),
-        ("tension_cutoff", m.tension_cutoff),
-    ];
-    if !m.model.is_plastic() {
-        if let Some((k, _)) = given.iter().find(|(_, v)| v.is_some()) {
-            return Err(SceneError::invalid(
-                key(k),
-                "applies only to model = \"mohr_coulomb\" or \"drucker_prager\"; remove it for an elastic material",
-            ));
-        }
-        return Ok(());
-    }
-    let required = |k: &str, v: Option<f64>| {
-        v.ok_or_else(|| {
-            SceneError::invalid(
-                key(k),
-                "is required for model = \"mohr_coulomb\" and \"drucker_prager\"",
-            )
-        })
-    };
-    let c = required("cohesion", m.cohesion)?;
-    finite(&key("cohesion"), c)?;
-    if c < 0.0 {
-        return Err(SceneError::invalid(
-            key("cohesion"),
-            format!("must be ≥ 0 Pa, got {c}"),
-        ));
-    }
-    let phi = required("friction_angle", m.friction_angle)?;
-    finite(&key("friction_angle"), phi)?;
-    if !(0.0..90.0).contains(&phi) {
-        return Err(SceneError::invalid(
-            key("friction_angle"),
-            format!("must be in [0, 90) degrees, got {phi}"),
-        ));
-    }
-    if let Some(psi) = m.dilation_angle {
-        finite(&key("dilation_angle"), psi)?;
-        if !(0.0..=phi).contains(&psi) {
-            return Err(SceneError::invalid(
-                key("dilation_angle"),
-                format!("must be in [0, friction_angle = {phi}] degrees, got {psi}"),
-            ));
-        }
-    }
-    if let Some(t) = m.tension_cutoff {
-        finite(&key("tension_cutoff"), t)?;
-        if t < 0.0 {
-            return Err(SceneError::invalid(
-                key("tension_cutoff"),
-                format!("must be ≥ 0 Pa, got {t}"),
-            ));
-        }
-        if phi > 0.0 {
-            let apex = c / phi.to_radians().tan();
-            // A value written from a hand-computed apex may round a few ulps
-            // above it; the material clamps t to the apex.
-            if t > apex * (1.0 + 1e-9) {
-                return Err(SceneError::invalid(
-                    key("tension_cutoff"),
-                    format!(
-                        "must not exceed the apex c / tan(friction_angle) = {apex} Pa, got {t}"
-                    ),
-                ));
-            }
-        }
+        positive(&format!("materials.{mname}.density"), m.density)?;
     }
     Ok(())
 }
@@ -500,6 +417,43 @@ fn check_bodies(file: &SceneFile) -> Result<(), SceneError> {
         ));
     }
     check_rect_overlaps(file)?;
+    for (bname, b) in &file.bodies {
+        check_initial_stress(file, bname, b)?;
+    }
+    Ok(())
+}
+
+/// A body's `initial_stress` and `k0`: geostatic needs full gravity along
+/// −y from the start; k0 > 0 and only with it.
+fn check_initial_stress(file: &SceneFile, bname: &str, b: &BodySpec) -> Result<(), SceneError> {
+    let key = |k: &str| format!("bodies.{bname}.{k}");
+    if let Some(k0) = b.k0 {
+        finite(&key("k0"), k0)?;
+        if k0 <= 0.0 {
+            return Err(SceneError::invalid(
+                key("k0"),
+                format!("must be > 0 (σ_h / σ_v), got {k0}"),
+            ));
+        }
+        if b.initial_stress != InitialStress::Geostatic {
+            return Err(SceneError::invalid(
+                key("k0"),
+                "applies only with initial_stress = \"geostatic\"",
+            ));
+        }
+    }
+    if b.initial_stress == InitialStress::Geostatic {
+        let ok = file
+            .gravity
+            .as_ref()
+            .is_some_and(|g| g.g[0] == 0.0 && g.g[1] < 0.0 && g.ramp == Ramp::None);
+        if !ok {
+            return Err(SceneError::invalid(
+                key("initial_stress"),
+                "= \"geostatic\" needs gravity along -y (gravity.g = [0, -g]) at full strength from the start (gravity.ramp = \"none\")",
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -511,7 +465,7 @@ fn check_constraints(file: &SceneFile) -> Result<(), SceneError> {
                 return Err(SceneError::invalid(
                     format!("constraints.{cname}"),
                     format!(
-                        "min/max must be ±inf or within ±{:e} m, not NaN",
+                        "min/max must be ±inf or within ±{:e} m, got {v}",
                         limits::COORD_MAX
                     ),
                 ));
@@ -775,7 +729,7 @@ fn check_rect_overlaps(file: &SceneFile) -> Result<(), SceneError> {
 
 fn check_manufactured(file: &SceneFile, m: &ManufacturedSpec) -> Result<(), SceneError> {
     let mat = file.materials.values().collect::<Vec<_>>();
-    if mat.len() != 1 || mat[0].model != MaterialModel::NeoHookean {
+    if mat.len() != 1 || mat[0].model != "neo_hookean" {
         return Err(SceneError::invalid(
             "manufactured",
             "needs exactly one material, of model \"neo_hookean\" (the solution is derived for it)",
@@ -842,12 +796,22 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ));
     }
     let m = file.materials.values().next().expect("one material");
-    if m.nu != 0.0 {
+    if m.get("E").is_none() {
+        return Err(SceneError::invalid(
+            "exact",
+            format!(
+                "= \"{what}\" is scored by an elastic solution and needs a material with Young's modulus E (model = \"{}\" has none)",
+                m.model
+            ),
+        ));
+    }
+    let nu = m.get("nu");
+    if nu != Some(0.0) {
         return Err(SceneError::invalid(
             "exact",
             format!(
                 "= \"{what}\" is scored by a 1D (bar or beam) solution and needs nu = 0 (plane strain then has no lateral coupling), got nu = {}",
-                m.nu
+                nu.map_or("none".to_string(), |v| v.to_string())
             ),
         ));
     }

@@ -773,7 +773,7 @@ impl Report<'_> {
         let scene = Scene::from_str(ROLLING_DISK, "rolling_disk", "rolling_disk", &[])?;
         let exact = RollingDisk::from_scene(&scene);
         let m = scene.materials().next().expect("the disk has a material").1;
-        let (e, nu) = (m.youngs_modulus, m.nu);
+        let (e, nu) = (m.get("E").unwrap_or(f64::NAN), m.get("nu").unwrap_or(0.0));
         let c = (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / m.density).sqrt();
         let courant = |dt: f64| dt * c / scene.file.grid.h;
         let n = disk_steps("implicit", self.quick).len();

@@ -225,46 +225,15 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     let main = backends.first().copied().unwrap_or("cpu");
     let mut charts = Vec::new();
     let mut md = String::new();
-    let t_label = if quick { "one period" } else { "T = 0.2 s" };
-    let _ = writeln!(
-        md,
-        "The B-spline paper's study (SPEC benchmark 4, `cases/aligned_vibration.toml`): unit square, \
-         Neo-Hookean, ν = 0.3, ρ0 = 1000 kg/m³, A = 0.1 m, the paper's update (`solver.integrator = \
-         \"musl\"`, eqs. 28–37) for every method, Δt = 1e-5 s, t_end = {}, 3 × 3 particles per cell, \
-         2 × 2 Gauss points per integration cell for MLS; cells per side: {}{}; E = {} Pa (the two \
-         readings of the paper's \"10e^7\"); {} runs{}. Errors: RMS over particles of |u − u_exact|, \
-         |v − v_exact| and the Cauchy stress difference (paper eq. 43), and the same divided by the \
-         exact field's RMS (1 = an error as large as the field). A run that went unstable shows when \
-         and why (`energy_runaway`: kinetic + stored energy above 10 times the exact field's peak). \
-         Raw results: `results.csv` of the study's output folder.\n",
-        if quick {
-            "one period 2L/c (quick sweep)"
-        } else {
-            "0.2 s"
-        },
-        cells
-            .iter()
-            .map(|c| c.to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        if !quick && cells.len() < CELLS_FULL.len() {
-            format!(" (restricted by {CELLS_ENV}; the full sweep is {CELLS_FULL:?})")
-        } else {
-            String::new()
-        },
-        readings(quick)
-            .iter()
-            .map(|r| r.0)
-            .collect::<Vec<_>>()
-            .join(" and "),
-        results.len(),
-        if backends.len() > 1 {
-            " (tables: the first backend)"
-        } else {
-            ""
-        }
-    );
-
+    let s = Section {
+        results,
+        dir,
+        quick,
+        main,
+        cells: &cells,
+        t_label: if quick { "one period" } else { "T = 0.2 s" },
+    };
+    s.intro(&mut md, &backends);
     for &(e_label, e_pa) in readings(quick) {
         let exact = exact_of(e_pa)?;
         let _ = writeln!(
@@ -273,6 +242,86 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             sig(exact.c),
             sig(period(e_pa))
         );
+        charts.extend(s.convergence_charts(e_label)?);
+        s.error_tables(&mut md, e_label);
+        let goal = s.order_table(&mut md, e_label, &exact);
+        s.acceptance(&mut md, e_label, goal);
+        for (_, _, stem, _) in QUANTITIES {
+            md.push_str(&image(
+                &format!("MMS convergence ({stem}, E = {e_label} Pa)"),
+                &format!("study-mms-{stem}-e{}.png", &e_label[2..]),
+            ));
+            md.push('\n');
+        }
+    }
+    charts.extend(s.front(&mut md, &backends)?);
+    Ok((md, charts))
+}
+
+/// What every part of the report reads.
+struct Section<'a> {
+    results: &'a [JobResult],
+    dir: &'a Path,
+    quick: bool,
+    /// The backend the tables show.
+    main: &'a str,
+    cells: &'a [usize],
+    /// When the errors are taken, in words.
+    t_label: &'static str,
+}
+
+/// The bspline2 + MLS displacement orders at T and after one period.
+type Goal = Option<(Vec<Option<f64>>, Vec<Option<f64>>)>;
+
+impl Section<'_> {
+    /// The study's set-up in words.
+    fn intro(&self, md: &mut String, backends: &[&str]) {
+        let (results, quick, cells) = (self.results, self.quick, self.cells);
+        let _ = writeln!(
+            md,
+            "The B-spline paper's study (SPEC benchmark 4, `cases/aligned_vibration.toml`): unit square, \
+     Neo-Hookean, ν = 0.3, ρ0 = 1000 kg/m³, A = 0.1 m, the paper's update (`solver.integrator = \
+     \"musl\"`, eqs. 28–37) for every method, Δt = 1e-5 s, t_end = {}, 3 × 3 particles per cell, \
+     2 × 2 Gauss points per integration cell for MLS; cells per side: {}{}; E = {} Pa (the two \
+     readings of the paper's \"10e^7\"); {} runs{}. Errors: RMS over particles of |u − u_exact|, \
+     |v − v_exact| and the Cauchy stress difference (paper eq. 43), and the same divided by the \
+     exact field's RMS (1 = an error as large as the field). A run that went unstable shows when \
+     and why (`energy_runaway`: kinetic + stored energy above 10 times the exact field's peak). \
+     Raw results: `results.csv` of the study's output folder.\n",
+            if quick {
+                "one period 2L/c (quick sweep)"
+            } else {
+                "0.2 s"
+            },
+            cells
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            if !quick && cells.len() < CELLS_FULL.len() {
+                format!(" (restricted by {CELLS_ENV}; the full sweep is {CELLS_FULL:?})")
+            } else {
+                String::new()
+            },
+            readings(quick)
+                .iter()
+                .map(|r| r.0)
+                .collect::<Vec<_>>()
+                .join(" and "),
+            results.len(),
+            if backends.len() > 1 {
+                " (tables: the first backend)"
+            } else {
+                ""
+            }
+        );
+    }
+
+    /// One convergence chart per quantity at E = `e_label`.
+    fn convergence_charts(&self, e_label: &str) -> Result<Vec<PathBuf>> {
+        let (results, main, cells, t_label, dir) =
+            (self.results, self.main, self.cells, self.t_label, self.dir);
+        let mut charts = Vec::new();
         // --- convergence charts, one per quantity -------------------------
         for (name, unit, stem, pick) in QUANTITIES {
             let curves: Vec<Curve> = METHODS
@@ -300,7 +349,12 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             )?;
             charts.extend(files);
         }
+        Ok(charts)
+    }
 
+    /// The absolute and relative error tables at E = `e_label`.
+    fn error_tables(&self, md: &mut String, e_label: &str) {
+        let (results, main, cells, t_label) = (self.results, self.main, self.cells, self.t_label);
         // --- tables ----------------------------------------------------------
         let mut header = vec!["cells".to_string()];
         header.extend(METHODS.iter().map(|m| m.0.to_string()));
@@ -347,10 +401,20 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         let _ = writeln!(
             md,
             "Relative errors (displacement / velocity / stress, each over the exact field's RMS) at \
-             {t_label}, E = {e_label} Pa:\n\n{}",
+         {t_label}, E = {e_label} Pa:\n\n{}",
             table(&header, &rows)
         );
+    }
 
+    /// The observed orders at E = `e_label`; returns bspline2 + MLS's.
+    fn order_table(&self, md: &mut String, e_label: &str, exact: &AlignedVibration) -> Goal {
+        let (results, main, cells, t_label, quick) = (
+            self.results,
+            self.main,
+            self.cells,
+            self.t_label,
+            self.quick,
+        );
         // --- orders ----------------------------------------------------------
         let spans: Vec<String> = cells
             .windows(2)
@@ -367,7 +431,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                         .collect()
                 };
                 let at_t = at(&|r| final_errors(r).map(pick));
-                let at_p = at(&|r| period_errors(r, &exact).map(|e| pick(&e)));
+                let at_p = at(&|r| period_errors(r, exact).map(|e| pick(&e)));
                 let (rt, rp) = (rates(&at_t), rates(&at_p));
                 if label == "bspline2-mls" && name == "displacement" {
                     goal = Some((rt.clone(), rp.clone()));
@@ -390,10 +454,21 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         let _ = writeln!(
             md,
             "Observed orders of convergence, log₂(e_h / e_h/2), between successive resolutions \
-             (\"-\": a run did not complete), E = {e_label} Pa:\n\n{}",
+         (\"-\": a run did not complete), E = {e_label} Pa:\n\n{}",
             table(&rh, &rate_rows)
         );
+        goal
+    }
 
+    /// The issue's acceptance figures for bspline2 + MLS, as measured.
+    fn acceptance(&self, md: &mut String, e_label: &str, goal: Goal) {
+        let (results, main, cells, t_label, quick) = (
+            self.results,
+            self.main,
+            self.cells,
+            self.t_label,
+            self.quick,
+        );
         // --- the issue's acceptance, as measured -------------------------------
         let mls_done: Vec<String> = cells
             .iter()
@@ -429,8 +504,8 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         let _ = writeln!(
             md,
             "Acceptance figures for bspline2 + MLS at E = {e_label} Pa: completes every resolution? \
-             {}. Displacement error below plain bspline2 at 32 and 64 cells? {}. Displacement order \
-             ≥ {GOAL_RATE} between successive resolutions? at {t_label}: {}{}.\n",
+         {}. Displacement error below plain bspline2 at 32 and 64 cells? {}. Displacement order \
+         ≥ {GOAL_RATE} between successive resolutions? at {t_label}: {}{}.\n",
             mls_done.join("; "),
             if beats.is_empty() {
                 "not run (no resolution ≥ 32)".to_string()
@@ -447,52 +522,51 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
                 )
             }
         );
-        for (_, _, stem, _) in QUANTITIES {
-            md.push_str(&image(
-                &format!("MMS convergence ({stem}, E = {e_label} Pa)"),
-                &format!("study-mms-{stem}-e{}.png", &e_label[2..]),
-            ));
-            md.push('\n');
-        }
     }
 
-    // --- error against wall time -----------------------------------------------
-    let mut curves = Vec::new();
-    for b in &backends {
-        for &(e_label, _) in readings(quick) {
-            for (m, &(label, _, mls)) in METHODS.iter().enumerate() {
-                let points: Vec<(f64, f64)> = cells
-                    .iter()
-                    .filter_map(|&n| {
-                        let r = find(results, b, e_label, label, n)?;
-                        Some((r.data()?.wall_seconds, final_errors(r)?.rms_displacement))
-                    })
-                    .collect();
-                if points.is_empty() {
-                    continue;
+    /// Error against wall time over every backend and reading.
+    fn front(&self, md: &mut String, backends: &[&str]) -> Result<Vec<PathBuf>> {
+        let (results, cells, t_label, quick, dir) =
+            (self.results, self.cells, self.t_label, self.quick, self.dir);
+        let mut charts = Vec::new();
+        // --- error against wall time -----------------------------------------------
+        let mut curves = Vec::new();
+        for b in backends {
+            for &(e_label, _) in readings(quick) {
+                for (m, &(label, _, mls)) in METHODS.iter().enumerate() {
+                    let points: Vec<(f64, f64)> = cells
+                        .iter()
+                        .filter_map(|&n| {
+                            let r = find(results, b, e_label, label, n)?;
+                            Some((r.data()?.wall_seconds, final_errors(r)?.rms_displacement))
+                        })
+                        .collect();
+                    if points.is_empty() {
+                        continue;
+                    }
+                    let mut name = format!("E {e_label} {label}");
+                    if backends.len() > 1 {
+                        name = format!("{b} {name}");
+                    }
+                    curves.push(Curve {
+                        label: name,
+                        points,
+                        color: color(m),
+                        dashed: mls,
+                    });
                 }
-                let mut name = format!("E {e_label} {label}");
-                if backends.len() > 1 {
-                    name = format!("{b} {name}");
-                }
-                curves.push(Curve {
-                    label: name,
-                    points,
-                    color: color(m),
-                    dashed: mls,
-                });
             }
         }
+        let (files, _) = report::front_chart(
+            &format!("Aligned vibration: displacement error at {t_label} against cost"),
+            "RMS displacement error (m)",
+            &curves,
+            &dir.join("study-mms-front"),
+        )?;
+        charts.extend(files);
+        md.push_str(&image("MMS error against wall time", "study-mms-front.png"));
+        Ok(charts)
     }
-    let (files, _) = report::front_chart(
-        &format!("Aligned vibration: displacement error at {t_label} against cost"),
-        "RMS displacement error (m)",
-        &curves,
-        &dir.join("study-mms-front"),
-    )?;
-    charts.extend(files);
-    md.push_str(&image("MMS error against wall time", "study-mms-front.png"));
-    Ok((md, charts))
 }
 
 /// "met" / "not met" with the orders.

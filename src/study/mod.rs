@@ -204,7 +204,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::All => unreachable!(),
         };
         if opts.progress || opts.progress_lines {
-            eprintln!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
+            crate::say!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
         let label = format!("study {}", n.slug());
         let results = runner::run_jobs(

@@ -1,8 +1,10 @@
 //! A sweep folder's runs as records: each `runs/ID/summary.json` read back
-//! (missing, killed and failed runs listed as such), then, where the runs
+//! (missing, killed and failed runs listed as such; a folder another plan
+//! wrote, or an unreadable summary, as failed with the reason), then, where the runs
 //! report no exact error, each run's error against its series' finest
 //! completed run (`reference.rs`).
 
+use super::entry::mismatch;
 use super::plan::Plan;
 use super::record::{Outcome, Record};
 use super::reference;
@@ -17,14 +19,30 @@ pub fn records(plan: &Plan, dir: &Path, known: &BTreeMap<String, String>) -> Vec
         .iter()
         .map(|run| {
             let keys = plan.keys_of(run);
-            let summary = dir.join("runs").join(&run.id).join("summary.json");
-            match std::fs::read_to_string(&summary) {
-                Ok(text) => {
-                    Record::from_summary(&run.id, keys.clone(), &text).unwrap_or_else(|e| {
-                        let mut r = Record::missing(&run.id, keys, &e);
-                        r.outcome = Outcome::Failed;
-                        r
-                    })
+            let folder = dir.join("runs").join(&run.id);
+            let summary = folder.join("summary.json");
+            let failed = |why: &str| {
+                let mut r = Record::missing(&run.id, keys.clone(), why);
+                r.outcome = Outcome::Failed;
+                r
+            };
+            match std::fs::read(&summary) {
+                Ok(bytes) => {
+                    // Garbage or a cut file alike: unreadable, so failed.
+                    let read = String::from_utf8(bytes)
+                        .map_err(|_| "summary.json unreadable: not UTF-8 text".to_string())
+                        .and_then(|text| Record::from_summary(&run.id, keys.clone(), &text));
+                    match (read, mismatch(plan, run, &folder)) {
+                        (Err(e), _) => failed(&e),
+                        (Ok(_), Some(why)) => failed(&format!(
+                            "not this plan's run: {why}; rerun its line, or collect the sweep \
+                             that wrote it"
+                        )),
+                        (Ok(r), None) => r,
+                    }
+                }
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    failed(&format!("summary.json unreadable: {e}"))
                 }
                 Err(_) => match known.get(&run.id) {
                     Some(reason) => {

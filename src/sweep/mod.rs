@@ -13,6 +13,8 @@
 
 pub mod collect;
 pub mod document;
+pub mod entry;
+pub mod number;
 pub mod plan;
 pub mod record;
 pub mod reference;
@@ -43,6 +45,36 @@ pub struct SweepOptions {
     pub stop: Option<Arc<AtomicBool>>,
     /// The figure the charts use (`--metric`); default the first error reported.
     pub metric: Option<String>,
+    /// Memory the runs running at once may take together (`--max-memory`,
+    /// bytes). Default: the memory available (MemAvailable) at the start.
+    pub max_memory: Option<u64>,
+}
+
+fn mib(bytes: u64) -> f64 {
+    bytes as f64 / 1048576.0
+}
+
+/// How many runs may run at once: at most `jobs`, and no more than the
+/// largest of them fit together in `budget` bytes (the `k` largest
+/// estimates summed), at least one. A run that alone exceeds the budget
+/// is refused by its own preflight.
+pub fn concurrent_runs(estimates: &[u64], budget: Option<u64>, jobs: usize) -> usize {
+    let jobs = jobs.max(1).min(estimates.len().max(1));
+    let Some(budget) = budget else {
+        return jobs;
+    };
+    let mut largest = estimates.to_vec();
+    largest.sort_unstable_by(|a, b| b.cmp(a));
+    let mut total = 0u64;
+    let mut k = 0;
+    for e in largest.iter().take(jobs) {
+        total = total.saturating_add(*e);
+        if total > budget {
+            break;
+        }
+        k += 1;
+    }
+    k.max(1)
 }
 
 /// Takes `dir` for a sweep: creates it, or accepts one that is empty or
@@ -107,6 +139,21 @@ pub fn check_metric(plan: &Plan, metric: &str) -> Result<()> {
 /// then writes the table and charts. A run that fails is a row with its
 /// reason; only a folder that cannot be used ends the sweep.
 pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written> {
+    // A run that alone exceeds --max-memory: refused before anything is written.
+    if let (Some(b), Some(big)) = (
+        opts.max_memory,
+        plan.runs.iter().max_by_key(|r| r.memory_bytes),
+    ) {
+        if big.memory_bytes > b {
+            return Err(Error::Scene(SceneError::Sweep {
+                arg: format!("run {} and --max-memory {b}", big.id),
+                message: format!(
+                    "the run alone needs about {:.1} MiB, more than --max-memory",
+                    mib(big.memory_bytes)
+                ),
+            }));
+        }
+    }
     prepare(dir)?;
     plan.write(dir)?;
     let choice = plan.backend_choice();
@@ -119,9 +166,35 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
             .iter()
             .any(|a| !a.is_software()),
     };
+    // Runs at once: what --jobs asks, as far as the memory allows.
+    let estimates: Vec<u64> = plan.runs.iter().map(|r| r.memory_bytes).collect();
+    let budget = opts.max_memory.or_else(crate::preflight::memory_available);
+    let jobs = if on_gpu { 1 } else { opts.jobs.max(1) };
+    let at_once = concurrent_runs(&estimates, budget, jobs);
+    if at_once < jobs.min(plan.runs.len()) {
+        crate::say!(
+            "sweep: running {at_once} at once, not {jobs}: the {} largest runs need about {:.1} \
+             MiB together, more than the {:.1} MiB {}",
+            at_once + 1,
+            {
+                let mut e = estimates.clone();
+                e.sort_unstable_by(|a, b| b.cmp(a));
+                mib(e.iter().take(at_once + 1).sum::<u64>())
+            },
+            mib(budget.unwrap_or(0)),
+            if opts.max_memory.is_some() {
+                "of --max-memory"
+            } else {
+                "available (MemAvailable; --max-memory sets it)"
+            }
+        );
+    }
+    for r in &plan.runs {
+        entry::Entry::of(plan, r).write(&dir.join("runs").join(&r.id))?;
+    }
     let bar = runner::progress_bar(plan.runs.len(), opts.progress);
     let opts_lines = opts.progress_lines;
-    let split = runner::Split::new(if on_gpu { 1 } else { opts.jobs.max(1) }, plan.runs.len());
+    let split = runner::Split::new(at_once, plan.runs.len());
     let done = std::sync::atomic::AtomicUsize::new(0);
     let outcomes = runner::run_parallel(
         &plan.runs,
@@ -145,7 +218,10 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
                 progress: false,
                 progress_lines: false,
                 verbose: false,
-                limits: Default::default(),
+                limits: crate::preflight::Limits {
+                    max_memory: opts.max_memory,
+                    ..Default::default()
+                },
                 stop: opts.stop.clone(),
             };
             let result = crate::run::run(&scene, &opts);
@@ -158,7 +234,7 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
                     },
                     Err(e) => format!("failed: {e}"),
                 };
-                eprintln!("sweep: {k}/{} runs done; {} {how}", plan.runs.len(), r.id);
+                crate::say!("sweep: {k}/{} runs done; {} {how}", plan.runs.len(), r.id);
             }
             result.map(|_| ()).map_err(|e| e.to_string())
         },
@@ -181,12 +257,28 @@ pub fn run_local(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Written
 /// Writes `file`: one self-contained shell line per run of `plan`, whose
 /// output goes to `dir/runs/ID`; and `dir/sweep-plan.json`, which
 /// `collect` reads. Runs nothing. Returns the number of lines.
+/// A folder that holds another plan is refused (exit 2): its runs would
+/// be tabled as this plan's. The same plan again is fine.
 pub fn emit(plan: &Plan, dir: &Path, file: &Path, exe: &str) -> Result<usize> {
     prepare(dir)?;
     let dir = dir
         .canonicalize()
         .map_err(|e| Error::io("cannot resolve", dir, e))?;
+    if dir.join(plan::PLAN_FILE).is_file() {
+        let same = Plan::read(&dir).is_ok_and(|old| old.same_runs(plan));
+        if !same {
+            return Err(Error::Folder(format!(
+                "{} holds another sweep's plan ({}): its run folders would be collected as \
+                 this sweep's; give a new --out, or remove the folder first",
+                dir.display(),
+                plan::PLAN_FILE
+            )));
+        }
+    }
     plan.write(&dir)?;
+    for r in &plan.runs {
+        entry::Entry::of(plan, r).write(&dir.join("runs").join(&r.id))?;
+    }
     let lines = plan.shell_lines(exe, &dir);
     let mut text = lines.join("\n");
     text.push('\n');

@@ -110,6 +110,11 @@ pub struct PlannedRun {
     pub id: String,
     /// This run's value of each axis, in axis order.
     pub values: Vec<String>,
+    /// Its peak memory as the preflight estimates it (bytes; 0 in plans
+    /// written before it was kept): what `run_local` sums over the runs
+    /// it runs at once.
+    #[serde(default)]
+    pub memory_bytes: u64,
 }
 
 /// A whole sweep, as written to `sweep-plan.json`.
@@ -223,13 +228,16 @@ impl Plan {
                 arg: format!("run {id} ({})", described()),
                 message: e.to_string(),
             })?;
-            crate::preflight::plan(&s, &limits, rayon::current_num_threads()).map_err(|e| {
-                SceneError::Sweep {
+            let checked = crate::preflight::plan(&s, &limits, rayon::current_num_threads())
+                .map_err(|e| SceneError::Sweep {
                     arg: format!("run {id} ({})", described()),
                     message: e.to_string(),
-                }
-            })?;
-            planned.push(PlannedRun { id, values });
+                })?;
+            planned.push(PlannedRun {
+                id,
+                values,
+                memory_bytes: checked.estimate.memory_bytes.round() as u64,
+            });
         }
         Ok(Plan {
             scene: scene_file,
@@ -318,6 +326,22 @@ impl Plan {
         })?;
         serde_json::from_str(&text)
             .map_err(|e| crate::Error::Folder(format!("{}: not a sweep plan: {e}", p.display())))
+    }
+
+    /// Whether `other` plans the same runs (the memory estimates aside,
+    /// which depend on the machine that planned).
+    pub fn same_runs(&self, other: &Plan) -> bool {
+        let ids = |p: &Plan| -> Vec<(String, Vec<String>)> {
+            p.runs
+                .iter()
+                .map(|r| (r.id.clone(), r.values.clone()))
+                .collect()
+        };
+        self.scene == other.scene
+            && self.sets == other.sets
+            && self.axes == other.axes
+            && self.backend == other.backend
+            && ids(self) == ids(other)
     }
 
     /// Writes `DIR/sweep-plan.json`.

@@ -113,7 +113,7 @@ impl Record {
             Outcome::Completed => "completed".into(),
             Outcome::Unstable => format!(
                 "unstable at {} s ({})",
-                self.t.map_or("?".into(), crate::sweep::report::sig),
+                self.t.map_or("?".into(), crate::sweep::number::sig),
                 if self.reason_code.is_empty() {
                     &self.reason
                 } else {
@@ -122,7 +122,7 @@ impl Record {
             ),
             Outcome::Interrupted => format!(
                 "interrupted at {} s",
-                self.t.map_or("?".into(), crate::sweep::report::sig)
+                self.t.map_or("?".into(), crate::sweep::number::sig)
             ),
             o => format!("{}: {}", o.as_str(), self.reason),
         }

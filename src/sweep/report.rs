@@ -10,19 +10,7 @@ use crate::error::Result;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// Three significant digits.
-pub fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32;
-    if (-3..4).contains(&e) {
-        let decimals = (2 - e).max(0) as usize;
-        format!("{v:.decimals$}")
-    } else {
-        format!("{v:.2e}")
-    }
-}
+pub use super::number::sig;
 
 /// A markdown table.
 pub fn table(header: &[String], rows: &[Vec<String>]) -> String {

@@ -25,6 +25,28 @@ pub enum ContactState {
     Slip(f64),
 }
 
+/// A state as one byte, for checkpoints: 0 open, 1 stick, 2 slip along
+/// +t, 3 slip along −t.
+pub fn code(state: ContactState) -> u8 {
+    match state {
+        ContactState::Open => 0,
+        ContactState::Stick => 1,
+        ContactState::Slip(s) if s >= 0.0 => 2,
+        ContactState::Slip(_) => 3,
+    }
+}
+
+/// The state of `code` (None for a byte no state has).
+pub fn from_code(code: u8) -> Option<ContactState> {
+    match code {
+        0 => Some(ContactState::Open),
+        1 => Some(ContactState::Stick),
+        2 => Some(ContactState::Slip(1.0)),
+        3 => Some(ContactState::Slip(-1.0)),
+        _ => None,
+    }
+}
+
 /// A node behind a wall, with mass: one contact of the step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ContactPair {
@@ -202,6 +224,15 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn states_round_trip_through_their_codes() {
+        use ContactState::*;
+        for s in [Open, Stick, Slip(1.0), Slip(-1.0)] {
+            assert_eq!(from_code(code(s)), Some(s));
+        }
+        assert_eq!(from_code(4), None);
     }
 
     #[test]

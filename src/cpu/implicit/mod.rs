@@ -28,7 +28,7 @@ pub mod contact;
 
 use crate::backend::{Backend, Halt, NewtonSample, NewtonStats, Sample, State, stop_requested};
 use crate::cpu::{ShapeCache, shape_eval};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::increment::StepState;
 use crate::model::walls::CONTACT_STICK;
@@ -871,8 +871,31 @@ impl Backend for ImplicitBackend {
         Some(&self.stats)
     }
 
+    fn held_contacts(&self) -> Vec<u8> {
+        self.node_states.iter().map(|&s| contact::code(s)).collect()
+    }
+
     fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
         crate::backend::check_state(&self.model, state)?;
+        // The contact states the next step starts from (none saved: a run
+        // from before they were kept, or an explicit run's state).
+        let held = if state.held_contacts.is_empty() {
+            vec![ContactState::Stick; self.node_states.len()]
+        } else if state.held_contacts.len() == self.node_states.len() {
+            state
+                .held_contacts
+                .iter()
+                .map(|&c| contact::from_code(c))
+                .collect::<Option<Vec<_>>>()
+                .ok_or_else(|| Error::Checkpoint("holds an unknown contact state".into()))?
+        } else {
+            return Err(Error::Checkpoint(format!(
+                "holds {} wall contact states, the model has {} (nodes x walls)",
+                state.held_contacts.len(),
+                self.node_states.len()
+            )));
+        };
+        self.node_states = held;
         self.model.particles = state.particles.clone();
         self.t = state.t;
         self.dt = state.dt;

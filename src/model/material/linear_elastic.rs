@@ -4,6 +4,25 @@
 //! this is a hypoelastic law (logarithmic strain under uniaxial load).
 //! WGSL twin: `shaders/shared/material_linear_elastic.wgsl`.
 
+use super::registry::{Constitutive, Key, Keys, StateKind};
+use super::{DefGrad, PlasticState};
+use crate::error::SceneError;
+use crate::model::fault::FaultKind;
+
+/// The keys of the models with E and ν alone.
+pub const ELASTIC_KEYS: &[Key] = &[
+    Key {
+        name: "E",
+        unit: "Pa",
+        doc: "Young's modulus, > 0",
+    },
+    Key {
+        name: "nu",
+        unit: "1",
+        doc: "Poisson's ratio, in (-1, 0.5)",
+    },
+];
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearElastic {
     /// Young's modulus E (Pa).
@@ -56,6 +75,58 @@ impl LinearElastic {
         let eyy = ((1.0 - nu * nu) * s[1] - nu * (1.0 + nu) * s[0]) / e;
         let exy = s[2] / (2.0 * self.shear);
         0.5 * (s[0] * exx + s[1] * eyy + 2.0 * s[2] * exy)
+    }
+}
+
+impl Constitutive for LinearElastic {
+    const NAME: &'static str = "linear_elastic";
+    const KEYS: &'static [Key] = ELASTIC_KEYS;
+    const STATE: StateKind = StateKind::Stress;
+    const GPU_PARAMS: &'static [&'static str] = &[];
+
+    fn from_keys(k: &Keys) -> Result<Self, SceneError> {
+        let (e, nu) = k.youngs_nu()?;
+        Ok(LinearElastic::new(e, nu, k.density()))
+    }
+    fn density(&self) -> f64 {
+        self.density
+    }
+    fn lame_shear(&self) -> (f64, f64) {
+        (self.lame, self.shear)
+    }
+    fn youngs_nu(&self) -> (f64, f64) {
+        (self.youngs, self.nu)
+    }
+    #[inline]
+    fn update(
+        &self,
+        l: [f64; 4],
+        dt: f64,
+        stress: &mut [f64; 3],
+        _f: &mut DefGrad,
+        _q: &mut PlasticState,
+    ) -> Result<f64, FaultKind> {
+        let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
+        let j = 1.0 + de[0] + de[1];
+        if j.is_nan() {
+            return Err(FaultKind::NonFinite { field: "strain" });
+        }
+        if j <= 0.0 {
+            return Err(FaultKind::NonPositiveDensity);
+        }
+        self.update_stress(stress, de);
+        Ok(j)
+    }
+    #[inline]
+    fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+        LinearElastic::wave_speed(self, rho)
+    }
+    #[inline]
+    fn strain_energy_density(&self, stress: &[f64; 3], _f: &DefGrad, _q: &PlasticState) -> f64 {
+        LinearElastic::strain_energy_density(self, stress)
+    }
+    fn gpu_params(&self) -> Vec<f32> {
+        Vec::new()
     }
 }
 

@@ -1,187 +1,173 @@
-//! Materials: one enum, one `update`. Each model in its own file with a
-//! WGSL twin in `shaders/shared/material_*.wgsl`. A model stores only the
-//! per-particle state it needs (linear elastic: the stress alone;
-//! Neo-Hookean: the deformation gradient too; Mohr–Coulomb and
-//! Drucker–Prager: σzz and the plastic strains, `plastic::PlasticState`).
+//! Materials: the registry. Each model is its own file (a type that
+//! implements `registry::Constitutive`: scene keys, state, update, GPU
+//! parameters), its WGSL twin `shaders/shared/material_<name>.wgsl`, and
+//! one line of `register!` below, from which the `Material` enum, its
+//! dispatch, the scene's model names and the GPU dispatch
+//! (`registry::wgsl`) follow. A model stores only the per-particle state it
+//! needs (linear elastic: the stress alone; Neo-Hookean: the deformation
+//! gradient too; the plastic models: a `plastic::PlasticState`).
 
-pub mod drucker_prager;
 pub mod increment;
-pub mod linear_elastic;
-pub mod mohr_coulomb;
-pub mod neo_hookean;
 pub mod plastic;
+pub mod registry;
 
-pub use drucker_prager::DruckerPrager;
-pub use linear_elastic::LinearElastic;
-pub use mohr_coulomb::MohrCoulomb;
-pub use neo_hookean::{DefGrad, NeoHookean};
+pub use neo_hookean::DefGrad;
 pub use plastic::PlasticState;
+pub use registry::{Constitutive, Entry, Key, Keys, StateKind};
 
+use crate::error::SceneError;
 use crate::model::fault::FaultKind;
-use crate::scene::{MaterialModel, MaterialSpec};
+use crate::scene::{MaterialSpec, SceneFile};
 
-#[derive(Debug, Clone, PartialEq)]
-pub enum Material {
-    LinearElastic(LinearElastic),
-    NeoHookean(NeoHookean),
-    MohrCoulomb(MohrCoulomb),
-    DruckerPrager(DruckerPrager),
+/// Declares the registered models: for each, its module (its Rust file),
+/// the `Material` variant and the type implementing `Constitutive`. Its
+/// code (GPU `MODEL_*`) is its place in the list.
+macro_rules! register {
+    ($($variant:ident($module:ident::$ty:ident)),* $(,)?) => {
+        $(pub mod $module; pub use $module::$ty;)*
+
+        /// A material of the scene: one registered model.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum Material {
+            $($variant($ty),)*
+        }
+
+        /// Every registered model; `code` is its place in the list.
+        pub fn registry() -> Vec<Entry> {
+            [$(Entry {
+                name: <$ty as Constitutive>::NAME,
+                code: 0,
+                state: <$ty as Constitutive>::STATE,
+                gpu_params: <$ty as Constitutive>::GPU_PARAMS,
+                keys: <$ty as Constitutive>::KEYS,
+            }),*]
+            .into_iter()
+            .enumerate()
+            .map(|(i, e)| Entry { code: i as u32, ..e })
+            .collect()
+        }
+
+        impl Material {
+            /// Builds material `name` of the scene from its keys, each
+            /// checked; unknown models and keys are refused, naming them.
+            pub fn from_spec(name: &str, spec: &MaterialSpec) -> Result<Material, SceneError> {
+                $(if spec.model == <$ty as Constitutive>::NAME {
+                    let k = Keys::new(name, spec, <$ty as Constitutive>::KEYS);
+                    let m = <$ty as Constitutive>::from_keys(&k)?;
+                    k.finish()?;
+                    return Ok(Material::$variant(m));
+                })*
+                let known: Vec<String> =
+                    registry().iter().map(|e| format!("\"{}\"", e.name)).collect();
+                Err(SceneError::invalid(
+                    format!("materials.{name}.model"),
+                    format!("unknown model \"{}\"; the models are {}", spec.model, known.join(", ")),
+                ))
+            }
+
+            /// The registry entry of this material's model.
+            pub fn entry(&self) -> Entry {
+                let name = match self {
+                    $(Material::$variant(_) => <$ty as Constitutive>::NAME,)*
+                };
+                registry()
+                    .into_iter()
+                    .find(|e| e.name == name)
+                    .expect("a registered model")
+            }
+
+            /// Initial density ρ0 (kg/m³).
+            pub fn density(&self) -> f64 {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::density(m),)* }
+            }
+
+            /// Lamé λ and shear modulus μ (Pa), at the initial state.
+            pub fn lame_shear(&self) -> (f64, f64) {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::lame_shear(m),)* }
+            }
+
+            /// Young's modulus E (Pa) and Poisson's ratio ν, at the initial state.
+            pub fn youngs_nu(&self) -> (f64, f64) {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::youngs_nu(m),)* }
+            }
+
+            /// One step of the constitutive update from the velocity
+            /// gradient `l` = [∂vx/∂x, ∂vx/∂y, ∂vy/∂x, ∂vy/∂y] (1/s) over
+            /// `dt` (s): updates the stress (and F, or the plastic state
+            /// `q`), and returns the volume ratio V_new / V_old. Models
+            /// ignore the state they do not keep.
+            #[inline]
+            pub fn update(
+                &self,
+                l: [f64; 4],
+                dt: f64,
+                stress: &mut [f64; 3],
+                f: &mut DefGrad,
+                q: &mut PlasticState,
+            ) -> Result<f64, FaultKind> {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::update(m, l, dt, stress, f, q),)* }
+            }
+
+            /// Speed of the fastest wave at density `rho` (m/s) and the
+            /// particle's state, for the CFL condition.
+            #[inline]
+            pub fn wave_speed(&self, rho: f64, stress: &[f64; 3], q: &PlasticState) -> f64 {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::wave_speed(m, rho, stress, q),)* }
+            }
+
+            /// Stored elastic energy per unit current volume (J/m³).
+            #[inline]
+            pub fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64 {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::strain_energy_density(m, stress, f, q),)* }
+            }
+
+            /// The stress (Pa) and plastic state a particle starts with.
+            pub fn initial_state(&self) -> ([f64; 3], PlasticState) {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::initial_state(m),)* }
+            }
+
+            /// The GPU parameters (`GpuMaterial::p`), in the entry's order.
+            pub fn gpu_params(&self) -> Vec<f32> {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::gpu_params(m),)* }
+            }
+        }
+    };
+}
+
+register! {
+    LinearElastic(linear_elastic::LinearElastic),
+    NeoHookean(neo_hookean::NeoHookean),
+    MohrCoulomb(mohr_coulomb::MohrCoulomb),
+    DruckerPrager(drucker_prager::DruckerPrager),
+    ModifiedCamClay(modified_cam_clay::ModifiedCamClay),
 }
 
 impl Material {
-    pub fn new(spec: &MaterialSpec) -> Material {
-        let (e, nu, rho) = (spec.youngs_modulus, spec.nu, spec.density);
-        match spec.model {
-            MaterialModel::LinearElastic => Material::LinearElastic(LinearElastic::new(e, nu, rho)),
-            MaterialModel::NeoHookean => Material::NeoHookean(NeoHookean::new(e, nu, rho)),
-            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
-                // Validation has made the two required keys present.
-                let c = spec.cohesion.unwrap_or(0.0);
-                let phi = spec.friction_angle.unwrap_or(0.0);
-                let psi = spec.dilation_angle.unwrap_or(0.0);
-                if spec.model == MaterialModel::MohrCoulomb {
-                    Material::MohrCoulomb(MohrCoulomb::new(
-                        e,
-                        nu,
-                        rho,
-                        c,
-                        phi,
-                        psi,
-                        spec.tension_cutoff,
-                    ))
-                } else {
-                    Material::DruckerPrager(DruckerPrager::new(
-                        e,
-                        nu,
-                        rho,
-                        c,
-                        phi,
-                        psi,
-                        spec.tension_cutoff,
-                    ))
-                }
-            }
-        }
-    }
-
-    /// Initial density ρ0 (kg/m³).
-    pub fn density(&self) -> f64 {
-        match self {
-            Material::LinearElastic(m) => m.density,
-            Material::NeoHookean(m) => m.density,
-            Material::MohrCoulomb(m) => m.density,
-            Material::DruckerPrager(m) => m.density,
-        }
-    }
-
-    /// Lamé λ and shear modulus μ (Pa).
-    pub fn lame_shear(&self) -> (f64, f64) {
-        match self {
-            Material::LinearElastic(m) => (m.lame, m.shear),
-            Material::NeoHookean(m) => (m.lame, m.shear),
-            Material::MohrCoulomb(m) => (m.elastic.lame, m.elastic.shear),
-            Material::DruckerPrager(m) => (m.elastic.lame, m.elastic.shear),
-        }
-    }
-
-    /// Young's modulus E (Pa) and Poisson's ratio ν.
-    pub fn youngs_nu(&self) -> (f64, f64) {
-        match self {
-            Material::LinearElastic(m) => (m.youngs, m.nu),
-            Material::NeoHookean(m) => (m.youngs, m.nu),
-            Material::MohrCoulomb(m) => (m.youngs, m.nu),
-            Material::DruckerPrager(m) => (m.youngs, m.nu),
-        }
-    }
-
     /// The model keeps a deformation gradient per particle.
     pub fn needs_deformation_gradient(&self) -> bool {
-        matches!(self, Material::NeoHookean(_))
+        self.entry().state == StateKind::DefGrad
     }
 
-    /// The model keeps a `PlasticState` (σzz, plastic strains) per particle.
+    /// The model keeps a `PlasticState` per particle.
     pub fn needs_plastic_state(&self) -> bool {
-        matches!(self, Material::MohrCoulomb(_) | Material::DruckerPrager(_))
+        self.entry().state == StateKind::Plastic
     }
+}
 
-    /// One step of the constitutive update from the velocity gradient
-    /// `l` = [∂vx/∂x, ∂vx/∂y, ∂vy/∂x, ∂vy/∂y] (1/s) over `dt` (s): updates the
-    /// stress (and F, or the plastic state `q`), and returns the volume
-    /// ratio V_new / V_old. Models ignore the state they do not keep.
-    #[inline]
-    pub fn update(
-        &self,
-        l: [f64; 4],
-        dt: f64,
-        stress: &mut [f64; 3],
-        f: &mut DefGrad,
-        q: &mut PlasticState,
-    ) -> Result<f64, FaultKind> {
-        match self {
-            Material::MohrCoulomb(m) => m.update(l, dt, stress, q),
-            Material::DruckerPrager(m) => m.update(l, dt, stress, q),
-            Material::LinearElastic(m) => {
-                let de = [dt * l[0], dt * l[3], 0.5 * dt * (l[1] + l[2])];
-                let j = 1.0 + de[0] + de[1];
-                if j.is_nan() {
-                    return Err(FaultKind::NonFinite { field: "strain" });
-                }
-                if j <= 0.0 {
-                    return Err(FaultKind::NonPositiveDensity);
-                }
-                m.update_stress(stress, de);
-                Ok(j)
-            }
-            Material::NeoHookean(m) => {
-                // F ← (I + Δt L) F.
-                let g = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
-                let nf = [
-                    g[0] * f[0] + g[1] * f[2],
-                    g[0] * f[1] + g[1] * f[3],
-                    g[2] * f[0] + g[3] * f[2],
-                    g[2] * f[1] + g[3] * f[3],
-                ];
-                let j_old = f[0] * f[3] - f[1] * f[2];
-                let j_new = nf[0] * nf[3] - nf[1] * nf[2];
-                if j_new.is_nan() {
-                    return Err(FaultKind::NonFinite {
-                        field: "deformation gradient",
-                    });
-                }
-                let s = m.cauchy(&nf).ok_or(FaultKind::NonPositiveDensity)?;
-                *f = nf;
-                *stress = s;
-                Ok(j_new / j_old)
-            }
-        }
-    }
+/// The generated WGSL of the material interface for `materials`' models
+/// (`registry::wgsl`), as `generated/materials.wgsl`.
+pub fn wgsl_of(materials: &[Material]) -> String {
+    let used = materials.iter().fold(0, |b, m| b | 1 << m.entry().code);
+    registry::wgsl(&registry(), used)
+}
 
-    /// Speed of the fastest wave at density `rho` (m/s), for the CFL condition.
-    #[inline]
-    pub fn wave_speed(&self, rho: f64) -> f64 {
-        match self {
-            Material::LinearElastic(m) => m.wave_speed(rho),
-            Material::NeoHookean(m) => m.wave_speed(rho),
-            // The elastic P-wave speed bounds the elastoplastic one.
-            Material::MohrCoulomb(m) => ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt(),
-            Material::DruckerPrager(m) => ((m.elastic.lame + 2.0 * m.elastic.shear) / rho).sqrt(),
-        }
-    }
-
-    /// Stored elastic energy per unit current volume (J/m³), from the
-    /// stress (linear elastic), the deformation gradient (Neo-Hookean), or
-    /// for the plastic models the elastic part: ½ σ : C : σ on the current
-    /// stress with its σzz (`q`).
-    #[inline]
-    pub fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64 {
-        let s4 = [stress[0], stress[1], q[plastic::SZZ], stress[2]];
-        match self {
-            Material::LinearElastic(m) => m.strain_energy_density(stress),
-            Material::NeoHookean(m) => m.energy_density(f),
-            Material::MohrCoulomb(m) => m.elastic.energy(s4),
-            Material::DruckerPrager(m) => m.elastic.energy(s4),
-        }
-    }
+/// Every material of `file`, built and checked (the scene's model keys;
+/// `scene::validate` checks the rest of the scene without the model).
+pub fn check(file: &SceneFile) -> Result<Vec<Material>, SceneError> {
+    file.materials
+        .iter()
+        .map(|(name, spec)| Material::from_spec(name, spec))
+        .collect()
 }
 
 #[cfg(test)]
@@ -225,17 +211,14 @@ mod tests {
         peak
     }
 
-    fn spec(model: MaterialModel, psi: f64) -> MaterialSpec {
-        MaterialSpec {
-            model,
-            density: 1800.0,
-            youngs_modulus: 2.0e7,
-            nu: 0.3,
-            cohesion: Some(1.0e4),
-            friction_angle: Some(30.0),
-            dilation_angle: Some(psi),
-            tension_cutoff: None,
-        }
+    fn material(model: &str, psi: f64) -> Material {
+        let spec = MaterialSpec::new(model, 1800.0)
+            .with("E", 2.0e7)
+            .with("nu", 0.3)
+            .with("cohesion", 1.0e4)
+            .with("friction_angle", 30.0)
+            .with("dilation_angle", psi);
+        Material::from_spec("m", &spec).unwrap()
     }
 
     /// Mohr–Coulomb's plane-strain peak: (σ1 − σ3) = 2c cos φ + (σ1 + σ3) sin φ
@@ -253,7 +236,7 @@ mod tests {
         for sigma_c in [5.0e4, 2.0e5] {
             let want = mc_peak(1.0e4, 30.0, sigma_c);
             for psi in [0.0, 15.0] {
-                let m = Material::new(&spec(MaterialModel::MohrCoulomb, psi));
+                let m = material("mohr_coulomb", psi);
                 // Δεyy = 1e-5 per step to 4 % axial strain.
                 let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
                 let err = (got - want) / want;
@@ -273,12 +256,12 @@ mod tests {
         // at collapse) stays below it.
         let sigma_c = 1.0e5;
         let want = mc_peak(1.0e4, 30.0, sigma_c);
-        let m = Material::new(&spec(MaterialModel::DruckerPrager, 30.0));
+        let m = material("drucker_prager", 30.0);
         let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
         let err = (got - want) / want;
         println!("DP ψ = φ: peak {got:.2} vs MC {want:.2} ({err:+.2e})");
         assert!(err.abs() < PEAK_REL, "{got} vs {want}");
-        let m = Material::new(&spec(MaterialModel::DruckerPrager, 0.0));
+        let m = material("drucker_prager", 0.0);
         let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
         println!("DP ψ = 0: peak {got:.2} vs MC {want:.2}");
         assert!(got < want, "{got} vs {want}");

@@ -3,6 +3,11 @@
 //! J = det F. F is updated each step as F ← (I + Δt L) F (eq. 35).
 //! WGSL twin: `shaders/shared/material_neo_hookean.wgsl`.
 
+use super::PlasticState;
+use super::registry::{Constitutive, Key, Keys, StateKind};
+use crate::error::SceneError;
+use crate::model::fault::FaultKind;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct NeoHookean {
     /// Young's modulus E (Pa), for the wave speed.
@@ -64,6 +69,67 @@ impl NeoHookean {
         let tr_c = f.iter().map(|x| x * x).sum::<f64>() + 1.0;
         let lj = j.ln();
         (0.5 * self.shear * (tr_c - 3.0) - self.shear * lj + 0.5 * self.lame * lj * lj) / j
+    }
+}
+
+impl Constitutive for NeoHookean {
+    const NAME: &'static str = "neo_hookean";
+    const KEYS: &'static [Key] = super::linear_elastic::ELASTIC_KEYS;
+    const STATE: StateKind = StateKind::DefGrad;
+    const GPU_PARAMS: &'static [&'static str] = &[];
+
+    fn from_keys(k: &Keys) -> Result<Self, SceneError> {
+        let (e, nu) = k.youngs_nu()?;
+        Ok(NeoHookean::new(e, nu, k.density()))
+    }
+    fn density(&self) -> f64 {
+        self.density
+    }
+    fn lame_shear(&self) -> (f64, f64) {
+        (self.lame, self.shear)
+    }
+    fn youngs_nu(&self) -> (f64, f64) {
+        (self.youngs, self.nu)
+    }
+    /// F ← (I + Δt L) F, σ = σ(F).
+    #[inline]
+    fn update(
+        &self,
+        l: [f64; 4],
+        dt: f64,
+        stress: &mut [f64; 3],
+        f: &mut DefGrad,
+        _q: &mut PlasticState,
+    ) -> Result<f64, FaultKind> {
+        let g = [1.0 + dt * l[0], dt * l[1], dt * l[2], 1.0 + dt * l[3]];
+        let nf = [
+            g[0] * f[0] + g[1] * f[2],
+            g[0] * f[1] + g[1] * f[3],
+            g[2] * f[0] + g[3] * f[2],
+            g[2] * f[1] + g[3] * f[3],
+        ];
+        let j_old = f[0] * f[3] - f[1] * f[2];
+        let j_new = nf[0] * nf[3] - nf[1] * nf[2];
+        if j_new.is_nan() {
+            return Err(FaultKind::NonFinite {
+                field: "deformation gradient",
+            });
+        }
+        let s = self.cauchy(&nf).ok_or(FaultKind::NonPositiveDensity)?;
+        *f = nf;
+        *stress = s;
+        Ok(j_new / j_old)
+    }
+    #[inline]
+    fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+        NeoHookean::wave_speed(self, rho)
+    }
+    #[inline]
+    fn strain_energy_density(&self, _s: &[f64; 3], f: &DefGrad, _q: &PlasticState) -> f64 {
+        self.energy_density(f)
+    }
+    fn gpu_params(&self) -> Vec<f32> {
+        Vec::new()
     }
 }
 

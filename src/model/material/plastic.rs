@@ -139,6 +139,91 @@ pub fn record(q: &mut PlasticState, e: &Elastic3, trial: [f64; 4], s: [f64; 4], 
     q[RETURN] = active as f64;
 }
 
+/// The keys of the elastic-perfectly plastic models (Mohr–Coulomb,
+/// Drucker–Prager): E and ν, then the yield keys.
+pub const YIELD_KEYS: &[super::Key] = &[
+    super::Key {
+        name: "E",
+        unit: "Pa",
+        doc: "Young's modulus, > 0",
+    },
+    super::Key {
+        name: "nu",
+        unit: "1",
+        doc: "Poisson's ratio, in (-1, 0.5)",
+    },
+    super::Key {
+        name: "cohesion",
+        unit: "Pa",
+        doc: "cohesion c, ≥ 0; required",
+    },
+    super::Key {
+        name: "friction_angle",
+        unit: "degrees",
+        doc: "friction angle φ, in [0, 90); required",
+    },
+    super::Key {
+        name: "dilation_angle",
+        unit: "degrees",
+        doc: "dilation angle ψ, in [0, φ]; default 0",
+    },
+    super::Key {
+        name: "tension_cutoff",
+        unit: "Pa",
+        doc: "tension cutoff t, in [0, c / tan φ]; default the apex",
+    },
+];
+
+/// The yield keys read and checked: (c (Pa), φ (degrees), ψ (degrees),
+/// tension cutoff (Pa) if given).
+pub fn yield_keys(
+    k: &super::Keys,
+) -> Result<(f64, f64, f64, Option<f64>), crate::error::SceneError> {
+    let c = k.required("cohesion")?;
+    let c = k.within("cohesion", c, 0.0, f64::INFINITY, false, "≥ 0 Pa")?;
+    let phi = k.required("friction_angle")?;
+    let phi = k.within(
+        "friction_angle",
+        phi,
+        0.0,
+        90.0,
+        false,
+        "in [0, 90) degrees",
+    )?;
+    let psi = match k.optional("dilation_angle")? {
+        Some(psi) => k.within(
+            "dilation_angle",
+            psi,
+            0.0,
+            phi,
+            true,
+            &format!("in [0, friction_angle = {phi}] degrees"),
+        )?,
+        None => 0.0,
+    };
+    let t = match k.optional("tension_cutoff")? {
+        Some(t) => {
+            let t = k.within("tension_cutoff", t, 0.0, f64::INFINITY, false, "≥ 0 Pa")?;
+            if phi > 0.0 {
+                let apex = c / phi.to_radians().tan();
+                // A value written from a hand-computed apex may round a few
+                // ulps above it; the material clamps t to the apex.
+                if t > apex * (1.0 + 1e-9) {
+                    return Err(k.invalid(
+                        "tension_cutoff",
+                        format!(
+                            "must not exceed the apex c / tan(friction_angle) = {apex} Pa, got {t}"
+                        ),
+                    ));
+                }
+            }
+            Some(t)
+        }
+        None => None,
+    };
+    Ok((c, phi, psi, t))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,400 @@
+//! The step plan: which stages run for a scene, in what order, which of
+//! them fuse into one pass over the particles, and which GPU passes do each
+//! (`StepPlan`), built once from the model and read by both backends and
+//! the driver. Nothing else decides it: the CPU backend runs `StepPlan::cpu`,
+//! the GPU backend records `StepPlan::gpu_step` and builds the pipelines of
+//! `StepPlan::gpu_uses`.
+//!
+//! The stage list is the paper's Algorithm 1 (`STEP`; FE and NPC share it
+//! and differ in parameters only: NPC predicts with (1 − γ)Δt a_p in `p2g`
+//! and corrects with γΔt f/m, FE has no acceleration term and corrects with
+//! Δt f/m); MUSL (the B-spline paper's update) orders the stages
+//! differently, `STEP_MUSL`: forces from the stress at the step's start,
+//! the particle update, a remap of the new velocities to the nodes, and the
+//! stress last.
+
+use crate::model::shape::Shape;
+use crate::model::{Integrator, Model};
+
+/// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
+/// WGSL twin `shaders/<name>.wgsl` of the same name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Δt from the Courant condition (eq. 43).
+    Cfl,
+    /// Zero nodal accumulators.
+    ClearGrid,
+    /// N, ∇N at every particle (LME: Newton on λ).
+    ShapeEval,
+    /// Scatter mass and (predicted) momentum.
+    P2g,
+    /// Nodal velocities and Dirichlet conditions.
+    GridPredict,
+    /// Strain increment, density and stress.
+    Stress,
+    /// Internal and external nodal forces.
+    Forces,
+    /// Reactions, fixed components, corrector.
+    GridCorrect,
+    /// Particle update.
+    G2p,
+    /// MUSL: the updated particle velocities mapped back to the nodes with
+    /// the step's start weights (by MLS with `solver.mls`, eqs. 31–33),
+    /// then the nodal velocities and Dirichlet conditions as in `GridPredict`.
+    Remap,
+}
+
+/// The stages of one step, in order.
+pub const STEP: &[Stage] = &[
+    Stage::Cfl,
+    Stage::ClearGrid,
+    Stage::ShapeEval,
+    Stage::P2g,
+    Stage::GridPredict,
+    Stage::Stress,
+    Stage::Forces,
+    Stage::GridCorrect,
+    Stage::G2p,
+];
+
+/// The stages of one MUSL step (B-spline paper eqs. 18–37), in order:
+/// projection at t (18–25), forces from σ^t, nodal momentum update (28),
+/// FLIP velocity and position (29–30), remap (31–33), and the velocity
+/// gradient, F, density and stress from the remapped velocity (34–37).
+pub const STEP_MUSL: &[Stage] = &[
+    Stage::Cfl,
+    Stage::ClearGrid,
+    Stage::ShapeEval,
+    Stage::P2g,
+    Stage::GridPredict,
+    Stage::Forces,
+    Stage::GridCorrect,
+    Stage::G2p,
+    Stage::Remap,
+    Stage::Stress,
+];
+
+/// The stage list of `integrator`.
+pub fn stages(integrator: Integrator) -> &'static [Stage] {
+    match integrator {
+        Integrator::Musl => STEP_MUSL,
+        _ => STEP,
+    }
+}
+
+/// One piece of a CPU step: a stage alone, or two consecutive stages done
+/// in one pass over the particles (the same numbers as the two one by one:
+/// `tests/fused_step.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CpuWork {
+    Stage(Stage),
+    /// `shape_eval` then `p2g` (`cpu::shape_eval::shape_eval_p2g`).
+    ShapeEvalP2g,
+    /// `stress` then `forces` (`cpu::stress::stress_forces`).
+    StressForces,
+}
+
+/// One GPU pass: a WGSL file (under `shaders/`) and entry point `main`,
+/// built with the scene's flags and the pass's own (`gpu::pipelines`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Pass {
+    Cfl,
+    StepBegin,
+    ClearGrid,
+    LmeNewton,
+    /// Particles binned by cell (shared/bins.wgsl): for MLS in `p2g`, for
+    /// the gather passes in `shape_eval`.
+    BinClear,
+    BinCount,
+    BinScan,
+    BinFill,
+    /// p2g.wgsl as a scatter with float atomics, or built with GATHER as
+    /// one invocation per node over the binned particles (no atomics).
+    P2g,
+    P2gGather,
+    /// p2g.wgsl built with PATCH: one invocation per bin of particles that
+    /// share a stencil (linear and B-splines on a regular grid, LME), summing
+    /// their contributions in registers, then one atomic per node and
+    /// component of the stencil.
+    P2gPatch,
+    MlsP2g,
+    GridPredict,
+    Stress,
+    /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
+    /// what a whole step runs without MLS. Not in `ALL`, which lists the
+    /// passes of the stages one by one.
+    StressForces,
+    /// `StressForces` built with PATCH: per bin, as `P2gPatch`. Not in `ALL`.
+    StressForcesPatch,
+    /// forces.wgsl as a scatter, or built with GATHER as `P2gGather` is.
+    Forces,
+    ForcesGather,
+    /// forces.wgsl built with PATCH, as `P2gPatch`.
+    ForcesPatch,
+    MlsForces,
+    GridCorrect,
+    G2p,
+    /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
+    /// then scatter the new velocities from particles (`Remap`) or Gauss
+    /// points (`MlsRemap`).
+    RemapClear,
+    Remap,
+    MlsRemap,
+    StepEnd,
+    Probes,
+    Energy,
+}
+
+impl Pass {
+    /// Every pass of the stages one by one, and the sample passes.
+    pub const ALL: [Pass; 26] = [
+        Pass::Cfl,
+        Pass::StepBegin,
+        Pass::ClearGrid,
+        Pass::LmeNewton,
+        Pass::BinClear,
+        Pass::BinCount,
+        Pass::BinScan,
+        Pass::BinFill,
+        Pass::P2g,
+        Pass::P2gGather,
+        Pass::P2gPatch,
+        Pass::MlsP2g,
+        Pass::GridPredict,
+        Pass::Stress,
+        Pass::Forces,
+        Pass::ForcesGather,
+        Pass::ForcesPatch,
+        Pass::MlsForces,
+        Pass::GridCorrect,
+        Pass::G2p,
+        Pass::RemapClear,
+        Pass::Remap,
+        Pass::MlsRemap,
+        Pass::StepEnd,
+        Pass::Probes,
+        Pass::Energy,
+    ];
+
+    /// The WGSL file (under shaders/).
+    pub fn file(self) -> &'static str {
+        match self {
+            Pass::Cfl => "cfl.wgsl",
+            Pass::StepBegin => "step_begin.wgsl",
+            Pass::ClearGrid => "clear_grid.wgsl",
+            Pass::LmeNewton => "lme_newton.wgsl",
+            Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
+            Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
+            Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
+            Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
+            Pass::G2p => "g2p.wgsl",
+            Pass::StepEnd => "step_end.wgsl",
+            Pass::Probes => "probes.wgsl",
+            Pass::Energy => "energy.wgsl",
+            Pass::BinClear => "bin_clear.wgsl",
+            Pass::BinCount => "bin_count.wgsl",
+            Pass::BinScan => "bin_scan.wgsl",
+            Pass::BinFill => "bin_fill.wgsl",
+            Pass::MlsP2g => "mls_p2g.wgsl",
+            Pass::MlsForces => "mls_forces.wgsl",
+            Pass::RemapClear | Pass::Remap => "remap.wgsl",
+            Pass::MlsRemap => "mls_remap.wgsl",
+        }
+    }
+}
+
+/// What a plan is decided from: the shape, the integrator, MLS, and how
+/// the GPU puts particle terms on nodes (its options' choice: the gather
+/// or the per-bin scatter; both off on the CPU and for MLS or MUSL).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlanInputs {
+    pub lme: bool,
+    pub mls: bool,
+    pub musl: bool,
+    /// `p2g` and `forces` gather at nodes over particles binned in `shape_eval`.
+    pub gather: bool,
+    /// `p2g` and `forces` scatter per bin of particles binned in `shape_eval`.
+    pub patch: bool,
+}
+
+/// The step of one scene, for both backends.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepPlan {
+    pub inputs: PlanInputs,
+    /// The stages in order (`STEP` or `STEP_MUSL`).
+    pub stages: &'static [Stage],
+    /// The CPU's step: without MLS, `shape_eval` and `p2g` fuse, and
+    /// `stress` and `forces` where they follow each other (not in MUSL).
+    pub cpu: Vec<CpuWork>,
+    /// The GPU's passes of one whole step, in order: each stage's passes
+    /// (`passes_for`), with `stress` and `forces` fused into `StressForces`
+    /// (per bin: `StressForcesPatch`) where both scatter (no MLS, not
+    /// MUSL, not gathering), then `StepEnd` (commit the time).
+    pub gpu_step: Vec<Pass>,
+}
+
+const BINS: [Pass; 4] = [Pass::BinClear, Pass::BinCount, Pass::BinScan, Pass::BinFill];
+
+impl StepPlan {
+    /// The plan of `model` with the GPU's `gather` / `patch` choice (both
+    /// false for the CPU, whose step does not depend on them).
+    pub fn of(model: &Model, gather: bool, patch: bool) -> StepPlan {
+        StepPlan::new(PlanInputs {
+            lme: matches!(model.shape, Shape::Lme(_)),
+            mls: model.mls,
+            musl: model.integrator == Integrator::Musl,
+            gather,
+            patch,
+        })
+    }
+
+    pub fn new(inputs: PlanInputs) -> StepPlan {
+        let PlanInputs {
+            mls, musl, gather, ..
+        } = inputs;
+        let stages = if musl { STEP_MUSL } else { STEP };
+        let fuse_stress = !mls && !musl;
+        let cpu = stages
+            .iter()
+            .filter_map(|&s| match s {
+                Stage::ShapeEval if !mls => Some(CpuWork::ShapeEvalP2g),
+                Stage::P2g if !mls => None,
+                Stage::Stress if fuse_stress => Some(CpuWork::StressForces),
+                Stage::Forces if fuse_stress => None,
+                s => Some(CpuWork::Stage(s)),
+            })
+            .collect();
+        let mut plan = StepPlan {
+            inputs,
+            stages,
+            cpu,
+            gpu_step: Vec::new(),
+        };
+        let fuse_gpu = fuse_stress && !gather;
+        plan.gpu_step = stages
+            .iter()
+            .flat_map(|&s| plan.passes_for(s).iter().copied())
+            .filter_map(|pass| match pass {
+                Pass::Stress if fuse_gpu && inputs.patch => Some(Pass::StressForcesPatch),
+                Pass::Stress if fuse_gpu => Some(Pass::StressForces),
+                Pass::Forces | Pass::ForcesPatch if fuse_gpu => None,
+                p => Some(p),
+            })
+            .chain([Pass::StepEnd])
+            .collect();
+        plan
+    }
+
+    /// The GPU passes that do `stage` on its own. `Cfl` is the reduction
+    /// plus the one-invocation Δt/stop pass; shape evaluation is LME's
+    /// Newton solve and, for the gather and per-bin passes, the binning
+    /// (the weights themselves are evaluated inline where used). With MLS,
+    /// `p2g` and `forces` work at Gauss points.
+    pub fn passes_for(&self, stage: Stage) -> &'static [Pass] {
+        let PlanInputs {
+            lme,
+            mls,
+            gather,
+            patch,
+            ..
+        } = self.inputs;
+        match stage {
+            Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
+            Stage::ClearGrid => &[Pass::ClearGrid],
+            Stage::ShapeEval if (gather || patch) && lme => {
+                &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
+            }
+            Stage::ShapeEval if gather || patch => &BINS,
+            Stage::ShapeEval if lme => &[Pass::LmeNewton],
+            Stage::ShapeEval => &[],
+            Stage::P2g if mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
+            Stage::P2g if gather => &[Pass::P2gGather],
+            Stage::P2g if patch => &[Pass::P2gPatch],
+            Stage::P2g => &[Pass::P2g],
+            Stage::Forces if mls => &[Pass::MlsForces],
+            Stage::Forces if gather => &[Pass::ForcesGather],
+            Stage::Forces if patch => &[Pass::ForcesPatch],
+            Stage::GridPredict => &[Pass::GridPredict],
+            Stage::Stress => &[Pass::Stress],
+            Stage::Forces => &[Pass::Forces],
+            Stage::GridCorrect => &[Pass::GridCorrect],
+            Stage::G2p => &[Pass::G2p],
+            Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
+            Stage::Remap => &[Pass::RemapClear, Pass::Remap, Pass::GridPredict],
+        }
+    }
+
+    /// Whether the GPU builds `pass` for this scene: a pass of some stage
+    /// (the parity tests run stages one by one), of the whole step, or a
+    /// sample pass (probes, energy).
+    pub fn gpu_uses(&self, pass: Pass) -> bool {
+        matches!(pass, Pass::Probes | Pass::Energy)
+            || self.gpu_step.contains(&pass)
+            || self
+                .stages
+                .iter()
+                .any(|&s| self.passes_for(s).contains(&pass))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(lme: bool, mls: bool, musl: bool, gather: bool, patch: bool) -> StepPlan {
+        StepPlan::new(PlanInputs {
+            lme,
+            mls,
+            musl,
+            gather,
+            patch,
+        })
+    }
+
+    #[test]
+    fn both_backends_fuse_stress_and_forces_only_without_mls_and_musl() {
+        let p = plan(false, false, false, false, false);
+        assert!(p.cpu.contains(&CpuWork::StressForces));
+        assert!(p.gpu_step.contains(&Pass::StressForces));
+        assert!(!p.gpu_step.contains(&Pass::Stress) && !p.gpu_step.contains(&Pass::Forces));
+        for (mls, musl) in [(true, true), (false, true)] {
+            let p = plan(false, mls, musl, false, false);
+            assert!(!p.cpu.contains(&CpuWork::StressForces));
+            assert!(!p.gpu_step.contains(&Pass::StressForces));
+            assert!(p.gpu_uses(Pass::Stress));
+        }
+        // The gather keeps stress and forces apart on the GPU only.
+        let p = plan(false, false, false, true, false);
+        assert!(p.cpu.contains(&CpuWork::StressForces));
+        assert!(p.gpu_step.contains(&Pass::ForcesGather) && !p.gpu_uses(Pass::StressForces));
+        let p = plan(true, false, false, false, true);
+        assert!(p.gpu_step.contains(&Pass::StressForcesPatch));
+        assert!(p.gpu_uses(Pass::ForcesPatch) && !p.gpu_uses(Pass::Forces));
+    }
+
+    #[test]
+    fn every_stage_is_done_once_in_order_on_both_backends() {
+        for bits in 0..32u32 {
+            let b = |i: u32| bits & 1 << i != 0;
+            let (lme, mls, musl, gather, patch) = (b(0), b(1), b(2), b(3), b(4));
+            if (gather || patch) && (mls || musl) || gather && patch {
+                continue; // the GPU options never pick these
+            }
+            let p = plan(lme, mls, musl, gather, patch);
+            let cpu: Vec<Stage> = p
+                .cpu
+                .iter()
+                .flat_map(|w| match w {
+                    CpuWork::Stage(s) => vec![*s],
+                    CpuWork::ShapeEvalP2g => vec![Stage::ShapeEval, Stage::P2g],
+                    CpuWork::StressForces => vec![Stage::Stress, Stage::Forces],
+                })
+                .collect();
+            assert_eq!(cpu, p.stages, "{bits:05b}");
+            assert_eq!(p.gpu_step.last(), Some(&Pass::StepEnd));
+            assert_eq!(p.gpu_step[..2], [Pass::Cfl, Pass::StepBegin]);
+            assert_eq!(p.gpu_uses(Pass::LmeNewton), lme, "{bits:05b}");
+            assert_eq!(p.gpu_uses(Pass::RemapClear), musl, "{bits:05b}");
+        }
+    }
+}

@@ -1,0 +1,151 @@
+//! `runs/ID/sweep-run.json`: the plan entry of the run a sweep put in a
+//! folder (its scene, `--set` list and backend), written before the run
+//! starts (locally, or by `--emit-jobs`); and the check `collect` makes
+//! before it tables a folder: the entry is this plan's, and the folder's
+//! `scene.resolved.toml` is the scene this plan gives the run. A folder
+//! that another plan (other `--set`, another value) wrote is flagged, not
+//! tabled as this plan's run.
+
+use super::plan::{Plan, PlannedRun};
+use crate::error::{Error, Result};
+use crate::output::folder::SWEEP_ENTRY;
+use crate::scene::{Override, Scene};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// What a sweep planned for one run folder.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Entry {
+    /// The run's id (its folder name under `runs/`).
+    pub id: String,
+    /// The scene file (absolute path).
+    pub scene: PathBuf,
+    /// Every `--set` of the run: the sweep's fixed ones, then the varied keys.
+    pub sets: Vec<String>,
+    /// `--backend` of the run.
+    pub backend: String,
+}
+
+impl Entry {
+    /// The entry `plan` gives `run`.
+    pub fn of(plan: &Plan, run: &PlannedRun) -> Entry {
+        Entry {
+            id: run.id.clone(),
+            scene: plan.scene.clone(),
+            sets: plan.sets_of(run),
+            backend: plan.backend.clone(),
+        }
+    }
+
+    /// Writes the entry into the run folder `dir` (made if missing).
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io("cannot create", dir, e))?;
+        let json = serde_json::to_string_pretty(self).expect("an entry serialises");
+        crate::output::write_atomic(&dir.join(SWEEP_ENTRY), json.as_bytes())
+    }
+}
+
+/// Why the run folder `dir` does not hold `plan`'s `run`, or None when it
+/// does (or holds nothing to compare: no entry and no resolved scene).
+pub fn mismatch(plan: &Plan, run: &PlannedRun, dir: &Path) -> Option<String> {
+    let want = Entry::of(plan, run);
+    match std::fs::read_to_string(dir.join(SWEEP_ENTRY)) {
+        Ok(text) => match serde_json::from_str::<Entry>(&text) {
+            Ok(got) if got == want => {}
+            Ok(got) => {
+                return Some(format!(
+                    "its {SWEEP_ENTRY} plans `{}` with --set {}, this plan `{}` with --set {}",
+                    got.scene.display(),
+                    got.sets.join(" --set "),
+                    want.scene.display(),
+                    want.sets.join(" --set ")
+                ));
+            }
+            Err(e) => return Some(format!("its {SWEEP_ENTRY} is unreadable: {e}")),
+        },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Some(format!("its {SWEEP_ENTRY} is unreadable: {e}")),
+    }
+    let text = std::fs::read_to_string(dir.join("scene.resolved.toml")).ok()?;
+    let got = match text.parse::<toml::Table>() {
+        Ok(t) => toml::Value::Table(t),
+        Err(e) => return Some(format!("its scene.resolved.toml is unreadable: {e}")),
+    };
+    let expected = match resolved(plan, run) {
+        Ok(v) => v,
+        Err(e) => return Some(format!("the plan's scene for it no longer loads: {e}")),
+    };
+    first_difference(&got, &expected, "").map(|d| format!("its scene.resolved.toml differs: {d}"))
+}
+
+/// The resolved scene `plan` gives `run`, as `lme-mpm run` writes it to
+/// `scene.resolved.toml` (after the preflight's clamping of intervals).
+fn resolved(plan: &Plan, run: &PlannedRun) -> Result<toml::Value> {
+    let overrides = plan
+        .sets_of(run)
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let scene = Scene::load(&plan.scene, &overrides)?;
+    // No limit refuses here: only the clamping matters.
+    let limits = crate::preflight::Limits {
+        max_memory: Some(u64::MAX),
+        max_steps: u64::MAX,
+        max_hours: None,
+        allow_many_snapshots: true,
+    };
+    let checked = crate::preflight::plan(&scene, &limits, rayon::current_num_threads())?;
+    let text = toml::to_string(&checked.scene.file).expect("a scene file serialises to TOML");
+    let table = text
+        .parse::<toml::Table>()
+        .expect("TOML lme-mpm wrote parses");
+    Ok(toml::Value::Table(table))
+}
+
+/// The first key at which `got` (the folder's) and `want` (the plan's)
+/// differ, in words.
+fn first_difference(got: &toml::Value, want: &toml::Value, at: &str) -> Option<String> {
+    let key = |k: &str| {
+        if at.is_empty() {
+            k.to_string()
+        } else {
+            format!("{at}.{k}")
+        }
+    };
+    match (got, want) {
+        (toml::Value::Table(a), toml::Value::Table(b)) => {
+            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+            keys.into_iter().find_map(|k| match (a.get(k), b.get(k)) {
+                (Some(x), Some(y)) => first_difference(x, y, &key(k)),
+                // A resumed run writes the default it ran with.
+                (Some(_), None) if key(k) == "output.sample_interval" => None,
+                (Some(x), None) => {
+                    Some(format!("{} = {x} in the folder, unset in the plan", key(k)))
+                }
+                (None, Some(y)) => Some(format!("{} unset in the folder, {y} in the plan", key(k))),
+                (None, None) => None,
+            })
+        }
+        (a, b) if a == b => None,
+        (a, b) => Some(format!("{at} = {a} in the folder, {b} in the plan")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_difference_is_named_by_its_dotted_key() {
+        let a: toml::Table = "[grid]\nh = 0.01\n[solver]\nshape = \"lme\"\n"
+            .parse()
+            .unwrap();
+        let b: toml::Table = "[grid]\nh = 0.005\n[solver]\nshape = \"lme\"\n"
+            .parse()
+            .unwrap();
+        let (a, b) = (toml::Value::Table(a), toml::Value::Table(b));
+        assert_eq!(first_difference(&a, &a, ""), None);
+        let d = first_difference(&a, &b, "").unwrap();
+        assert!(d.starts_with("grid.h = 0.01 in the folder, 0.005"), "{d}");
+    }
+}
