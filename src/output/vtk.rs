@@ -23,6 +23,8 @@ enum Szz {
     Neo { lame: f64, density: f64 },
     /// The plastic laws carry it (`Particles::plastic[i][0]`).
     Carried,
+    /// A law this does not know: 0.
+    Unknown,
 }
 
 impl OutOfPlane {
@@ -36,7 +38,10 @@ impl OutOfPlane {
                     lame: e.lame,
                     density: e.density,
                 },
-                Material::MohrCoulomb(_) | Material::DruckerPrager(_) => Szz::Carried,
+                // The plastic laws (Mohr–Coulomb, Drucker–Prager,
+                // modified Cam-clay) carry σzz in their plastic state.
+                m if m.needs_plastic_state() => Szz::Carried,
+                _ => Szz::Unknown,
             })
             .collect();
         OutOfPlane { rule }
@@ -55,7 +60,7 @@ impl OutOfPlane {
                 lame * j.ln() / j
             }
             Some(Szz::Carried) => p.plastic.get(i).map_or(0.0, |q| q[0]),
-            None => 0.0,
+            Some(Szz::Unknown) | None => 0.0,
         }
     }
 }
