@@ -35,12 +35,6 @@ const LEFT_OUT: &[(&str, &str)] = &[
     ),
 ];
 
-/// The line that continues a completed run. It needs completed runs to
-/// leave a final checkpoint, which issue 25 (branch `safety`) adds: until
-/// that is merged, this line fails with "none in this folder" and is
-/// skipped, loudly, for that reason only. Remove this skip after the merge.
-const DEPENDS_ON_ISSUE_25: &str = "lme-mpm resume out/dyka_bar";
-
 /// The Use block's command lines, comments stripped.
 fn use_lines() -> Vec<String> {
     let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
@@ -102,16 +96,6 @@ fn the_use_lines_run_in_order() {
             .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         let out = String::from_utf8_lossy(&o.stdout);
-        if line.starts_with(DEPENDS_ON_ISSUE_25)
-            && !o.status.success()
-            && err.contains("none in this folder")
-        {
-            eprintln!(
-                "SKIPPED README line (depends on issue 25: a completed run leaves no final \
-                 checkpoint yet): {line}\n{err}"
-            );
-            continue;
-        }
         assert!(
             o.status.success(),
             "README line failed ({:?}): {line}\nstderr:\n{err}\nstdout:\n{out}",
