@@ -9,6 +9,7 @@ use crate::model::Model;
 use crate::scene::{Override, Scene};
 use crate::simulation::{BackendChoice, BackendSpec, Simulation};
 use std::fmt::Write;
+use std::io::IsTerminal;
 use std::time::Instant;
 
 /// One benchmark configuration.
@@ -221,6 +222,18 @@ pub fn run(
                 particle_steps_per_second: particles as f64 * steps as f64 / seconds,
                 bytes_per_particle: backend.bytes_per_particle(),
             };
+            if !std::io::stderr().is_terminal() {
+                // Off a terminal (a log), a line per point as it is measured.
+                eprintln!(
+                    "bench: {} n={} on {}: {:.3e} particle-steps/s ({}/{} points of this backend)",
+                    p.case,
+                    p.particles,
+                    p.backend,
+                    p.particle_steps_per_second,
+                    out.len() + 1,
+                    cases.len() * counts.len()
+                );
+            }
             on_point(&p);
             out.push(p);
         }
@@ -475,12 +488,21 @@ pub fn chart(points: &[Point], stem: &std::path::Path) -> Result<()> {
         let s = Series::line(format!("{backend} {case}"), pts, color).markers();
         c.series.push(if backend == "cpu" { s } else { s.dashed() });
     }
+    c.size = (900, 560);
+    c.place_legend();
     c.save(stem)
 }
 
-/// "cpu" or "gpu" from a backend's full name.
+/// "cpu" or "gpu" from a backend's full name; "gpu (software)" for a
+/// software adapter such as llvmpipe (wgpu's device type `Cpu`), which is
+/// no measure of a GPU.
 fn short_backend(name: &str) -> String {
-    name.split([' ', ':']).next().unwrap_or(name).to_string()
+    let short = name.split([' ', ':']).next().unwrap_or(name);
+    if short == "gpu" && name.contains(", Cpu)") {
+        "gpu (software)".to_string()
+    } else {
+        short.to_string()
+    }
 }
 
 /// Time spent in one stage (CPU) or pass (GPU), per particle-step.

@@ -12,7 +12,8 @@ use std::sync::Once;
 
 static FONT: Once = Once::new();
 
-fn register_font() {
+/// Registers the embedded font once (every drawing calls it first).
+pub fn register_font() {
     FONT.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
         for style in [
@@ -33,6 +34,26 @@ fn err(path: &Path, e: impl std::fmt::Display) -> Error {
         path,
         std::io::Error::other(e.to_string()),
     )
+}
+
+/// PNG bytes of an RGB image of `size` (width, height) pixels.
+pub fn png_bytes(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    let e = |e: png::EncodingError| {
+        Error::io(
+            "cannot encode PNG",
+            Path::new("(memory)"),
+            std::io::Error::other(e.to_string()),
+        )
+    };
+    {
+        let mut enc = png::Encoder::new(&mut out, size.0, size.1);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(e)?;
+        w.write_image_data(rgb).map_err(e)?;
+    }
+    Ok(out)
 }
 
 /// A categorical palette readable on white (Tableau 10).
@@ -126,6 +147,55 @@ impl LineChart {
         }
     }
 
+    /// Puts the legend in the corner the data leave emptiest: the one
+    /// whose quarter of the plot (in the axes' own scale) holds the fewest
+    /// points, line segments sampled between them.
+    pub fn place_legend(&mut self) {
+        let xa = self.axis(0, self.log_x);
+        let ya = self.axis(1, self.log_y);
+        let unit = |v: f64, a: &Axis, log: bool| {
+            if log {
+                (v.ln() - a.lo.ln()) / (a.hi.ln() - a.lo.ln())
+            } else {
+                (v - a.lo) / (a.hi - a.lo)
+            }
+        };
+        let mut count = [0usize; 4]; // UL, UR, LL, LR
+        for s in &self.series {
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .filter(|p| (!self.log_x || p.0 > 0.0) && (!self.log_y || p.1 > 0.0))
+                .map(|p| (unit(p.0, &xa, self.log_x), unit(p.1, &ya, self.log_y)))
+                .collect();
+            for w in pts.windows(2).chain(pts.chunks(1).take(1)) {
+                let (a, b) = (w[0], *w.last().expect("non-empty window"));
+                for k in 0..=8 {
+                    let f = f64::from(k) / 8.0;
+                    let (u, v) = (a.0 + f * (b.0 - a.0), a.1 + f * (b.1 - a.1));
+                    // The legend's box: about 40 % of the width, 45 % of the height.
+                    let left = u < 0.4;
+                    let right = u > 0.6;
+                    let top = v > 0.55;
+                    let bottom = v < 0.45;
+                    count[0] += usize::from(left && top);
+                    count[1] += usize::from(right && top);
+                    count[2] += usize::from(left && bottom);
+                    count[3] += usize::from(right && bottom);
+                }
+            }
+        }
+        let best = (0..4).min_by_key(|&k| count[k]).unwrap_or(0);
+        self.legend = [
+            SeriesLabelPosition::UpperLeft,
+            SeriesLabelPosition::UpperRight,
+            SeriesLabelPosition::LowerLeft,
+            SeriesLabelPosition::LowerRight,
+        ][best]
+            .clone();
+    }
+
     pub fn log_log(mut self) -> Self {
         self.log_x = true;
         self.log_y = true;
@@ -150,7 +220,9 @@ impl LineChart {
         Ok(())
     }
 
-    fn range(&self, axis: usize, log: bool) -> (f64, f64) {
+    /// The data's extent on `axis` (0: x, 1: y), with a margin; without
+    /// data, a unit range.
+    fn extent(&self, axis: usize, log: bool) -> (f64, f64) {
         let vals = self
             .series
             .iter()
@@ -167,23 +239,33 @@ impl LineChart {
             return if log { (1.0, 10.0) } else { (0.0, 1.0) };
         }
         if log {
-            let (lo, hi) = if hi > lo {
+            if hi > lo {
                 (lo, hi)
             } else {
                 (lo * 0.5, hi * 2.0)
-            };
-            (lo / 1.3, hi * 1.3)
+            }
+        } else if hi > lo {
+            (lo, hi)
         } else {
-            let pad = if hi > lo {
-                0.05 * (hi - lo)
-            } else {
-                0.5 * lo.abs().max(1.0)
-            };
+            let pad = 0.5 * lo.abs().max(1.0);
             (lo - pad, hi + pad)
         }
     }
 
-    fn draw<DB: DrawingBackend>(
+    /// The axis range and its labelled ticks: the range runs from a tick
+    /// at or below the lowest point to one at or above the highest, so
+    /// every point can be read against a labelled value on both sides.
+    fn axis(&self, axis: usize, log: bool) -> Axis {
+        let (lo, hi) = self.extent(axis, log);
+        if log {
+            Axis::log(lo, hi)
+        } else {
+            Axis::linear(lo, hi, axis == 1)
+        }
+    }
+
+    /// Draws the chart on `root` (a whole image or a panel of one).
+    pub fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String>
@@ -191,18 +273,19 @@ impl LineChart {
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (x0, x1) = self.range(0, self.log_x);
-        let (y0, y1) = self.range(1, self.log_y);
+        let xa = self.axis(0, self.log_x);
+        let ya = self.axis(1, self.log_y);
         let mut b = ChartBuilder::on(root);
         b.caption(&self.title, ("sans-serif", 20))
             .margin(12)
+            .margin_right(28)
             .x_label_area_size(40)
             .y_label_area_size(70);
         macro_rules! body {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                let fx = |v: &f64| tick(*v, self.log_x);
-                let fy = |v: &f64| tick(*v, self.log_y);
+                let fx = |v: &f64| xa.label(*v);
+                let fy = |v: &f64| ya.label(*v);
                 chart
                     .configure_mesh()
                     .x_desc(self.x_label.as_str())
@@ -265,31 +348,36 @@ impl LineChart {
                 }
             }};
         }
-        // Log axes carry their own ticks (`log_ticks`): plotters' own
-        // start at a power of ten, so a range inside one decade got none.
-        let log_axis = |lo: f64, hi: f64| {
-            let (bold, light) = log_ticks(lo, hi);
-            (lo..hi)
+        // Every axis carries its own ticks (`Axis`): plotters' log ticks
+        // start at a power of ten, so a range inside one decade got none,
+        // and its linear ones need not reach the top point.
+        let log_axis = |a: &Axis| {
+            (a.lo..a.hi)
                 .log_scale()
-                .with_key_points(bold)
-                .with_light_points(light)
+                .with_key_points(a.ticks.clone())
+                .with_light_points(a.light.clone())
+        };
+        let lin_axis = |a: &Axis| LinearTicks {
+            lo: a.lo,
+            hi: a.hi,
+            ticks: a.ticks.clone(),
         };
         match (self.log_x, self.log_y) {
             (false, false) => body!(
-                b.build_cartesian_2d(x0..x1, y0..y1)
+                b.build_cartesian_2d(lin_axis(&xa), lin_axis(&ya))
                     .map_err(|e| e.to_string())?
             ),
             (true, false) => body!(
-                b.build_cartesian_2d(log_axis(x0, x1), y0..y1)
+                b.build_cartesian_2d(log_axis(&xa), lin_axis(&ya))
                     .map_err(|e| e.to_string())?
             ),
             (false, true) => body!(
-                b.build_cartesian_2d(x0..x1, log_axis(y0, y1))
+                b.build_cartesian_2d(lin_axis(&xa), log_axis(&ya))
                     .map_err(|e| e.to_string())?
             ),
             (true, true) => {
                 body!(
-                    b.build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))
+                    b.build_cartesian_2d(log_axis(&xa), log_axis(&ya))
                         .map_err(|e| e.to_string())?
                 )
             }
@@ -336,7 +424,8 @@ impl ParticleImage {
         root.present().map_err(|e| err(&png, e))
     }
 
-    fn draw<DB: DrawingBackend>(
+    /// Draws the panels on `root` in `rows` rows.
+    pub fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
         rows: usize,
@@ -403,10 +492,10 @@ impl ParticleImage {
                 .map_err(|e| e.to_string())?;
         }
         let style = ("sans-serif", 12).into_font().color(&BLACK);
-        bar.draw(&Text::new(format!("{hi:.3}"), (18, 0), style.clone()))
+        bar.draw(&Text::new(tick(hi, 0.0), (18, 0), style.clone()))
             .map_err(|e| e.to_string())?;
         bar.draw(&Text::new(
-            format!("{lo:.3}"),
+            tick(lo, 0.0),
             (18, bh as i32 - 12),
             style.clone(),
         ))
@@ -522,7 +611,6 @@ impl StatusGrid {
     }
 }
 
-/// Tick label: powers of ten and 2/5 multiples as 1e3, 2e3; plain numbers otherwise.
 /// Labelled and light ticks of a log axis from `lo` to `hi` (> 0): powers
 /// of ten, with 2 and 5 times them over up to three decades and every
 /// digit within about one; light lines at every digit.
@@ -550,22 +638,178 @@ fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
     (bold, light)
 }
 
-fn tick(v: f64, log: bool) -> String {
-    if v == 0.0 {
+/// One axis of a line chart: its range and labelled ticks.
+#[derive(Debug, Clone)]
+struct Axis {
+    lo: f64,
+    hi: f64,
+    /// Labelled ticks.
+    ticks: Vec<f64>,
+    /// Unlabelled grid lines (log axes).
+    light: Vec<f64>,
+    /// Tick spacing (linear axes; 0 on log axes).
+    step: f64,
+}
+
+/// A linear axis with the given labelled ticks (plotters' own linear axis
+/// picks its ticks itself, and `with_key_points` on it loses the label
+/// formatter `configure_mesh` needs).
+#[derive(Debug, Clone)]
+struct LinearTicks {
+    lo: f64,
+    hi: f64,
+    ticks: Vec<f64>,
+}
+
+impl plotters::coord::ranged1d::Ranged for LinearTicks {
+    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        let f = (v - self.lo) / (self.hi - self.lo);
+        limit.0 + (f * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<H: plotters::coord::ranged1d::KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.lo..self.hi
+    }
+}
+
+/// A tick above the data when the data come within this fraction of the
+/// range of the last tick (a point on the frame's edge is hard to read).
+const EDGE: f64 = 0.02;
+
+impl Axis {
+    /// Ticks every 1, 2, 2.5 or 5 × 10^k, about six of them, the range
+    /// snapped out to a tick on each side; with `pad` (a y axis) one step
+    /// more where the data come within `EDGE` of the frame (zero stays the
+    /// edge when the data start or end there).
+    fn linear(lo: f64, hi: f64, pad: bool) -> Axis {
+        let span = hi - lo;
+        let raw = span / 6.0;
+        let k = raw.log10().floor();
+        let base = 10f64.powf(k);
+        let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+            .into_iter()
+            .map(|m| m * base)
+            .find(|s| *s >= raw * (1.0 - 1e-9))
+            .unwrap_or(10.0 * base);
+        let mut a = (lo / step + 1e-9).floor() * step;
+        if pad && lo != 0.0 && lo - a < EDGE * span {
+            a -= step;
+        }
+        let mut b = (hi / step - 1e-9).ceil() * step;
+        if pad && hi != 0.0 && b - hi < EDGE * span {
+            b += step;
+        }
+        let n = ((b - a) / step).round() as i64;
+        let ticks = (0..=n).map(|i| a + i as f64 * step).collect();
+        Axis {
+            lo: a,
+            hi: b,
+            ticks,
+            light: Vec::new(),
+            step,
+        }
+    }
+
+    /// `log_ticks` on a range widened to a labelled tick at or beyond the
+    /// data on each side.
+    fn log(lo: f64, hi: f64) -> Axis {
+        let (mut a, mut b) = (lo, hi);
+        for _ in 0..6 {
+            let (bold, _) = log_ticks(a, b);
+            let top = bold.last().copied().unwrap_or(0.0);
+            let bottom = bold.first().copied().unwrap_or(f64::INFINITY);
+            let up = top < hi * (1.0 - 1e-9);
+            let down = bottom > lo * (1.0 + 1e-9);
+            if !up && !down {
+                break;
+            }
+            if up {
+                b = nice_beyond(hi, true);
+            }
+            if down {
+                a = nice_beyond(lo, false);
+            }
+            if bold.is_empty() || (b / a) > 1e3 * (hi / lo) {
+                // Widening no longer helps: powers of ten around the data.
+                a = 10f64.powf(lo.log10().floor());
+                b = 10f64.powf(hi.log10().ceil());
+            }
+        }
+        let (ticks, light) = log_ticks(a, b);
+        Axis {
+            lo: a / 1.04,
+            hi: b * 1.04,
+            ticks,
+            light,
+            step: 0.0,
+        }
+    }
+
+    fn label(&self, v: f64) -> String {
+        tick(v, self.step)
+    }
+}
+
+/// The next 1, 2 or 5 × 10^k strictly beyond `v` (> 0), up or down.
+fn nice_beyond(v: f64, up: bool) -> f64 {
+    let k = v.log10().floor() as i32;
+    let mut c: Vec<f64> = (k - 1..=k + 1)
+        .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+        .collect();
+    c.sort_by(f64::total_cmp);
+    if up {
+        c.into_iter()
+            .find(|x| *x > v * (1.0 + 1e-9))
+            .unwrap_or(10.0 * v)
+    } else {
+        c.into_iter()
+            .rev()
+            .find(|x| *x < v * (1.0 - 1e-9))
+            .unwrap_or(0.1 * v)
+    }
+}
+
+/// Tick label: plain decimals from 0.001 to 99999 (as many decimals as the
+/// tick spacing `step` needs; on a log axis, `step` = 0, up to four
+/// significant digits), else a mantissa and exponent such as 2.5e-5.
+fn tick(v: f64, step: f64) -> String {
+    if v == 0.0 || v.abs() < step * 1e-9 {
         return "0".into();
     }
     let a = v.abs();
-    if log || !(1e-3..1e5).contains(&a) {
+    let trim = |s: String| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let plain = (1e-3..1e5).contains(&a) && (step == 0.0 || step >= 1e-4);
+    if plain {
+        let decimals = if step > 0.0 {
+            // 2.5 × 10^k needs one digit more than 10^k.
+            let d = -(step.log10() - 1e-9).floor();
+            let extra = usize::from(((step / 10f64.powf(-d)) - 2.5).abs() < 1e-6);
+            d.max(0.0) as usize + extra
+        } else {
+            (3.0 - a.log10().floor()).max(0.0) as usize
+        };
+        trim(format!("{v:.decimals$}"))
+    } else {
         let e = a.log10().floor();
         let m = v / 10f64.powf(e);
-        if (m - m.round()).abs() < 1e-6 {
-            format!("{}e{}", m.round(), e)
-        } else {
-            format!("{m:.1}e{e}")
-        }
-    } else {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
+        format!("{}e{}", trim(format!("{m:.2}")), e)
     }
 }
 
@@ -587,6 +831,37 @@ mod tests {
         }
         let (bold, _) = log_ticks(0.03, 3.0);
         assert_eq!(bold.len(), 6, "{bold:?}"); // 0.05, 0.1, 0.2, 0.5, 1, 2
+    }
+
+    #[test]
+    fn ticks_are_plain_decimals_and_reach_past_the_data() {
+        // The issue's `9e-1`, `5e0`, `6e0 %` read 0.9, 5 and 6.
+        assert_eq!(tick(0.9, 0.0), "0.9");
+        assert_eq!(tick(5.0, 0.0), "5");
+        assert_eq!(tick(6.0, 1.0), "6");
+        assert_eq!(tick(0.25, 0.05), "0.25");
+        assert_eq!(tick(2.5e-5, 5e-6), "2.5e-5");
+        assert_eq!(tick(3e-4, 0.0), "3e-4");
+        // A log axis whose top point is 1.3 gets a labelled tick above it.
+        let a = Axis::log(0.55, 1.3);
+        assert!(a.ticks.iter().any(|t| *t >= 1.3), "{:?}", a.ticks);
+        assert!(a.ticks.iter().any(|t| *t <= 0.55), "{:?}", a.ticks);
+        assert!(a.hi > 1.3 && a.lo < 0.55);
+        // Linear: ticks on both sides of the data, a tick at the edge.
+        let a = Axis::linear(0.12, 4.9, true);
+        assert!(
+            *a.ticks.last().unwrap() >= 4.9 && a.ticks[0] <= 0.12,
+            "{:?}",
+            a.ticks
+        );
+        assert_eq!(a.hi, *a.ticks.last().unwrap());
+        let a = Axis::linear(0.0, 1e-4, true);
+        assert_eq!(a.lo, 0.0);
+        // A time axis ends at the tick its data end on.
+        assert_eq!(Axis::linear(0.0, 20.0, false).hi, 20.0);
+        let a = Axis::linear(0.0, 1e-4, false);
+        assert_eq!(a.lo, 0.0);
+        assert!(a.ticks.iter().all(|t| !a.label(*t).contains("e0")));
     }
 
     #[test]

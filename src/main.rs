@@ -35,7 +35,9 @@ enum Command {
     Run {
         /// Scene file (TOML), e.g. cases/dyka_bar.toml.
         scene: PathBuf,
-        /// Where to run: auto = GPU when an adapter exists, else CPU.
+        /// Where to run: auto = a hardware GPU when wgpu finds one, else the CPU
+        /// path (a software adapter such as llvmpipe is slower than the CPU
+        /// path and counts as none; --backend gpu uses it).
         #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
         backend: BackendChoice,
         /// GPU adapter to use: a case-insensitive part of its name (see `lme-mpm info`).
@@ -62,7 +64,9 @@ enum Command {
     Resume {
         /// The run's output folder.
         dir: PathBuf,
-        /// Where to run: auto = GPU when an adapter exists, else CPU.
+        /// Where to run: auto = a hardware GPU when wgpu finds one, else the CPU
+        /// path (a software adapter such as llvmpipe is slower than the CPU
+        /// path and counts as none; --backend gpu uses it).
         #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
         backend: BackendChoice,
         /// GPU adapter to use: a case-insensitive part of its name.
@@ -83,7 +87,9 @@ enum Command {
     /// memory and time from the shapes (refusing what `run` would refuse),
     /// then builds the model and prints what will run.
     Check {
+        /// Scene file (TOML), e.g. cases/elastic_block.toml.
         scene: PathBuf,
+        /// Override a scene key as `run` would, e.g. --set grid.h=0.0005 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         #[command(flatten)]
@@ -127,6 +133,37 @@ enum Command {
     /// Measure particle-steps per second of whole steps on a synthetic scene,
     /// on the CPU path, the GPU, or both (with the GPU/CPU ratio).
     Bench(BenchArgs),
+    /// Turn a run's VTK snapshots into pictures: one PNG per snapshot and an
+    /// animated GIF (and an MP4 when ffmpeg is on the PATH), the particles
+    /// drawn as their domains coloured by FIELD on one scale for the whole
+    /// run, with a colour bar, the time, walls and prescribed-velocity
+    /// regions, on one frame that holds every snapshot. The run needs
+    /// snapshots: output.vtk_interval (e.g. --set output.vtk_interval=0.04).
+    Render(RenderArgs),
+}
+
+/// `lme-mpm render`'s arguments.
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
+    /// The run's output folder (holding particles.pvd and vtk/).
+    dir: PathBuf,
+    /// What colours the particles: speed (m/s), stress (von Mises, Pa),
+    /// pressure (Pa, positive in compression), eps_p (equivalent plastic
+    /// strain; plastic materials), displacement (m, from the start).
+    #[arg(long, value_enum, default_value_t = lme_mpm::output::render::Field::Speed)]
+    field: lme_mpm::output::render::Field,
+    /// Frames per second of the animation.
+    #[arg(long, default_value_t = 10.0)]
+    fps: f64,
+    /// Image width in pixels (the height follows the frame's shape).
+    #[arg(long, default_value_t = 800)]
+    width: u32,
+    /// Draw every N-th snapshot (the last one always).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    every: usize,
+    /// Output folder. Default: DIR/render.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// `lme-mpm bench`'s arguments.
@@ -314,6 +351,7 @@ fn main() -> ExitCode {
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
                 doc: doc.clone(),
                 progress: std::io::stderr().is_terminal(),
+                progress_lines: !std::io::stderr().is_terminal(),
             };
             match lme_mpm::study::run(name, &opts) {
                 Ok(reports) => {
@@ -346,6 +384,9 @@ fn main() -> ExitCode {
         }
         Command::Sweep(args) => sweep(args),
         Command::Bench(args) => bench(&args),
+        Command::Render(a) => {
+            lme_mpm::output::render::command(&a.dir, a.field, a.fps, a.width, a.every, a.out)
+        }
         Command::Check { scene, set, limits } => {
             let scene = match load(&scene, &set) {
                 Ok(s) => s,
@@ -490,6 +531,9 @@ fn report(
         if let Some(e) = &s.errors {
             lme_mpm::say!("errors: {}", serde_json::to_string(e).unwrap_or_default());
         }
+        if let Some(words) = lme_mpm::output::result::text(s) {
+            lme_mpm::say!("result: {words}");
+        }
         lme_mpm::say!("outputs: {}", opts.out.display());
     }
     match outcome.status {
@@ -528,7 +572,8 @@ struct SweepArgs {
     /// an exact solution: ref_probe_u_rms, against the finest run).
     #[arg(long, value_name = "NAME")]
     metric: Option<String>,
-    /// Where each run runs: auto = GPU when a hardware adapter exists, else CPU.
+    /// Where each run runs: auto = a hardware GPU when wgpu finds one, else the
+    /// CPU path (a software adapter counts as none; --backend gpu uses it).
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
     /// Runs at once (default: one per core; each run gets cores / jobs threads),
@@ -842,6 +887,10 @@ fn bench(args: &BenchArgs) -> ExitCode {
     if let Err(e) = bench::chart(&points, &out.join("bench")) {
         return fail(&e);
     }
+    eprintln!(
+        "outputs: {0}/bench.csv, {0}/bench.png (and .svg)",
+        out.display()
+    );
     if let Some((doc, section)) = doc {
         let name = section.map_or_else(|| format!("{backends:?}").to_lowercase(), String::from);
         let charts = doc

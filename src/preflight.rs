@@ -285,6 +285,15 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         f64::INFINITY
     };
     let steps = steps.max(1.0);
+    // A static implicit run takes its load steps, whatever the wave speed.
+    let (dt, steps) = if matches!(f.solver.integrator, crate::scene::IntegratorKind::Implicit)
+        && f.solver.static_analysis
+    {
+        let n = f64::from(f.solver.load_steps.max(1));
+        (t_end / n, n)
+    } else {
+        (dt, steps)
+    };
     let samples = (t_end / scene.sample_interval.max(dt)).floor() + 1.0;
     let snapshots = f
         .output
@@ -577,6 +586,17 @@ mod tests {
         assert_eq!(parse_size("1.5k").unwrap(), 1536);
         assert!(parse_size("-1G").is_err());
         assert!(parse_size("lots").is_err());
+    }
+
+    #[test]
+    fn a_static_implicit_run_takes_its_load_steps() {
+        // cases/cantilever.toml: static, one load step (issue 26 saw about
+        // 12,000, from the wave speed an explicit run would need).
+        let scene =
+            Scene::from_str(crate::cases::CANTILEVER, "cantilever", "cantilever", &[]).unwrap();
+        let est = plan(&scene, &Limits::default(), 1).unwrap().estimate;
+        assert_eq!(est.steps, f64::from(scene.file.solver.load_steps));
+        assert_eq!(est.dt, scene.file.solver.t_end / est.steps);
     }
 
     #[test]

@@ -311,9 +311,27 @@ fn finish(
         peak_rss_bytes: crate::preflight::peak_rss(),
         newton,
     };
+    write_result_picture(writer, &scene, model, &summary)?;
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     writer.write("summary.json", json.as_bytes())?;
     Ok(Outcome { status, summary })
+}
+
+/// `result.png` (`output::result`): the run's result as a picture. A
+/// picture that cannot be drawn is a warning, not a failed run.
+fn write_result_picture(
+    writer: &mut Writer,
+    scene: &Scene,
+    model: &Model,
+    summary: &Summary,
+) -> Result<()> {
+    match output::result::picture(scene, model, &writer.samples, summary) {
+        Ok(png) => writer.write(output::result::FILE, &png),
+        Err(e) => {
+            eprintln!("warning: {e}");
+            Ok(())
+        }
+    }
 }
 
 /// Observer that keeps the samples, rewrites the CSV files now and then (so
@@ -337,6 +355,8 @@ struct Writer {
     /// When driving started, with the time and steps then.
     started: Option<(Instant, f64, u64)>,
     resumed_from: Option<f64>,
+    /// σzz of the VTK stress tensor, per body.
+    out_of_plane: vtk::OutOfPlane,
 }
 
 /// Rewrite the CSV files at most this often while running.
@@ -379,6 +399,7 @@ impl Writer {
             lines: opts.progress_lines.then(|| (0, Instant::now())),
             started: None,
             resumed_from: None,
+            out_of_plane: vtk::OutOfPlane::of(model),
         };
         let o = &scene.file.output;
         if o.vtk_final || o.vtk_interval.is_some() {
@@ -450,7 +471,7 @@ impl Writer {
         let vdir = self.folder.path("vtk");
         std::fs::create_dir_all(&vdir).map_err(|e| Error::io("cannot create", &vdir, e))?;
         let name = format!("vtk/particles_{:05}.vtu", self.snapshots.len());
-        self.write(&name, &vtk::particles_vtu(particles, t))?;
+        self.write(&name, &vtk::particles_vtu(particles, &self.out_of_plane, t))?;
         self.snapshots.push((t, name));
         self.write_pvd()?;
         self.io_seconds += t0.elapsed().as_secs_f64();
@@ -476,11 +497,13 @@ impl Writer {
         let Some((t0, time0, steps0)) = self.started else {
             return;
         };
-        let secs = t0.elapsed().as_secs_f64().max(1e-9);
+        // Stepping time only, outputs excluded, as summary.json counts it.
+        let secs = (t0.elapsed().as_secs_f64() - self.io_seconds).max(1e-9);
         let rate = self.n_particles as f64 * steps.saturating_sub(steps0) as f64 / secs;
         let done = (t - time0) / (t_end - time0).max(f64::MIN_POSITIVE);
         let eta = if done > 0.0 {
-            format!("{:.0} s", secs * (1.0 - done) / done)
+            // Never "-0 s" once past the end.
+            format!("{:.0} s", (secs * (1.0 - done) / done).max(0.0))
         } else {
             "unknown".to_string()
         };
@@ -553,7 +576,15 @@ impl Observer for Writer {
 
 /// Text that `lme-mpm check` prints: what the scene will run.
 pub fn describe(scene: &Scene, model: &Model) -> String {
-    let dt = crate::model::time_step::time_step(model, 0.0).0;
+    let mut dt = crate::model::time_step::time_step(model, 0.0).0;
+    if let crate::model::Integrator::Implicit(s) = &model.integrator {
+        // A static run takes its load steps; a dynamic one its fixed Δt.
+        if s.static_analysis {
+            dt = scene.solver().t_end / f64::from(s.load_steps.max(1));
+        } else if let Some(fixed) = model.fixed_dt {
+            dt = fixed;
+        }
+    }
     let bytes_cpu = CpuBackend::bytes_per_particle_of(model);
     let s = scene.solver();
     let g = &model.grid;

@@ -24,11 +24,12 @@ use crate::solver::{self, Cursor, Observer, RunStatus, Schedule};
 /// `--backend`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum BackendChoice {
-    /// The GPU when an adapter exists, else the CPU path (says which and why).
+    /// A hardware GPU when wgpu finds one, else the CPU path; a software
+    /// adapter (llvmpipe) counts as none (says which and why).
     Auto,
     /// The f64 CPU reference path.
     Cpu,
-    /// The wgpu path; fails when no adapter exists.
+    /// The wgpu path on any adapter, software included; fails when none exists.
     Gpu,
 }
 

@@ -392,11 +392,31 @@ fn completed_run_writes_every_output() {
         let text = String::from_utf8_lossy(&bytes);
         assert!(text.contains(&format!("NumberOfPoints=\"{n}\"")));
         assert!(text.ends_with("</AppendedData>\n</VTKFile>\n"));
-        // Header + payload sizes add up: 6 point arrays, points, 3 cell arrays.
-        let payload = n * (12 * 3 + 4 + 4 + 4) + n * 12 + n * (8 + 8 + 1) + 10 * 8;
+        // Header + payload sizes add up: 8 point arrays (velocity,
+        // displacement, the stress tensor's 6 and its 3 in-plane
+        // components, density, volume, speed, body), points, 3 cell arrays.
+        let payload = n * (12 * 3 + 24 + 4 * 4) + n * 12 + n * (8 + 8 + 1) + 12 * 8;
         let start = text.find("<AppendedData encoding=\"raw\">\n_").unwrap() + 31;
         let end = bytes.len() - "\n</AppendedData>\n</VTKFile>\n".len();
         assert_eq!(end - start, payload);
+        // Read back: the points, and the tensor's σzz = ν (σxx + σyy) of
+        // plane-strain linear elasticity (f32 round-off: 1e-6 relative).
+        let vtu = lme_mpm::output::vtk::read_vtu(&bytes).unwrap();
+        assert_eq!(vtu.n, n);
+        let (tensor, comps) = vtu.get("stress").unwrap();
+        assert_eq!(comps, 6);
+        let nu = s["scene_resolved"]["materials"]["steel"]["nu"]
+            .as_f64()
+            .unwrap();
+        for s in tensor.chunks_exact(6) {
+            let zz = nu * (f64::from(s[0]) + f64::from(s[1]));
+            assert!(
+                (f64::from(s[2]) - zz).abs() <= 1e-6 * (1.0 + zz.abs() + f64::from(s[0]).abs()),
+                "{s:?}"
+            );
+        }
+        let (vol, _) = vtu.get("volume").unwrap();
+        assert!(vol.iter().all(|v| *v > 0.0));
     }
     let _ = std::fs::remove_dir_all(&out);
 }

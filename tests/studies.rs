@@ -21,6 +21,7 @@ fn run(name: StudyName) -> (Vec<JobResult>, String, PathBuf) {
         jobs: 2,
         doc: None,
         progress: false,
+        progress_lines: false,
     };
     let mut reports = study::run(name, &opts).unwrap();
     let r = reports.pop().unwrap();
@@ -37,7 +38,22 @@ fn run(name: StudyName) -> (Vec<JobResult>, String, PathBuf) {
         r.results.len() + 1,
         "one CSV row per run"
     );
-    assert!(dir.join("report.md").exists());
+    // Every link of report.md resolves from its folder (the charts sit
+    // beside it; the docs' copy links them in charts/).
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for link in report
+        .split("](")
+        .skip(1)
+        .filter_map(|s| s.split(')').next())
+    {
+        if link.starts_with("http") || link.contains(".md") {
+            continue;
+        }
+        assert!(
+            dir.join(link).is_file(),
+            "report.md links {link}, missing in {dir:?}"
+        );
+    }
     (r.results, r.markdown, dir)
 }
 

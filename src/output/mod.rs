@@ -6,6 +6,8 @@
 pub mod checkpoint;
 pub mod csv;
 pub mod folder;
+pub mod render;
+pub mod result;
 pub mod summary;
 pub mod vtk;
 

@@ -2,12 +2,72 @@
 //! with binary appended data (Float32 fields, UInt64 block headers), and a
 //! ParaView collection (.pvd) listing the snapshots with their times.
 //! The format is small enough that a dependency would add more than it saves.
+//! `read_vtu` reads such a file back (`lme-mpm render`).
 
-use crate::model::Particles;
+use crate::model::material::Material;
+use crate::model::{Model, Particles};
 use std::fmt::Write;
 
-/// The .vtu file for the particle state at time `t`.
-pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
+/// σzz of plane strain (εzz = 0), per body: what each material's law
+/// makes of it from the state a particle carries.
+#[derive(Debug, Clone, Default)]
+pub struct OutOfPlane {
+    rule: Vec<Szz>,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Szz {
+    /// Linear elastic from a stress-free start: ν (σxx + σyy).
+    Linear { nu: f64 },
+    /// Neo-Hookean: λ ln J / J (b_zz = 1).
+    Neo { lame: f64, density: f64 },
+    /// The plastic laws carry it (`Particles::plastic[i][0]`).
+    Carried,
+    /// A law this does not know: 0.
+    Unknown,
+}
+
+impl OutOfPlane {
+    pub fn of(model: &Model) -> OutOfPlane {
+        let rule = model
+            .body_material
+            .iter()
+            .map(|&m| match &model.materials[m as usize] {
+                Material::LinearElastic(e) => Szz::Linear { nu: e.nu },
+                Material::NeoHookean(e) => Szz::Neo {
+                    lame: e.lame,
+                    density: e.density,
+                },
+                // The plastic laws (Mohr–Coulomb, Drucker–Prager,
+                // modified Cam-clay) carry σzz in their plastic state.
+                m if m.needs_plastic_state() => Szz::Carried,
+                _ => Szz::Unknown,
+            })
+            .collect();
+        OutOfPlane { rule }
+    }
+
+    /// σzz of particle `i` (Pa); 0 for a body this does not know.
+    pub fn szz(&self, p: &Particles, i: usize) -> f64 {
+        let s = p.stress[i];
+        match self.rule.get(p.body[i] as usize) {
+            Some(Szz::Linear { nu }) => nu * (s[0] + s[1]),
+            Some(Szz::Neo { lame, density }) => {
+                let j = match p.f.get(i) {
+                    Some(f) => f[0] * f[3] - f[1] * f[2],
+                    None => density / p.rho[i],
+                };
+                lame * j.ln() / j
+            }
+            Some(Szz::Carried) => p.plastic.get(i).map_or(0.0, |q| q[0]),
+            Some(Szz::Unknown) | None => 0.0,
+        }
+    }
+}
+
+/// The .vtu file for the particle state at time `t`; `zz` gives the
+/// out-of-plane stress of the symmetric `stress` tensor.
+pub fn particles_vtu(p: &Particles, zz: &OutOfPlane, t: f64) -> Vec<u8> {
     let n = p.len();
     let mut arrays: Vec<(&str, &str, usize, Vec<u8>)> = Vec::new();
     let f32s = |it: &mut dyn Iterator<Item = f64>| {
@@ -20,6 +80,12 @@ pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
     arrays.push(("velocity", "Float32", 3, f32s(&mut vel)));
     let mut disp = (0..n).flat_map(|i| [p.x[i][0] - p.x0[i][0], p.x[i][1] - p.x0[i][1], 0.0]);
     arrays.push(("displacement", "Float32", 3, f32s(&mut disp)));
+    // The Cauchy stress as ParaView's symmetric tensor: xx, yy, zz, xy, yz, xz.
+    let mut tensor = (0..n).flat_map(|i| {
+        let s = p.stress[i];
+        [s[0], s[1], zz.szz(p, i), s[2], 0.0, 0.0]
+    });
+    arrays.push(("stress", "Float32", 6, f32s(&mut tensor)));
     let mut sig = (0..n).flat_map(|i| p.stress[i]);
     arrays.push(("stress_xx_yy_xy", "Float32", 3, f32s(&mut sig)));
     if !p.plastic.is_empty() {
@@ -39,6 +105,8 @@ pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
     }
     let mut rho = p.rho.iter().copied();
     arrays.push(("density", "Float32", 1, f32s(&mut rho)));
+    let mut vol = (0..n).map(|i| p.mass[i] / p.rho[i]);
+    arrays.push(("volume", "Float32", 1, f32s(&mut vol)));
     let mut speed = (0..n).map(|i| p.v[i][0].hypot(p.v[i][1]));
     arrays.push(("speed", "Float32", 1, f32s(&mut speed)));
     let body: Vec<u8> = p
@@ -72,7 +140,7 @@ pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
     );
     xml.push_str("</FieldData>\n");
     let _ = writeln!(xml, r#"<Piece NumberOfPoints="{n}" NumberOfCells="{n}">"#);
-    xml.push_str("<PointData Scalars=\"density\" Vectors=\"velocity\">\n");
+    xml.push_str("<PointData Scalars=\"density\" Vectors=\"velocity\" Tensors=\"stress\">\n");
     for (name, ty, comps, data) in arrays {
         add(&mut xml, name, ty, comps, data);
     }
@@ -90,6 +158,111 @@ pub fn particles_vtu(p: &Particles, t: f64) -> Vec<u8> {
     }
     out.extend_from_slice(b"\n</AppendedData>\n</VTKFile>\n");
     out
+}
+
+/// A .vtu file read back: its time and its arrays as f32 (Int32 ones
+/// converted), the points under the name `position`.
+#[derive(Debug, Clone, Default)]
+pub struct Vtu {
+    pub t: f64,
+    pub n: usize,
+    /// (name, components, values).
+    pub arrays: Vec<(String, usize, Vec<f32>)>,
+}
+
+impl Vtu {
+    /// The array `name` and its number of components.
+    pub fn get(&self, name: &str) -> Option<(&[f32], usize)> {
+        self.arrays
+            .iter()
+            .find(|a| a.0 == name)
+            .map(|a| (a.2.as_slice(), a.1))
+    }
+}
+
+/// Reads a .vtu that `particles_vtu` wrote (raw appended data, UInt64
+/// headers). Errors say what is missing.
+pub fn read_vtu(bytes: &[u8]) -> std::result::Result<Vtu, String> {
+    let marker = b"<AppendedData encoding=\"raw\">";
+    let at = bytes
+        .windows(marker.len())
+        .position(|w| w == marker)
+        .ok_or("no raw appended data (not a file lme-mpm wrote)")?;
+    let header = std::str::from_utf8(&bytes[..at]).map_err(|_| "header is not UTF-8")?;
+    let data = at
+        + marker.len()
+        + bytes[at + marker.len()..]
+            .iter()
+            .position(|&b| b == b'_')
+            .ok_or("appended data without its '_' mark")?
+        + 1;
+    let attr = |tag: &str, key: &str| -> Option<String> {
+        let k = tag.find(&format!("{key}=\""))? + key.len() + 2;
+        let end = tag[k..].find('"')? + k;
+        Some(tag[k..end].to_string())
+    };
+    let mut out = Vtu::default();
+    if let Some(k) = header.find("NumberOfPoints=\"") {
+        let rest = &header[k + 16..];
+        out.n = rest[..rest.find('"').unwrap_or(0)]
+            .parse()
+            .map_err(|_| "bad NumberOfPoints")?;
+    }
+    if let Some(k) = header.find("Name=\"TimeValue\"") {
+        let rest = &header[k..];
+        let (a, b) = (rest.find('>'), rest.find("</DataArray>"));
+        if let (Some(a), Some(b)) = (a, b) {
+            out.t = rest[a + 1..b].trim().parse().unwrap_or(0.0);
+        }
+    }
+    for tag in header.split("<DataArray ").skip(1) {
+        let tag = &tag[..tag.find("/>").unwrap_or(tag.len())];
+        let (Some(ty), Some(name), Some(off)) =
+            (attr(tag, "type"), attr(tag, "Name"), attr(tag, "offset"))
+        else {
+            continue;
+        };
+        let comps: usize = attr(tag, "NumberOfComponents")
+            .map_or(Ok(1), |c| c.parse())
+            .map_err(|_| "bad NumberOfComponents")?;
+        let off: usize = off.parse().map_err(|_| "bad offset")?;
+        let start = data + off;
+        let len_bytes = bytes.get(start..start + 8).ok_or("array past the end")?;
+        let len = u64::from_le_bytes(len_bytes.try_into().expect("8 bytes")) as usize;
+        let raw = bytes
+            .get(start + 8..start + 8 + len)
+            .ok_or("array past the end")?;
+        let values: Vec<f32> = match ty.as_str() {
+            "Float32" => raw
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
+                .collect(),
+            "Int32" => raw
+                .chunks_exact(4)
+                .map(|c| i32::from_le_bytes(c.try_into().expect("4 bytes")) as f32)
+                .collect(),
+            _ => continue,
+        };
+        out.arrays.push((name, comps, values));
+    }
+    match out.get("position") {
+        Some((v, 3)) if v.len() == 3 * out.n => Ok(out),
+        _ => Err("no position array of NumberOfPoints points".into()),
+    }
+}
+
+/// Reads a .pvd collection: its (time, file) entries, files relative to it.
+pub fn read_pvd(text: &str) -> Vec<(f64, String)> {
+    text.split("<DataSet ")
+        .skip(1)
+        .filter_map(|tag| {
+            let get = |key: &str| {
+                let k = tag.find(&format!("{key}=\""))? + key.len() + 2;
+                Some(tag[k..k + tag[k..].find('"')?].to_string())
+            };
+            Some((get("timestep")?.parse().ok()?, get("file")?))
+        })
+        .collect()
 }
 
 /// ParaView collection listing `(time, file)` snapshots.

@@ -85,7 +85,10 @@ pub struct StudyOptions {
     pub jobs: usize,
     /// Markdown file whose study sections are regenerated (full runs only).
     pub doc: Option<PathBuf>,
+    /// A progress bar (on a terminal).
     pub progress: bool,
+    /// A line on stderr per finished run (off a terminal, for logs).
+    pub progress_lines: bool,
 }
 
 /// What a study produced.
@@ -200,10 +203,16 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Implicit => implicit::jobs(opts.quick),
             StudyName::All => unreachable!(),
         };
-        if opts.progress {
+        if opts.progress || opts.progress_lines {
             crate::say!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
-        let results = runner::run_jobs(jobs, opts.jobs, opts.progress);
+        let label = format!("study {}", n.slug());
+        let results = runner::run_jobs(
+            jobs,
+            opts.jobs,
+            opts.progress,
+            opts.progress_lines.then_some(label.as_str()),
+        );
         let records: Vec<Record> = results.iter().map(Record::from_job).collect();
         crate::output::write_atomic(
             &dir.join("results.csv"),
@@ -220,7 +229,10 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
-        crate::output::write_atomic(&dir.join("report.md"), markdown.as_bytes())?;
+        // The charts sit beside report.md; the markdown links them in
+        // `charts/` as the docs keep them.
+        let local = markdown.replace("](charts/", "](");
+        crate::output::write_atomic(&dir.join("report.md"), local.as_bytes())?;
         if let (Some(doc), false) = (&opts.doc, opts.quick) {
             publish(doc, n, &markdown, &charts)?;
         }

@@ -135,12 +135,16 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
 /// error, the block's settlement error.
 fn error_figure(r: &JobResult) -> Option<String> {
     match r.data()?.errors.as_ref()? {
-        Errors::Mms(e) => Some(format!("u {}", sig(e.rms_displacement))),
-        Errors::Dyka(e) => Some(format!("rms {}", sig(e.rms_velocity_relative))),
-        Errors::Column(e) => Some(format!("settle {}", sig(e.settlement_rel_error))),
-        Errors::Sliding(e) => Some(format!("v {}", sig(e.velocity_rel_error))),
-        Errors::Rolling(e) => Some(format!("u_x {}", sig(e.u_x_rel_error))),
-        Errors::Cantilever(e) => Some(format!("tip {}", sig(e.rel_error_timoshenko))),
+        // Relative errors as percentages, so each cell says what it holds.
+        Errors::Mms(e) => Some(format!("u err {} m", sig(e.rms_displacement))),
+        Errors::Dyka(e) => Some(format!("v err {} %", sig(100.0 * e.rms_velocity_relative))),
+        Errors::Column(e) => Some(format!(
+            "settle err {} %",
+            sig(100.0 * e.settlement_rel_error)
+        )),
+        Errors::Sliding(e) => Some(format!("v err {} %", sig(100.0 * e.velocity_rel_error))),
+        Errors::Rolling(e) => Some(format!("u_x err {} %", sig(100.0 * e.u_x_rel_error))),
+        Errors::Cantilever(e) => Some(format!("tip err {} %", sig(100.0 * e.rel_error_timoshenko))),
     }
 }
 
@@ -186,7 +190,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         "Every shape function (Q4, uGIMP, LME γ = 3) with both integrators, on Dyka's bar, the elastic block, \
          the plate impact at several cell sizes, regular and perturbed (0.2 h) grids, and the two large-deformation \
          scenes of the implicit-MPM paper (the rolling disk and the Mohr–Coulomb column collapse): {n} runs, {} \
-         completed, {} not. Each completed cell shows the error where an exact solution exists (Dyka: RMS \
+         completed, {} not. Each completed cell shows the error in percent where an exact solution exists (Dyka: RMS \
          velocity error over the impact speed; block: settlement error; disk: relative error of the centre's \
          displacement at t_end).{}\n",
         n - failed.len(),

@@ -75,6 +75,33 @@ fn unit(key: &str) -> &'static str {
     }
 }
 
+/// The unit of an error figure, from its name (summary.json's and the
+/// sweep's `ref_*` figures): relative ones are fractions of the field's
+/// scale; absolute ones in m, m/s or Pa.
+pub fn metric_label(name: &str) -> String {
+    let unit = if name.ends_with("_relative") || name.contains("rel_error") {
+        "relative to the field's scale, 1 = 100 %"
+    } else if name.contains("velocity") || name.contains("_v_") || name.starts_with("v_") {
+        "m/s"
+    } else if name.contains("stress") || name.contains("sigma") {
+        "Pa"
+    } else if name.contains("displacement")
+        || name.contains("settlement")
+        || name.contains("deflection")
+        || name.contains("_u_")
+        || name.starts_with("u_")
+    {
+        "m"
+    } else {
+        ""
+    };
+    if unit.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name} ({unit})")
+    }
+}
+
 /// Writes sweep.csv, the charts and sweep.md into `dir`.
 pub fn write(
     plan: &Plan,
@@ -218,7 +245,7 @@ pub fn write(
         if curves.iter().any(|c| !c.points.is_empty()) {
             let (f, front) = report::front_chart(
                 &format!("{}: {m} against wall time", plan.scene_name),
-                m,
+                &metric_label(m),
                 &curves,
                 &dir.join("sweep-front"),
             )?;
@@ -250,7 +277,7 @@ pub fn write(
                 let (f, orders) = report::convergence_chart(
                     &format!("{}: {m} against {res}", plan.scene_name),
                     &format!("{res}{}", unit(res)),
-                    m,
+                    &metric_label(m),
                     &curves,
                     &dir.join("sweep-convergence"),
                 )?;
@@ -334,4 +361,21 @@ pub fn write(
         metric,
         files,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_figures_carry_their_units() {
+        assert_eq!(metric_label("rms_velocity"), "rms_velocity (m/s)");
+        assert!(metric_label("rms_velocity_relative").contains("relative"));
+        assert_eq!(metric_label("ref_probe_u_rms"), "ref_probe_u_rms (m)");
+        assert_eq!(
+            metric_label("ref_probe_stress_rms"),
+            "ref_probe_stress_rms (Pa)"
+        );
+        assert_eq!(metric_label("settlement_top"), "settlement_top (m)");
+    }
 }

@@ -349,9 +349,19 @@ pub fn run_parallel<T: Sync, R: Send>(
     results.into_inner().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Runs a study's `jobs` on `n_workers` threads; results come back in job order.
-pub fn run_jobs(jobs: Vec<Job>, n_workers: usize, progress: bool) -> Vec<JobResult> {
+/// Runs a study's `jobs` on `n_workers` threads; results come back in job
+/// order. `progress`: the bar (a terminal); `lines`: one line on stderr per
+/// finished run, for logs (`name` starts it).
+pub fn run_jobs(
+    jobs: Vec<Job>,
+    n_workers: usize,
+    progress: bool,
+    lines: Option<&str>,
+) -> Vec<JobResult> {
     let bar = progress_bar(jobs.len(), progress);
+    let done = AtomicUsize::new(0);
+    let start = Instant::now();
+    let n = jobs.len();
     let outcomes = run_parallel(
         &jobs,
         Split::new(n_workers, jobs.len()),
@@ -359,7 +369,22 @@ pub fn run_jobs(jobs: Vec<Job>, n_workers: usize, progress: bool) -> Vec<JobResu
         |j| j.label.clone(),
         |j| j.backend != BackendChoice::Cpu,
         None,
-        run_one,
+        |job, threads| {
+            let r = run_one(job, threads);
+            if let Some(name) = lines {
+                let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+                let how = match &r {
+                    Ok(d) => d.status_text(),
+                    Err(e) => format!("failed: {e}"),
+                };
+                eprintln!(
+                    "{name}: {k}/{n} runs done ({:.0} s); {} {how}",
+                    start.elapsed().as_secs_f64(),
+                    job.label
+                );
+            }
+            r
+        },
         |_, msg| Err(format!("the run panicked: {msg}")),
     );
     bar.finish_and_clear();
