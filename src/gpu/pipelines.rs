@@ -36,6 +36,9 @@ pub enum Pass {
     /// component of the stencil.
     P2gPatch,
     MlsP2g,
+    /// Walls only: the walls each node touches (wall_touch.wgsl), before
+    /// `GridPredict`.
+    WallTouch,
     GridPredict,
     Stress,
     /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
@@ -78,7 +81,7 @@ enum Domain {
 }
 
 impl Pass {
-    pub const ALL: [Pass; 26] = [
+    pub const ALL: [Pass; 27] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -91,6 +94,7 @@ impl Pass {
         Pass::P2gGather,
         Pass::P2gPatch,
         Pass::MlsP2g,
+        Pass::WallTouch,
         Pass::GridPredict,
         Pass::Stress,
         Pass::Forces,
@@ -115,6 +119,7 @@ impl Pass {
             Pass::ClearGrid => "clear_grid.wgsl",
             Pass::LmeNewton => "lme_newton.wgsl",
             Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
+            Pass::WallTouch => "wall_touch.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
@@ -174,7 +179,8 @@ impl Pass {
             Stage::Forces if plan.mls => &[Pass::MlsForces],
             Stage::Forces if plan.gather => &[Pass::ForcesGather],
             Stage::Forces if plan.patch => &[Pass::ForcesPatch],
-            Stage::GridPredict => &[Pass::GridPredict],
+            // `WallTouch` is built only with walls (`Variant::uses`).
+            Stage::GridPredict => &[Pass::WallTouch, Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect => &[Pass::GridCorrect],
@@ -228,7 +234,8 @@ pub struct Variant {
     pub mms: bool,
     /// MLS reconstruction at Gauss points.
     pub mls: bool,
-    /// Rigid walls (the `Walls` and `WallMask` buffers).
+    /// Rigid walls (the `Walls`, `WallMask` and `WallTouch` buffers, the
+    /// `WallTouch` pass).
     pub walls: bool,
     /// Tractions or point loads (the `ExtForce` buffer).
     pub ext_force: bool,
@@ -375,6 +382,7 @@ impl Variant {
             Pass::RemapClear => self.integrator == Integrator::Musl,
             Pass::Remap => self.integrator == Integrator::Musl && !self.mls,
             Pass::MlsRemap => self.integrator == Integrator::Musl && self.mls,
+            Pass::WallTouch => self.walls,
             _ => true,
         }
     }

@@ -128,6 +128,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ),
     ("p2g.wgsl", include_str!("../../shaders/p2g.wgsl")),
     (
+        "wall_touch.wgsl",
+        include_str!("../../shaders/wall_touch.wgsl"),
+    ),
+    (
         "grid_update.wgsl",
         include_str!("../../shaders/grid_update.wgsl"),
     ),
