@@ -264,7 +264,6 @@ fn disk_quick_rolls_on_friction_and_on_stick() {
         lme_mpm::study::disk::error_percent(&exact, r).unwrap()
     };
     for r in &results {
-        let m = r.job.tag_value("method").unwrap();
         assert!(r.completed(), "{}: {:?}", r.job.label, r.outcome);
         let e = lme_mpm::study::disk::error_percent(&exact, r).unwrap();
         assert!(e < DISK_QUICK_ERROR_BOUND, "{}: error {e} %", r.job.label);
