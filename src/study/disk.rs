@@ -308,7 +308,8 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
          reaches (docs/methods.md, \"Walls\"), but at those nodes the rule is decided per node from its \
          velocity: ahead of the contact the nodes approach and are held, behind it they lift off and are \
          released, so the wall's normal force sits about a cell ahead of the contact point and acts as a \
-         rolling resistance of the order of h/R (first order in h).{}\n",
+         rolling resistance of the order of h/R (first order in h on a grid-aligned floor, \
+         docs/methods.md; on this inclined plane see the finer run).{}\n",
         last + 1,
         spread.join("; "),
         match (
