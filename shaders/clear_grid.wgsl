@@ -1,9 +1,13 @@
-// Stage `clear_grid`: zero the nodal accumulators and the reactions.
+// Stage `clear_grid`: zero the nodal accumulators and the reactions (and,
+// with walls, the nodes' touch bits, which the CPU's `wall_touch` zeroes).
 // CPU twin: src/cpu/clear_grid.rs.
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
 @group(0) @binding({{B_REACTIONS}}) var<storage, read_write> reactions: array<f32>;
+#if WALLS
+@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<u32>;
+#endif
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -21,4 +25,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var k = 0u; k < NODE_STRIDE; k++) {
         node_acc[n * NODE_STRIDE + k] = 0.0;
     }
+#if WALLS
+    wall_touch[n] = 0u;
+#endif
 }

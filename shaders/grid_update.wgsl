@@ -1,6 +1,6 @@
 // Stage `grid_update`, two entry points around the force computation.
 // `predict`: v_I = q_I / m_I, then each wall's contact rule (the walls the
-// node is behind, in scene order), then the fixed components set to their
+// node is behind and touches, `wall_touch.wgsl`, in scene order), then the fixed components set to their
 // constraint's prescribed velocity at the step's end (zero by default): a
 // constraint wins over a wall.
 // `correct`: reactions (−f on fixed components, summed per constraint),
@@ -14,6 +14,7 @@
 #if WALLS
 @group(0) @binding({{B_WALLS}}) var<storage, read> walls: array<Wall>;
 @group(0) @binding({{B_WALL_MASK}}) var<storage, read> wall_mask: array<u32>;
+@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read> wall_touch: array<u32>;
 #endif
 #if CORRECT
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
@@ -36,17 +37,18 @@ fn fix_bits(i: u32, j: u32) -> u32 {
 }
 
 #if WALLS
-// A wall's contact rule on node velocity v (CPU twin: `wall_velocity`):
-// stick stops it; slip removes an approaching normal component (v·n < 0);
-// friction also takes μ Δv_n (Δv_n = −v·n) off the tangential speed, or
-// stops it when that speed is at most μ Δv_n.
+// A wall's contact rule on the velocity v of a node in contact (CPU twin:
+// `wall_velocity`): separating or resting (v·n ≥ 0) is free; approaching,
+// stick stops it, slip removes the normal component, friction also takes
+// μ Δv_n (Δv_n = −v·n) off the tangential speed, or stops it when that
+// speed is at most μ Δv_n.
 fn wall_velocity(v: vec2<f32>, w: Wall) -> vec2<f32> {
-    if w.contact == CONTACT_STICK {
-        return vec2<f32>(0.0);
-    }
     let vn = dot(v, w.normal);
     if vn >= 0.0 {
         return v;
+    }
+    if w.contact == CONTACT_STICK {
+        return vec2<f32>(0.0);
     }
     let vt = v - vn * w.normal;
     if w.contact != CONTACT_FRICTION {
@@ -119,7 +121,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let gdt = params.npc_gamma * sim.dt;
         var v = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f;
 #if WALLS
-        let mask = wall_mask[n];
+        let mask = wall_mask[n] & wall_touch[n];
         for (var k = 0u; mask != 0u && k < arrayLength(&walls); k++) {
             if (mask & (1u << k)) == 0u {
                 continue;
@@ -153,7 +155,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if m > params.mass_eps {
         vel = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) / m;
 #if WALLS
-        let mask = wall_mask[n];
+        let mask = wall_mask[n] & wall_touch[n];
         for (var k = 0u; mask != 0u && k < arrayLength(&walls); k++) {
             if (mask & (1u << k)) != 0u {
                 vel = wall_velocity(vel, walls[k]);

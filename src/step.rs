@@ -118,6 +118,9 @@ pub enum Pass {
     /// component of the stencil.
     P2gPatch,
     MlsP2g,
+    /// Walls only: the walls each node touches (wall_touch.wgsl), before
+    /// `GridPredict`.
+    WallTouch,
     GridPredict,
     Stress,
     /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
@@ -147,7 +150,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 26] = [
+    pub const ALL: [Pass; 27] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -160,6 +163,7 @@ impl Pass {
         Pass::P2gGather,
         Pass::P2gPatch,
         Pass::MlsP2g,
+        Pass::WallTouch,
         Pass::GridPredict,
         Pass::Stress,
         Pass::Forces,
@@ -184,6 +188,7 @@ impl Pass {
             Pass::ClearGrid => "clear_grid.wgsl",
             Pass::LmeNewton => "lme_newton.wgsl",
             Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
+            Pass::WallTouch => "wall_touch.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
@@ -215,6 +220,8 @@ pub struct PlanInputs {
     pub gather: bool,
     /// `p2g` and `forces` scatter per bin of particles binned in `shape_eval`.
     pub patch: bool,
+    /// Rigid walls: the nodes they act on are found before `GridPredict`.
+    pub walls: bool,
 }
 
 /// The step of one scene, for both backends.
@@ -245,6 +252,7 @@ impl StepPlan {
             musl: model.integrator == Integrator::Musl,
             gather,
             patch,
+            walls: !model.walls.is_empty(),
         })
     }
 
@@ -296,6 +304,7 @@ impl StepPlan {
             mls,
             gather,
             patch,
+            walls,
             ..
         } = self.inputs;
         match stage {
@@ -314,6 +323,7 @@ impl StepPlan {
             Stage::Forces if mls => &[Pass::MlsForces],
             Stage::Forces if gather => &[Pass::ForcesGather],
             Stage::Forces if patch => &[Pass::ForcesPatch],
+            Stage::GridPredict if walls => &[Pass::WallTouch, Pass::GridPredict],
             Stage::GridPredict => &[Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
@@ -348,6 +358,7 @@ mod tests {
             musl,
             gather,
             patch,
+            walls: lme,
         })
     }
 
@@ -395,6 +406,7 @@ mod tests {
             assert_eq!(p.gpu_step[..2], [Pass::Cfl, Pass::StepBegin]);
             assert_eq!(p.gpu_uses(Pass::LmeNewton), lme, "{bits:05b}");
             assert_eq!(p.gpu_uses(Pass::RemapClear), musl, "{bits:05b}");
+            assert_eq!(p.gpu_uses(Pass::WallTouch), p.inputs.walls, "{bits:05b}");
         }
     }
 }

@@ -1,8 +1,9 @@
 //! Walls, prescribed velocities, tractions and point loads against exact
 //! answers: the wall rules on an inclined normal, a block sliding on a
 //! frictional plane (both geometries, sliding and at rest; CPU and GPU), a
-//! suddenly loaded bar (stress behind the front) and a column under a
-//! surcharge and its weight (σ_yy = −p − ρ0 g (H − Y)).
+//! suddenly loaded bar (stress behind the front), a column under a
+//! surcharge and its weight (σ_yy = −p − ρ0 g (H − Y)), and a disk rolling
+//! on friction and stick walls on a grid line.
 
 mod common;
 
@@ -297,4 +298,78 @@ fn column_with_a_surcharge_matches_the_exact_stress() {
         assert!(worst < COLUMN_TOL, "{sets:?}: {worst}");
         assert!((ry / load - 1.0).abs() < COLUMN_TOL, "{sets:?}: {ry}");
     }
+}
+
+/// A disk (R = 0.5 m, Neo-Hookean, ρ = 7800 kg/m³, E = 200 MPa) at rest on
+/// a level wall on a grid line, gravity tilted by 30°: R/h = 10, linear,
+/// NPC, to t = 0.5 s (issue 23's coarse case).
+const DISK_ON_A_GRID_LINE: &str = r#"
+exact = "rolling_disk"
+[grid]
+h = 0.05
+min = [-0.6, -0.3]
+max = [1.4, 1.3]
+[materials.steel_like]
+model = "neo_hookean"
+density = 7800.0
+E = 2e8
+nu = 0.3
+[bodies.disk]
+material = "steel_like"
+ppc = 2
+disks = [[0.0, 0.5, 0.5]]
+[walls.floor]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+contact = "friction"
+friction = 0.5
+[gravity]
+g = [4.905, -8.495709211]
+[solver]
+shape = "linear"
+cfl = 0.3
+t_end = 0.5
+[output]
+sample_interval = 0.1
+"#;
+
+/// The disk's centre displacement at 0.5 s within 20 % of the exact
+/// rolling distance (a = (2/3) g sin θ). Measured 17.5 % on the friction
+/// wall and 18.1 % on the stick wall (2026-11-25); before the walls acted
+/// only on the nodes the body touches, 49.6 % (every node behind the wall
+/// under the disk's lower cells was held) and the stick wall glued it.
+/// What is left is the node rule's rolling resistance (docs/methods.md,
+/// "Walls"); issue 23's 5 % is not met.
+const DISK_R10_BOUND: f64 = 0.20;
+/// Most the stick wall's relative error may differ from the friction
+/// wall's: both hold the contact without slip (μ = 0.5 > tan θ / 3), so
+/// the disk must roll alike on both. Measured 0.6 points.
+const DISK_STICK_GAP: f64 = 0.02;
+
+#[test]
+fn disk_rolls_on_friction_and_stick_walls_on_a_grid_line() {
+    let rolled = |text: &str| {
+        let scene = scene_of(text, &[]);
+        let model = Model::new(&scene).unwrap();
+        let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
+        match sim.score().unwrap() {
+            Some(Errors::Rolling(e)) => e,
+            other => panic!("not a rolling score: {other:?}"),
+        }
+    };
+    let friction = rolled(DISK_ON_A_GRID_LINE);
+    // `friction` is refused on a stick wall, and an override cannot remove
+    // a key: the stick wall's scene text.
+    let stick = rolled(&DISK_ON_A_GRID_LINE.replace(
+        "contact = \"friction\"\nfriction = 0.5",
+        "contact = \"stick\"",
+    ));
+    println!("friction {friction:?}\nstick {stick:?}");
+    for (law, e) in [("friction", &friction), ("stick", &stick)] {
+        assert!(e.u_x_rel_error < DISK_R10_BOUND, "{law}: {e:?}");
+    }
+    assert!(
+        (stick.u_x_rel_error - friction.u_x_rel_error).abs() < DISK_STICK_GAP,
+        "stick {stick:?} against friction {friction:?}"
+    );
 }

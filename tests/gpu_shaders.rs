@@ -221,7 +221,7 @@ fn every_pass_validates_in_every_variant() {
                 "{pass:?} {v:?}: cell bins without MLS, gather or patch"
             );
             assert!(
-                !(has(Buf::Walls) || has(Buf::WallMask)) || v.walls,
+                !(has(Buf::Walls) || has(Buf::WallMask) || has(Buf::WallTouch)) || v.walls,
                 "{pass:?} {v:?}: wall buffers without walls"
             );
             assert!(
@@ -230,6 +230,7 @@ fn every_pass_validates_in_every_variant() {
             );
             if v.walls && matches!(pass, Pass::GridPredict | Pass::GridCorrect) {
                 assert!(has(Buf::WallMask), "{pass:?} {v:?}: walls unread");
+                assert!(has(Buf::WallTouch), "{pass:?} {v:?}: touch bits unread");
             }
             if v.ext_force && matches!(pass, Pass::Forces | Pass::ForcesGather) {
                 assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");
@@ -257,6 +258,7 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::MlsForces
             | Pass::Remap
             | Pass::MlsRemap
+            | Pass::WallTouch
     )
 }
 

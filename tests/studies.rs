@@ -245,12 +245,19 @@ fn mms_quick_every_method_converges_or_reports_why_not() {
 }
 
 /// Bound on the quick disk study's eq. 67 error (percent) on a frictional
-/// wall at R/h = 20: the wall's grid contact drags on a patch of width
-/// about sqrt(2 R h); measured 6–8 % over 0.2 s on 2026-11-23.
+/// or stick wall at R/h = 20: the wall's node rule puts its normal force
+/// about a cell ahead of the contact (docs/methods.md, "Walls"); before
+/// the walls acted only where the body touches them, 6–8 % over 0.2 s
+/// (2026-11-23); the stick wall then glued the disk (53 %).
 const DISK_QUICK_ERROR_BOUND: f64 = 10.0;
 
+/// Most the stick wall's error may differ from the frictional wall's
+/// (percentage points): both hold the contact without slip (μ = 0.5 is
+/// above the tan θ / 3 rolling needs), so the disk rolls alike on both.
+const DISK_STICK_FRICTION_GAP: f64 = 2.0;
+
 #[test]
-fn disk_quick_rolls_and_a_stick_wall_glues() {
+fn disk_quick_rolls_on_friction_and_on_stick() {
     let (results, md, _) = run(StudyName::Disk);
     assert!(md.contains("study-disk-error-time.png"));
     let exact = {
@@ -273,20 +280,14 @@ fn disk_quick_rolls_and_a_stick_wall_glues() {
         lme_mpm::study::disk::error_percent(&exact, r).unwrap()
     };
     for r in &results {
-        let m = r.job.tag_value("method").unwrap();
         assert!(r.completed(), "{}: {:?}", r.job.label, r.outcome);
         let e = lme_mpm::study::disk::error_percent(&exact, r).unwrap();
-        if m != "linear-stick" {
-            assert!(e < DISK_QUICK_ERROR_BOUND, "{}: error {e} %", r.job.label);
-        }
+        assert!(e < DISK_QUICK_ERROR_BOUND, "{}: error {e} %", r.job.label);
     }
-    // The stick wall holds the disk's lower patch still, so it lags far
-    // behind: measured 53 % against 6 % on the frictional wall (2026-11-23);
-    // a quarter of that ratio still tells glued from rolling.
     let (stick, friction) = (error_of("linear-stick"), error_of("linear"));
     assert!(
-        stick > 4.0 * friction,
-        "a stick wall should glue the disk: error {stick} % against {friction} % on friction"
+        (stick - friction).abs() < DISK_STICK_FRICTION_GAP,
+        "a stick wall should let the disk roll as friction does: error {stick} % against {friction} %"
     );
 }
 

@@ -1,7 +1,10 @@
 //! Stage `grid_update`, in two passes around the force computation.
+//! `wall_touch` (walls only, before `predict`): the walls each node is in
+//! contact with, from where the body is: a node touches wall k when a
+//! particle whose domain reaches the wall line holds it in its stencil.
 //! `predict`: nodal velocity from the scattered momentum, v_I = q_I / m_I,
-//! then the walls' contact rules (each wall the node is behind, in scene
-//! order), then the Dirichlet conditions (fixed components set to the
+//! then the walls' contact rules (each wall the node is behind and
+//! touches, in scene order), then the Dirichlet conditions (fixed components set to the
 //! constraint's prescribed velocity at the step's end, zero by default):
 //! a constraint wins over a wall.
 //! `correct`: reactions on fixed nodes, their force components zeroed, then
@@ -10,8 +13,10 @@
 //! corrected velocity, whose change Δv becomes the wall's force
 //! m Δv / (γ Δt), added to f_I (so the particles feel it) and to the wall's
 //! reaction. Fixed components keep their prescribed value.
-//! GPU twin: `shaders/grid_update.wgsl` (entry points `predict`, `correct`).
+//! GPU twin: `shaders/grid_update.wgsl` (built without and with `CORRECT`)
+//! and `shaders/wall_touch.wgsl`.
 
+use super::ShapeCache;
 use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
 use rayon::prelude::*;
@@ -28,20 +33,22 @@ fn zero_fixed(v: &mut [f64], fix: u8) {
     }
 }
 
-/// A wall's contact rule on a node velocity `v` (m/s): stick stops it;
-/// slip removes the normal component when it points into the wall
-/// (v·n < 0) and leaves separation free; friction does that and applies
-/// Coulomb's law with the normal velocity change Δv_n = −v·n as the
-/// impulse per unit mass: a tangential velocity |v_t| ≤ μ Δv_n stops,
-/// a larger one loses μ Δv_n along −v_t/|v_t|.
+/// A wall's contact rule on a node velocity `v` (m/s), for a node in
+/// contact: a separating or resting velocity (v·n ≥ 0) is free under every
+/// law; an approaching one loses its normal component, and then stick
+/// stops it (no slip where in contact, so a disk can roll: the nodes that
+/// lift off behind the contact are released), slip keeps the tangential
+/// part, and friction applies Coulomb's law with the normal velocity
+/// change Δv_n = −v·n as the impulse per unit mass: a tangential velocity
+/// |v_t| ≤ μ Δv_n stops, a larger one loses μ Δv_n along −v_t/|v_t|.
 #[inline]
 pub fn wall_velocity(v: [f64; 2], normal: [f64; 2], contact: u32, mu: f64) -> [f64; 2] {
-    if contact == CONTACT_STICK {
-        return [0.0, 0.0];
-    }
     let vn = v[0] * normal[0] + v[1] * normal[1];
     if vn >= 0.0 {
         return v;
+    }
+    if contact == CONTACT_STICK {
+        return [0.0, 0.0];
     }
     let vt = [v[0] - vn * normal[0], v[1] - vn * normal[1]];
     if contact != CONTACT_FRICTION {
@@ -67,6 +74,60 @@ fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
     v
 }
 
+/// Per node, the bit set of the walls it touches (bit k = wall k): the
+/// nodes of the stencil (weight > 0) of every particle p whose domain
+/// reaches the wall line, (x_p − point)·n − l_p (|n_x| + |n_y|) ≤ s l_p
+/// (s = `WALL_TOUCH_SLACK`), with
+/// l_p = ½ sqrt(m_p / ρ_p) the half-width of its (square) domain. A node
+/// behind a wall that no touching particle reaches is free: the body is
+/// not at the wall there, whatever its velocity (before, every node
+/// behind the wall that held mass got the rule, so the patch of about
+/// sqrt(2 R h) under a disk dragged on it; docs/methods.md, "Walls").
+/// `touch` is zeroed first (its GPU twin is zeroed by `clear_grid`).
+pub fn wall_touch(
+    cache: &ShapeCache,
+    x: &[[f64; 2]],
+    mass: &[f64],
+    rho: &[f64],
+    walls: &Walls,
+    touch: &mut [u32],
+) {
+    touch.fill(0);
+    for p in 0..x.len() {
+        let bits = touching_walls(x[p], mass[p], rho[p], &walls.list);
+        if bits == 0 {
+            continue;
+        }
+        let (nodes, w) = cache.particle(p);
+        for (&n, wk) in nodes.iter().zip(w) {
+            if wk[0] > 0.0 {
+                touch[n as usize] |= bits;
+            }
+        }
+    }
+}
+
+/// Slack of the touch test, relative to the particle's half-width: a
+/// domain whose edge lies on the line (a body seeded against a wall with
+/// the uniform layout) touches it on both backends, whatever the f32
+/// round-off of the GPU's positions (about 1e-7 of the grid's size).
+pub const WALL_TOUCH_SLACK: f64 = 1e-3;
+
+/// The walls (bit k = wall k) that the domain of a particle at `x` (m)
+/// with mass `m` and density `rho` reaches.
+#[inline]
+pub fn touching_walls(x: [f64; 2], m: f64, rho: f64, walls: &[Wall]) -> u32 {
+    let lp = 0.5 * (m / rho).sqrt();
+    let mut bits = 0;
+    for (k, w) in walls.iter().enumerate() {
+        let d = (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1];
+        if d - lp * (w.normal[0].abs() + w.normal[1].abs()) <= WALL_TOUCH_SLACK * lp {
+            bits |= 1 << k;
+        }
+    }
+    bits
+}
+
 /// Prescribed velocities at time `t` (s) on the fixed components of the
 /// groups that move (later groups win on shared nodes); nodes without
 /// mass stay at rest.
@@ -87,12 +148,14 @@ fn prescribe(mv: &mut [[f64; 3]], groups: &[ConstraintGroup], t: f64, mass_eps: 
     }
 }
 
-/// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end time (s).
+/// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end
+/// time (s); `touch` is `wall_touch`'s (empty without walls).
 pub fn predict(
     mv: &mut [[f64; 3]],
     fix: &[u8],
     groups: &[ConstraintGroup],
     walls: &Walls,
+    touch: &[u32],
     t: f64,
     mass_eps: f64,
 ) {
@@ -105,6 +168,7 @@ pub fn predict(
             if n[0] > mass_eps {
                 let mut v = [n[1] / n[0], n[2] / n[0]];
                 if let Some(&mask) = walls.mask.get(i) {
+                    let mask = mask & touch[i];
                     if mask != 0 {
                         v = walls_velocity(v, mask, wl);
                     }
@@ -120,8 +184,9 @@ pub fn predict(
 
 /// Records reactions per constraint group (the force the support exerts,
 /// −f_I on each fixed component), zeroes those components, corrects the
-/// velocities by `gamma_dt` · f/m, then applies the walls. `reactions`
-/// holds the constraint groups' then the walls'.
+/// velocities by `gamma_dt` · f/m, then applies the walls on the nodes
+/// that touch them (`touch`, as in `predict`). `reactions` holds the
+/// constraint groups' then the walls'.
 #[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
@@ -129,6 +194,7 @@ pub fn correct(
     fix: &[u8],
     groups: &[ConstraintGroup],
     walls: &Walls,
+    touch: &[u32],
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
     mass_eps: f64,
@@ -165,7 +231,8 @@ pub fn correct(
     }
     // Each wall's velocity change on its nodes, one wall after another in
     // scene order (a node behind two walls gets both), as on the GPU.
-    for (node, &mask) in walls.mask.iter().enumerate() {
+    for (node, (&mask, &t)) in walls.mask.iter().zip(touch).enumerate() {
+        let mask = mask & t;
         let n = &mut mv[node];
         if mask == 0 || n[0] <= mass_eps {
             continue;
@@ -207,8 +274,36 @@ mod tests {
     const N: [f64; 2] = [0.0, 1.0];
 
     #[test]
-    fn stick_stops() {
-        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_STICK, 0.0), [0.0, 0.0]);
+    fn stick_stops_approach_and_frees_separation() {
+        assert_eq!(
+            wall_velocity([1.0, -2.0], N, CONTACT_STICK, 0.0),
+            [0.0, 0.0]
+        );
+        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_STICK, 0.0), [1.0, 2.0]);
+    }
+
+    #[test]
+    fn touch_from_the_particle_domain() {
+        let wall = Wall {
+            name: "w".into(),
+            point: [0.0, 0.0],
+            normal: N,
+            contact: CONTACT_STICK,
+            mu: 0.0,
+            nodes: Vec::new(),
+        };
+        // Domain 0.1 m wide (m / ρ = 0.01): it reaches the line from 0.05 m.
+        let walls = [
+            wall.clone(),
+            Wall {
+                point: [0.0, -1.0],
+                ..wall
+            },
+        ];
+        assert_eq!(touching_walls([0.3, 0.05], 10.0, 1000.0, &walls), 1);
+        assert_eq!(touching_walls([0.3, 0.05004], 10.0, 1000.0, &walls), 1);
+        assert_eq!(touching_walls([0.3, 0.0501], 10.0, 1000.0, &walls), 0);
+        assert_eq!(touching_walls([0.3, -0.96], 10.0, 1000.0, &walls), 3);
     }
 
     #[test]

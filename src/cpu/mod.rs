@@ -65,6 +65,9 @@ pub struct CpuBackend {
     pub force: Vec<[f64; 2]>,
     /// Per constraint group: reaction (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
+    /// Per node: the walls it touches this step (`grid_update::wall_touch`);
+    /// empty without walls.
+    pub wall_touch: Vec<u32>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -88,6 +91,11 @@ impl CpuBackend {
             mv: vec![[0.0; 3]; nodes],
             force: vec![[0.0; 2]; nodes],
             reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
+            wall_touch: if model.walls.is_empty() {
+                Vec::new()
+            } else {
+                vec![0; nodes]
+            },
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -139,12 +147,12 @@ impl CpuBackend {
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
-        // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask
-        // and node lists.
+        // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask,
+        // touch bits and node lists.
         let walls = if model.walls.is_empty() {
             0.0
         } else {
-            4.0 * model.grid.n_nodes() as f64
+            8.0 * model.grid.n_nodes() as f64
                 + 4.0
                     * model
                         .walls
@@ -302,14 +310,27 @@ impl CpuBackend {
                     &mut self.p2g_scatter,
                 );
             }
-            Stage::GridPredict => grid_update::predict(
-                &mut self.mv,
-                &m.constraints.fix,
-                &m.constraints.groups,
-                &m.walls,
-                self.t + self.dt,
-                self.mass_eps,
-            ),
+            Stage::GridPredict => {
+                if !m.walls.is_empty() {
+                    grid_update::wall_touch(
+                        &self.cache,
+                        &p.x,
+                        &p.mass,
+                        &p.rho,
+                        &m.walls,
+                        &mut self.wall_touch,
+                    );
+                }
+                grid_update::predict(
+                    &mut self.mv,
+                    &m.constraints.fix,
+                    &m.constraints.groups,
+                    &m.walls,
+                    &self.wall_touch,
+                    self.t + self.dt,
+                    self.mass_eps,
+                );
+            }
             Stage::Stress => stress::stress(
                 &self.cache,
                 &self.mv,
@@ -351,6 +372,7 @@ impl CpuBackend {
                 &m.constraints.fix,
                 &m.constraints.groups,
                 &m.walls,
+                &self.wall_touch,
                 &mut self.reactions,
                 gamma * self.dt,
                 self.mass_eps,
@@ -385,11 +407,14 @@ impl CpuBackend {
                         &mut self.p2g_scatter,
                     );
                 }
+                // The walls' touch bits stay those of the step's start
+                // (`GridPredict`), as on the GPU.
                 grid_update::predict(
                     &mut self.mv,
                     &m.constraints.fix,
                     &m.constraints.groups,
                     &m.walls,
+                    &self.wall_touch,
                     self.t + self.dt,
                     self.mass_eps,
                 );

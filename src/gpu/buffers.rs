@@ -54,6 +54,8 @@ pub enum Buf {
     MlsCoef,
     Walls,
     WallMask,
+    /// Per node: the walls it touches this step (wall_touch.wgsl).
+    WallTouch,
     ExtForce,
     /// MUSL: each particle's position at the step's start (grid-relative),
     /// for the remap and the stress, which run after g2p has moved it.
@@ -61,7 +63,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 35] = [
+    pub const ALL: [Buf; 36] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -95,6 +97,7 @@ impl Buf {
         Buf::MlsCoef,
         Buf::Walls,
         Buf::WallMask,
+        Buf::WallTouch,
         Buf::ExtForce,
         Buf::XStart,
     ];
@@ -341,6 +344,7 @@ fn grid_and_output_data(
             Buf::WallMask,
             bytemuck::cast_slice(&model.walls.mask).to_vec(),
         ));
+        data.push((Buf::WallTouch, vec![0u8; 4 * g.n_nodes()]));
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
     let probe_idx = if probe_idx.is_empty() {

@@ -133,6 +133,7 @@ impl Variant {
             musl: self.integrator == Integrator::Musl,
             gather: self.gather,
             patch: self.patch,
+            walls: self.walls,
         })
     }
 
