@@ -143,55 +143,18 @@ impl DruckerPrager {
     }
 }
 
-impl super::Constitutive for DruckerPrager {
-    const NAME: &'static str = "drucker_prager";
-    const KEYS: &'static [super::Key] = plastic::YIELD_KEYS;
-    const STATE: super::StateKind = super::StateKind::Plastic;
-    const GPU_PARAMS: &'static [&'static str] = &["tension", "alpha", "alpha_psi", "k"];
-
-    fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
-        let (e, nu) = k.youngs_nu()?;
-        let (c, phi, psi, t) = plastic::yield_keys(k)?;
-        Ok(DruckerPrager::new(e, nu, k.density(), c, phi, psi, t))
-    }
-    fn density(&self) -> f64 {
-        self.density
-    }
-    fn lame_shear(&self) -> (f64, f64) {
-        (self.elastic.lame, self.elastic.shear)
-    }
-    fn youngs_nu(&self) -> (f64, f64) {
-        (self.youngs, self.nu)
-    }
-    #[inline]
-    fn update(
-        &self,
-        l: [f64; 4],
-        dt: f64,
-        stress: &mut [f64; 3],
-        _f: &mut super::DefGrad,
-        q: &mut PlasticState,
-    ) -> Result<f64, FaultKind> {
-        DruckerPrager::update(self, l, dt, stress, q)
-    }
-    /// The elastic P-wave speed bounds the elastoplastic one.
-    #[inline]
-    fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
-        ((self.elastic.lame + 2.0 * self.elastic.shear) / rho).sqrt()
-    }
-    /// The elastic part, ½ σ : C⁻¹ : σ with σzz from `q`.
-    #[inline]
-    fn strain_energy_density(&self, s: &[f64; 3], _f: &super::DefGrad, q: &PlasticState) -> f64 {
-        self.elastic.energy([s[0], s[1], q[plastic::SZZ], s[2]])
-    }
-    /// Cap t −1 where there is none; α, ᾱ, k of the plane-strain match.
-    fn gpu_params(&self) -> Vec<f32> {
-        vec![self.tension.map_or(-1.0, |t| t as f32),
-            self.alpha as f32,
-            self.alpha_psi as f32,
-            self.k as f32,]
-    }
-}
+plastic::elastoplastic_constitutive!(
+    DruckerPrager,
+    "drucker_prager",
+    ["tension", "alpha", "alpha_psi", "k"],
+    // Cap t −1 where there is none; α, ᾱ, k of the plane-strain match.
+    |m| vec![
+        m.tension.map_or(-1.0, |t| t as f32),
+        m.alpha as f32,
+        m.alpha_psi as f32,
+        m.k as f32,
+    ]
+);
 
 
 /// Mean stress p and sqrt(J2) of [xx, yy, zz, xy].

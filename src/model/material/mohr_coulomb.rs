@@ -266,56 +266,19 @@ impl MohrCoulomb {
 }
 
 
-impl super::Constitutive for MohrCoulomb {
-    const NAME: &'static str = "mohr_coulomb";
-    const KEYS: &'static [super::Key] = plastic::YIELD_KEYS;
-    const STATE: super::StateKind = super::StateKind::Plastic;
-    const GPU_PARAMS: &'static [&'static str] = &["cohesion", "sin_phi", "cos_phi", "sin_psi", "tension"];
-
-    fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
-        let (e, nu) = k.youngs_nu()?;
-        let (c, phi, psi, t) = plastic::yield_keys(k)?;
-        Ok(MohrCoulomb::new(e, nu, k.density(), c, phi, psi, t))
-    }
-    fn density(&self) -> f64 {
-        self.density
-    }
-    fn lame_shear(&self) -> (f64, f64) {
-        (self.elastic.lame, self.elastic.shear)
-    }
-    fn youngs_nu(&self) -> (f64, f64) {
-        (self.youngs, self.nu)
-    }
-    #[inline]
-    fn update(
-        &self,
-        l: [f64; 4],
-        dt: f64,
-        stress: &mut [f64; 3],
-        _f: &mut super::DefGrad,
-        q: &mut PlasticState,
-    ) -> Result<f64, FaultKind> {
-        MohrCoulomb::update(self, l, dt, stress, q)
-    }
-    /// The elastic P-wave speed bounds the elastoplastic one.
-    #[inline]
-    fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
-        ((self.elastic.lame + 2.0 * self.elastic.shear) / rho).sqrt()
-    }
-    /// The elastic part, ½ σ : C⁻¹ : σ with σzz from `q`.
-    #[inline]
-    fn strain_energy_density(&self, s: &[f64; 3], _f: &super::DefGrad, q: &PlasticState) -> f64 {
-        self.elastic.energy([s[0], s[1], q[plastic::SZZ], s[2]])
-    }
-    /// Tension cutoff −1 where there is none.
-    fn gpu_params(&self) -> Vec<f32> {
-        vec![self.cohesion as f32,
-            self.sin_phi as f32,
-            self.cos_phi as f32,
-            self.sin_psi as f32,
-            self.tension.map_or(-1.0, |t| t as f32),]
-    }
-}
+plastic::elastoplastic_constitutive!(
+    MohrCoulomb,
+    "mohr_coulomb",
+    ["cohesion", "sin_phi", "cos_phi", "sin_psi", "tension"],
+    // Tension cutoff −1 where there is none.
+    |m| vec![
+        m.cohesion as f32,
+        m.sin_phi as f32,
+        m.cos_phi as f32,
+        m.sin_psi as f32,
+        m.tension.map_or(-1.0, |t| t as f32),
+    ]
+);
 
 /// In-plane principal decomposition of `t` with `tzz`, sorted, returned by
 /// `ret`, and rotated back with the in-plane eigenvectors. Returns

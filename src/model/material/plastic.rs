@@ -139,6 +139,67 @@ pub fn record(q: &mut PlasticState, e: &Elastic3, trial: [f64; 4], s: [f64; 4], 
     q[RETURN] = active as f64;
 }
 
+/// `Constitutive` for an elastic-perfectly plastic model (Mohr–Coulomb,
+/// Drucker–Prager): E, ν and the yield keys, the `Elastic3` moduli, the
+/// elastic P-wave speed (which bounds the elastoplastic one), the elastic
+/// energy with σzz from the state, and the model's own `update` and GPU
+/// parameters. The type has `youngs`, `nu`, `density`, `elastic` and
+/// `new(E, ν, ρ, c, φ, ψ, t)`.
+macro_rules! elastoplastic_constitutive {
+    ($ty:ident, $name:literal, [$($param:literal),*], |$m:ident| $pack:expr) => {
+        impl super::Constitutive for $ty {
+            const NAME: &'static str = $name;
+            const KEYS: &'static [super::Key] = plastic::YIELD_KEYS;
+            const STATE: super::StateKind = super::StateKind::Plastic;
+            const GPU_PARAMS: &'static [&'static str] = &[$($param),*];
+
+            fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
+                let (e, nu) = k.youngs_nu()?;
+                let (c, phi, psi, t) = plastic::yield_keys(k)?;
+                Ok($ty::new(e, nu, k.density(), c, phi, psi, t))
+            }
+            fn density(&self) -> f64 {
+                self.density
+            }
+            fn lame_shear(&self) -> (f64, f64) {
+                (self.elastic.lame, self.elastic.shear)
+            }
+            fn youngs_nu(&self) -> (f64, f64) {
+                (self.youngs, self.nu)
+            }
+            #[inline]
+            fn update(
+                &self,
+                l: [f64; 4],
+                dt: f64,
+                stress: &mut [f64; 3],
+                _f: &mut super::DefGrad,
+                q: &mut PlasticState,
+            ) -> Result<f64, FaultKind> {
+                $ty::update(self, l, dt, stress, q)
+            }
+            #[inline]
+            fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+                ((self.elastic.lame + 2.0 * self.elastic.shear) / rho).sqrt()
+            }
+            #[inline]
+            fn strain_energy_density(
+                &self,
+                s: &[f64; 3],
+                _f: &super::DefGrad,
+                q: &PlasticState,
+            ) -> f64 {
+                self.elastic.energy([s[0], s[1], q[plastic::SZZ], s[2]])
+            }
+            fn gpu_params(&self) -> Vec<f32> {
+                let $m = self;
+                $pack
+            }
+        }
+    };
+}
+pub(crate) use elastoplastic_constitutive;
+
 /// The keys of the elastic-perfectly plastic models (Mohr–Coulomb,
 /// Drucker–Prager): E and ν, then the yield keys.
 pub const YIELD_KEYS: &[super::Key] = &[
