@@ -7,7 +7,7 @@
 //!      v_I the corrected or the predicted nodal velocity (`NpcPosition`).
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::ShapeCache;
+use super::stage_inputs::ShapeCache;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
 use crate::model::{Grid, Integrator};

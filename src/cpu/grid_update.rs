@@ -16,7 +16,7 @@
 //! GPU twin: `shaders/grid_update.wgsl` (built without and with `CORRECT`)
 //! and `shaders/wall_touch.wgsl`.
 
-use super::ShapeCache;
+use super::stage_inputs::ShapeCache;
 use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
 use rayon::prelude::*;

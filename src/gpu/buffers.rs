@@ -4,11 +4,11 @@
 //! below is the one place binding numbers are defined: WGSL files write
 //! `@binding({{B_X0}})`, the preprocessor fills in the number.
 
-use super::GpuOptions;
 use super::context::GpuContext;
 use super::layout::{
     GPU_PARAM_SLOTS, GpuConstraint, GpuMaterial, GpuWall, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
 };
+use super::options::GpuOptions;
 use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
 use crate::model::shape::Shape;

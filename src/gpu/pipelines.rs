@@ -94,7 +94,7 @@ pub struct Variant {
 }
 
 impl Variant {
-    pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
+    pub fn of(model: &Model, atomics: AtomicMode, opts: &super::options::GpuOptions) -> Variant {
         Variant {
             materials: model
                 .materials
@@ -325,7 +325,7 @@ impl Pipelines {
         ctx: &GpuContext,
         model: &Model,
         buffers: &Buffers,
-        opts: &super::GpuOptions,
+        opts: &super::options::GpuOptions,
     ) -> Result<Pipelines> {
         let variant = Variant::of(model, ctx.atomics, opts);
         let plan = variant.plan();
