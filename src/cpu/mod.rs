@@ -292,6 +292,7 @@ impl CpuBackend {
                         &p.mass,
                         &p.rho,
                         &m.walls,
+                        self.t,
                         &mut self.wall_touch,
                     );
                 }
@@ -349,6 +350,7 @@ impl CpuBackend {
                 &self.wall_touch,
                 &mut self.reactions,
                 gamma * self.dt,
+                m.local_damping,
                 self.mass_eps,
             ),
             Stage::G2p => {
@@ -357,6 +359,7 @@ impl CpuBackend {
                     integrator: m.integrator,
                     mass_eps: self.mass_eps,
                     edge_margin: m.shape.edge_margin(),
+                    pic_fraction: m.pic_fraction,
                 };
                 g2p::g2p(
                     &self.cache,

@@ -336,7 +336,13 @@ fn grid_and_output_data(
                 normal: f32x2(w.normal),
                 mu: w.mu as f32,
                 contact: w.contact,
-                _pad: [0; 2],
+                appear_at: w.appear_at as f32,
+                // A finite "never" (WGSL may assume no infinities).
+                remove_at: if w.remove_at.is_finite() {
+                    w.remove_at as f32
+                } else {
+                    f32::MAX
+                },
             })
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));

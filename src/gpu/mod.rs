@@ -427,8 +427,8 @@ pub fn params(model: &Model) -> Params {
         mls_spans_y: mls_spans[1],
         mls_break_off,
         mls_weight_scale: (1.5 / model.mls_support) as f32,
-        _pad_p0: 0,
-        _pad_p1: 0,
+        pic_fraction: model.pic_fraction as f32,
+        local_damping: model.local_damping as f32,
         _pad_p2: 0,
     }
 }

@@ -257,6 +257,12 @@ pub struct WallSpec {
     pub contact: Contact,
     /// Coulomb friction coefficient μ ≥ 0, only with `contact = "friction"`.
     pub friction: Option<f64>,
+    /// Time the wall starts to act (s), ≥ 0. Default 0 (from the start).
+    #[serde(default)]
+    pub appear_at: f64,
+    /// Time the wall stops acting (s), > `appear_at` (a gate). Default:
+    /// never.
+    pub remove_at: Option<f64>,
 }
 
 /// A traction on a segment of a body's boundary (dead load).
@@ -445,6 +451,16 @@ pub struct SolverSpec {
     /// r = Δx/(2h); in [1.5, 3].
     #[serde(default = "default_mls_support")]
     pub mls_support: f64,
+    /// Share α of PIC in the particle velocity update, in [0, 1]:
+    /// v_p ← (1 − α) v_FLIP + α v_PIC (explicit integrators). Default 0
+    /// (pure FLIP).
+    #[serde(default)]
+    pub pic_fraction: f64,
+    /// Cundall's non-viscous local damping α, in [0, 1): each component of
+    /// the unbalanced nodal force loses α |f| sign(v) (explicit
+    /// integrators). Default 0 (none).
+    #[serde(default)]
+    pub local_damping: f64,
 }
 
 fn default_mls_support() -> f64 {

@@ -4,7 +4,8 @@
 //! and 2.0 s, run-out and final height with their change between meshes;
 //! and the cohesionless variant against the experimental run-out scaling of
 //! 2D granular collapses, (L_f − L_0)/L_0 ≈ 1.2 H/W (Lajeunesse et al.
-//! 2005; Lube et al. 2005).
+//! 2005; Lube et al. 2005): released from geostatic rest by a gate, for
+//! a = 0.5, 1 and 2, with pure FLIP and with 1 % PIC.
 
 use super::runner::{Job, JobResult};
 use super::{Method, backend_slug, image, sig, table};
@@ -34,6 +35,20 @@ pub const MESHES: [f64; 2] = [0.05, 0.025];
 pub const COLUMN: (f64, f64) = (2.0, 4.0);
 /// Cohesionless column: width and height (m), from `cases/granular_collapse.toml`.
 pub const GRANULAR: (f64, f64) = (1.0, 2.0);
+
+/// Aspect ratios a = H/W of the cohesionless runs (W = 1 m, H = a W):
+/// the experiments' 1.2 a scaling holds below about 3.
+pub const GRANULAR_ASPECTS: [f64; 3] = [0.5, 1.0, 2.0];
+
+/// Shares of PIC the cohesionless runs take: pure FLIP (the solver's
+/// default) and the case's 1 %.
+pub const GRANULAR_PIC: [f64; 2] = [0.0, 0.01];
+
+/// Cell size of the cohesionless runs (m): twice the case's 0.025 m keeps
+/// the 24 runs to minutes; at a = 2 with 1 % PIC, bspline2 gives a run-out
+/// ratio of 2.70 here and 2.97 at 0.025 m (docs/methods.md, "Granular
+/// collapse").
+pub const GRANULAR_H: f64 = 0.05;
 
 /// Particles per cell per direction in both cases.
 const PPC: f64 = 2.0;
@@ -73,18 +88,31 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
             continue;
         }
         for m in METHODS {
-            let mut j = Job::new(
-                format!("{}-granular-{}", backend_slug(b), m.0),
-                GRANULAR_COLLAPSE,
-                "granular_collapse",
-            )
-            .set("output.vtk_interval=1e9")
-            .on(b)
-            .tag("case", "granular")
-            .method(m)
-            .tag("h", 0.025);
-            j.keep_final = true;
-            out.push(j);
+            for a in GRANULAR_ASPECTS {
+                for pic in GRANULAR_PIC {
+                    let mut j = Job::new(
+                        format!("{}-granular-{}-a{a}-pic{pic}", backend_slug(b), m.0),
+                        GRANULAR_COLLAPSE,
+                        "granular_collapse",
+                    )
+                    .set("output.vtk_interval=1e9")
+                    .set(format!("grid.h={GRANULAR_H}"))
+                    .set(format!(
+                        "bodies.column.rects=[[0.0, 0.0, {}, {}]]",
+                        GRANULAR.0,
+                        a * GRANULAR.0
+                    ))
+                    .set(format!("solver.pic_fraction={pic}"))
+                    .on(b)
+                    .tag("case", "granular")
+                    .method(m)
+                    .tag("a", a)
+                    .tag("pic", pic)
+                    .tag("h", GRANULAR_H);
+                    j.keep_final = true;
+                    out.push(j);
+                }
+            }
         }
     }
     out
@@ -326,92 +354,120 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
 
     // --- cohesionless variant ----------------------------------------------------
     if !granular.is_empty() {
-        let (w, hgt) = GRANULAR;
-        let a = hgt / w;
-        let _ = writeln!(
-            md,
-            "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
-             sits at the apex), φ = 30°, a = H/W = {}, h = 0.025 m, t_end = 2 s. Experiments on 2D \
-             collapses give (L_f − L_0)/L_0 ≈ 1.2 a = {} for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. \
-             2005), with L_0 = W the initial length and L_f the front of the deposit where it is at \
-             least one cell thick (the furthest particle is listed too).\n",
-            sig(a),
-            sig(1.2 * a)
-        );
-        let header: Vec<String> = [
-            "method",
-            "status",
-            "L_f (m)",
-            "furthest particle (m)",
-            "(L_f − L_0)/L_0",
-            "vs 1.2 a",
-            "final height (m)",
-            "kinetic energy at end / m g H",
-        ]
-        .map(String::from)
-        .to_vec();
-        let rows: Vec<Vec<String>> = granular
-            .iter()
-            .map(|r| {
-                let m = r.job.tag_value("method").unwrap_or("").to_string();
-                let p = r.data().and_then(|d| d.final_particles.as_ref());
-                match p {
-                    Some(p) if r.completed() => {
-                        let lf = run_out(p, 0.025);
-                        let ratio = (lf - w) / w;
-                        let mass: f64 = p.mass.iter().sum();
-                        let ke: f64 = (0..p.len())
-                            .map(|i| 0.5 * p.mass[i] * (p.v[i][0].powi(2) + p.v[i][1].powi(2)))
-                            .sum();
-                        vec![
-                            m,
-                            "completed".into(),
-                            sig(lf),
-                            sig(front(p, 0.025)),
-                            sig(ratio),
-                            format!("{:+.0} %", 100.0 * (ratio / (1.2 * a) - 1.0)),
-                            sig(height(p, 0.025)),
-                            sig(ke / (mass * 9.81 * hgt)),
-                        ]
-                    }
-                    _ => vec![
-                        m,
-                        super::failure_text(r),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                    ],
-                }
-            })
-            .collect();
-        md.push_str(&table(&header, &rows));
-        md.push('\n');
-        let ratios: Vec<f64> = granular
-            .iter()
-            .filter(|r| r.completed())
-            .filter_map(|r| r.data()?.final_particles.as_ref())
-            .map(|p| (run_out(p, 0.025) - w) / w)
-            .collect();
-        if !ratios.is_empty() {
-            let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let _ = writeln!(
-                md,
-                "**Findings.** The simulated deposits run further than the experiments: \
-                 (L_f − L_0)/L_0 = {}–{} against 1.2 a = {}. We have not found why. A Coulomb floor \
-                 with μ = tan φ instead of the stick floor changes little, and associated flow (ψ = φ) \
-                 runs out further still (both tried on mesh 1 with linear shapes). Candidates not yet \
-                 tested: a rate-independent Mohr–Coulomb law has no collisional dissipation, which the \
-                 μ(I) rheology that fits these experiments adds; the fast thin front's particles dilate \
-                 (their density falls, see methods.md) and stop resisting shear.\n",
-                sig(lo),
-                sig(hi),
-                sig(1.2 * a)
-            );
-        }
+        granular_report(&mut md, &granular);
     }
     Ok((md, charts))
+}
+
+/// The cohesionless variant's table: per method, aspect ratio and PIC
+/// share, the run-out ratio against the experiments' 1.2 a.
+fn granular_report(md: &mut String, granular: &[&JobResult]) {
+    let w = GRANULAR.0;
+    let h = GRANULAR_H;
+    let _ = writeln!(
+        md,
+        "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
+         sits at the apex), φ = 30°, ψ = 0, a column W = {} m wide and H = a W high at geostatic rest \
+         (K0 = 1 − sin φ) between a smooth back wall and a smooth gate, on a rough (`stick`) floor; \
+         the gate is lifted at 0.05 s; h = {} m, t_end = 2 s. Experiments on 2D collapses give \
+         (L_f − L_0)/L_0 ≈ 1.2 a for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. 2005), with \
+         L_0 = W and L_f the front of the deposit where it is at least one cell thick. Each run is \
+         made with pure FLIP (`pic_fraction = 0`, the solver's default) and with the case's 1 % \
+         of PIC; the acceptance is within 25 % of 1.2 a.\n",
+        sig(w),
+        sig(h)
+    );
+    let header: Vec<String> = [
+        "method",
+        "a",
+        "pic_fraction",
+        "status",
+        "L_f (m)",
+        "(L_f − L_0)/L_0",
+        "1.2 a",
+        "off by",
+        "final height (m)",
+        "kinetic energy at end / m g H",
+        "least density (kg/m³)",
+    ]
+    .map(String::from)
+    .to_vec();
+    let mut within = [0usize; 2];
+    let mut counted = [0usize; 2];
+    let mut spread = [(f64::INFINITY, f64::NEG_INFINITY); 2];
+    let rows: Vec<Vec<String>> = granular
+        .iter()
+        .map(|r| {
+            let m = r.job.tag_value("method").unwrap_or("").to_string();
+            let a: f64 = r
+                .job
+                .tag_value("a")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.0);
+            let pic: f64 = r
+                .job
+                .tag_value("pic")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.0);
+            let k = usize::from(pic > 0.0);
+            let p = r.data().and_then(|d| d.final_particles.as_ref());
+            match p {
+                Some(p) if r.completed() => {
+                    let lf = run_out(p, h);
+                    let ratio = (lf - w) / w;
+                    let off = ratio / (1.2 * a) - 1.0;
+                    counted[k] += 1;
+                    if off.abs() <= 0.25 {
+                        within[k] += 1;
+                    }
+                    spread[k] = (spread[k].0.min(off), spread[k].1.max(off));
+                    let mass: f64 = p.mass.iter().sum();
+                    let ke: f64 = (0..p.len())
+                        .map(|i| 0.5 * p.mass[i] * (p.v[i][0].powi(2) + p.v[i][1].powi(2)))
+                        .sum();
+                    let rho_min = p.rho.iter().copied().fold(f64::INFINITY, f64::min);
+                    vec![
+                        m,
+                        sig(a),
+                        sig(pic),
+                        "completed".into(),
+                        sig(lf),
+                        sig(ratio),
+                        sig(1.2 * a),
+                        format!("{:+.0} %", 100.0 * off),
+                        sig(height(p, h)),
+                        sig(ke / (mass * 9.81 * a * w)),
+                        sig(rho_min),
+                    ]
+                }
+                _ => {
+                    let mut row = vec![m, sig(a), sig(pic), super::failure_text(r)];
+                    row.extend(std::iter::repeat_n("-".to_string(), 7));
+                    row
+                }
+            }
+        })
+        .collect();
+    md.push_str(&table(&header, &rows));
+    md.push('\n');
+    let pct = |v: f64| format!("{:+.0} %", 100.0 * v);
+    let _ = writeln!(
+        md,
+        "**Findings.** Pure FLIP: {} of {} runs within 25 % of 1.2 a (off by {} to {}); with 1 % \
+         PIC: {} of {} (off by {} to {}). With FLIP the deposit never comes to rest (its kinetic \
+         energy at 2 s is orders of magnitude above the PIC runs') and its particles spread apart \
+         (the least density falls far below the initial 1850 kg/m³): the velocity noise FLIP keeps \
+         (the part of the particles' velocities the grid does not see, which nothing damps) keeps \
+         the frictional material shearing, so it creeps on after it should have stopped. A share \
+         of PIC damps that noise; see docs/methods.md (\"Granular collapse: why FLIP runs out too \
+         far\") for the test that shows it and for what was tried.\n",
+        within[0],
+        counted[0],
+        pct(spread[0].0),
+        pct(spread[0].1),
+        within[1],
+        counted[1],
+        pct(spread[1].0),
+        pct(spread[1].1),
+    );
 }
