@@ -187,17 +187,13 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             .filter(|r| r.job.tag_value("case") == Some(case))
             .collect()
     };
-    let cohesive = mine("cohesive");
-    let granular = mine("granular");
-    let get = |m: &str, h: f64| {
-        cohesive.iter().copied().find(|r| {
-            r.job.tag_value("method") == Some(m)
-                && r.job.tag_value("h") == Some(h.to_string().as_str())
-        })
+    let cohesive = Cohesive {
+        runs: mine("cohesive"),
+        meshes: if quick { &MESHES[..1] } else { &MESHES },
+        times: if quick { &TIMES[..1] } else { &TIMES },
+        main: main.clone(),
     };
-    let meshes: &[f64] = if quick { &MESHES[..1] } else { &MESHES };
-    let times: &[f64] = if quick { &TIMES[..1] } else { &TIMES };
-    let mut charts = Vec::new();
+    let granular = mine("granular");
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -210,116 +206,164 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
          least one cell thick) and final height, and how much they move between meshes.\n",
         COLUMN.0, COLUMN.1
     );
-
-    // --- profiles, one chart per time -----------------------------------------
-    for &t in times {
-        // No dot in the stem: the chart writer sets the extension.
-        let stem = format!("study-column-profile-{:.0}ms", t * 1e3);
-        let mut c = LineChart::new(
-            format!("Column collapse ({main}): free surface at t = {t:.2} s"),
-            "x (m)",
-            "y (m)",
-        );
-        for (k, (m, ..)) in METHODS.iter().enumerate() {
-            for (mi, &h) in meshes.iter().enumerate() {
-                let Some(p) = get(m, h).and_then(|r| at(r, t)) else {
-                    continue;
-                };
-                let s = Series::line(format!("{m}, h = {h}"), profile(p, h), k);
-                c.series.push(if mi == 0 { s.dashed() } else { s });
-            }
-        }
-        c.legend = plotters::prelude::SeriesLabelPosition::UpperRight;
-        c.size = (800, 440);
-        c.save(&dir.join(&stem))?;
-        charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
-        md.push_str(&image(
-            &format!("free surface at {t:.2} s"),
-            &format!("{stem}.png"),
-        ));
+    let mut charts = cohesive.profiles(dir, &mut md)?;
+    charts.extend(cohesive.plastic_strain(dir, &mut md)?);
+    cohesive.run_out_table(&mut md);
+    cohesive.findings(&mut md);
+    if !granular.is_empty() {
+        granular_report(&mut md, &granular);
     }
-    md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+    Ok((md, charts))
+}
 
-    // --- equivalent plastic strain, LME on the finest mesh -------------------
-    let h_fine = meshes[meshes.len() - 1];
-    if let Some(r) = get("lme-g1.8", h_fine) {
-        let panels: Vec<Panel> = times
-            .iter()
-            .filter_map(|&t| {
-                let p = at(r, t)?;
-                Some(Panel {
-                    title: format!("t = {t:.2} s"),
-                    points: (0..p.len())
-                        .map(|i| (p.x[i][0], p.x[i][1], p.plastic.get(i).map_or(0.0, |q| q[1])))
-                        .collect(),
-                    size: h_fine / PPC,
-                })
-            })
-            .collect();
-        if !panels.is_empty() {
-            let stem = "study-column-plastic-strain";
-            ParticleImage {
-                title: format!("Column, LME γ = 1.8, h = {h_fine} m: ε̄p"),
-                value_label: "ε̄p".into(),
-                cols: panels.len().min(2),
-                panels,
-                range: (0.0, 1.0),
-                panel_size: (420, 260),
-            }
-            .save(&dir.join(stem))?;
-            charts.push(dir.join(format!("{stem}.png")));
-            md.push_str(&image("equivalent plastic strain", &format!("{stem}.png")));
-            md.push_str("\nColour scale clamped at ε̄p = 1.\n\n");
-        }
+/// The cohesive column's runs and what its report shows of them.
+struct Cohesive<'a> {
+    runs: Vec<&'a JobResult>,
+    meshes: &'static [f64],
+    times: &'static [f64],
+    /// The backend the report is about.
+    main: String,
+}
+
+impl Cohesive<'_> {
+    /// The run of method `m` at cell size `h`.
+    fn get(&self, m: &str, h: f64) -> Option<&JobResult> {
+        self.runs.iter().copied().find(|r| {
+            r.job.tag_value("method") == Some(m)
+                && r.job.tag_value("h") == Some(h.to_string().as_str())
+        })
     }
 
-    // --- run-out and height table ----------------------------------------------
-    let t_last = times[times.len() - 1];
-    let mut header: Vec<String> = vec!["method".into()];
-    for &h in meshes {
-        header.push(format!("h = {h}: status"));
-        header.push(format!("run-out at {t_last} s (m)"));
-        header.push(format!("height at {t_last} s (m)"));
-    }
-    if meshes.len() == 2 {
-        header.push("run-out change".into());
-        header.push("height change".into());
-    }
-    let mut rows = Vec::new();
-    for (m, ..) in METHODS {
-        let mut row = vec![m.to_string()];
-        let mut figs = Vec::new();
-        for &h in meshes {
-            match get(m, h) {
-                Some(r) if r.completed() => {
-                    let p = at(r, t_last);
-                    let (ro, ht) =
-                        p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
-                    row.extend(["completed".into(), sig(ro), sig(ht)]);
-                    figs.push((ro, ht));
+    /// The free surface at each time, every method on both meshes.
+    fn profiles(&self, dir: &Path, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
+        for &t in self.times {
+            // No dot in the stem: the chart writer sets the extension.
+            let stem = format!("study-column-profile-{:.0}ms", t * 1e3);
+            let mut c = LineChart::new(
+                format!(
+                    "Column collapse ({}): free surface at t = {t:.2} s",
+                    self.main
+                ),
+                "x (m)",
+                "y (m)",
+            );
+            for (k, (m, ..)) in METHODS.iter().enumerate() {
+                for (mi, &h) in self.meshes.iter().enumerate() {
+                    let Some(p) = self.get(m, h).and_then(|r| at(r, t)) else {
+                        continue;
+                    };
+                    let s = Series::line(format!("{m}, h = {h}"), profile(p, h), k);
+                    c.series.push(if mi == 0 { s.dashed() } else { s });
                 }
-                Some(r) => row.extend([super::failure_text(r), "-".into(), "-".into()]),
-                None => row.extend(["-".into(), "-".into(), "-".into()]),
             }
+            c.legend = plotters::prelude::SeriesLabelPosition::UpperRight;
+            c.size = (800, 440);
+            c.save(&dir.join(&stem))?;
+            charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
+            md.push_str(&image(
+                &format!("free surface at {t:.2} s"),
+                &format!("{stem}.png"),
+            ));
         }
-        if meshes.len() == 2 {
-            if let [(r1, h1), (r2, h2)] = figs[..] {
-                row.push(format!("{:+.1} %", 100.0 * (r2 - r1) / r1));
-                row.push(format!("{:+.1} %", 100.0 * (h2 - h1) / h1));
-            } else {
-                row.extend(["-".into(), "-".into()]);
-            }
-        }
-        rows.push(row);
+        md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+        Ok(charts)
     }
-    md.push_str(&table(&header, &rows));
-    md.push('\n');
-    if meshes.len() == 2 {
+
+    /// ε̄p of LME γ = 1.8 on the finest mesh, one panel per time.
+    fn plastic_strain(&self, dir: &Path, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
+        let h_fine = self.meshes[self.meshes.len() - 1];
+        if let Some(r) = self.get("lme-g1.8", h_fine) {
+            let panels: Vec<Panel> = self
+                .times
+                .iter()
+                .filter_map(|&t| {
+                    let p = at(r, t)?;
+                    Some(Panel {
+                        title: format!("t = {t:.2} s"),
+                        points: (0..p.len())
+                            .map(|i| (p.x[i][0], p.x[i][1], p.plastic.get(i).map_or(0.0, |q| q[1])))
+                            .collect(),
+                        size: h_fine / PPC,
+                    })
+                })
+                .collect();
+            if !panels.is_empty() {
+                let stem = "study-column-plastic-strain";
+                ParticleImage {
+                    title: format!("Column, LME γ = 1.8, h = {h_fine} m: ε̄p"),
+                    value_label: "ε̄p".into(),
+                    cols: panels.len().min(2),
+                    panels,
+                    range: (0.0, 1.0),
+                    panel_size: (420, 260),
+                }
+                .save(&dir.join(stem))?;
+                charts.push(dir.join(format!("{stem}.png")));
+                md.push_str(&image("equivalent plastic strain", &format!("{stem}.png")));
+                md.push_str("\nColour scale clamped at ε̄p = 1.\n\n");
+            }
+        }
+        Ok(charts)
+    }
+
+    /// Run-out and height per method and mesh, and their change between
+    /// meshes.
+    fn run_out_table(&self, md: &mut String) {
+        let t_last = self.times[self.times.len() - 1];
+        let mut header: Vec<String> = vec!["method".into()];
+        for &h in self.meshes {
+            header.push(format!("h = {h}: status"));
+            header.push(format!("run-out at {t_last} s (m)"));
+            header.push(format!("height at {t_last} s (m)"));
+        }
+        if self.meshes.len() == 2 {
+            header.push("run-out change".into());
+            header.push("height change".into());
+        }
+        let mut rows = Vec::new();
+        for (m, ..) in METHODS {
+            let mut row = vec![m.to_string()];
+            let mut figs = Vec::new();
+            for &h in self.meshes {
+                match self.get(m, h) {
+                    Some(r) if r.completed() => {
+                        let p = at(r, t_last);
+                        let (ro, ht) =
+                            p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
+                        row.extend(["completed".into(), sig(ro), sig(ht)]);
+                        figs.push((ro, ht));
+                    }
+                    Some(r) => row.extend([super::failure_text(r), "-".into(), "-".into()]),
+                    None => row.extend(["-".into(), "-".into(), "-".into()]),
+                }
+            }
+            if self.meshes.len() == 2 {
+                if let [(r1, h1), (r2, h2)] = figs[..] {
+                    row.push(format!("{:+.1} %", 100.0 * (r2 - r1) / r1));
+                    row.push(format!("{:+.1} %", 100.0 * (h2 - h1) / h1));
+                } else {
+                    row.extend(["-".into(), "-".into()]);
+                }
+            }
+            rows.push(row);
+        }
+        md.push_str(&table(&header, &rows));
+        md.push('\n');
+    }
+
+    /// The largest change between meshes and the spread between shapes.
+    fn findings(&self, md: &mut String) {
+        let t_last = self.times[self.times.len() - 1];
+        if self.meshes.len() != 2 {
+            return;
+        }
         let mut changes = (0.0f64, 0.0f64);
         let mut fine = Vec::new();
         for (m, ..) in METHODS {
             let fig = |h: f64| {
-                let r = get(m, h).filter(|r| r.completed())?;
+                let r = self.get(m, h).filter(|r| r.completed())?;
                 let p = at(r, t_last)?;
                 Some((run_out(p, h), height(p, h)))
             };
@@ -351,12 +395,6 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             );
         }
     }
-
-    // --- cohesionless variant ----------------------------------------------------
-    if !granular.is_empty() {
-        granular_report(&mut md, &granular);
-    }
-    Ok((md, charts))
 }
 
 /// The cohesionless variant's table: per method, aspect ratio and PIC
