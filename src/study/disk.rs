@@ -14,7 +14,6 @@ use crate::exact::rolling::RollingDisk;
 use crate::scene::Scene;
 use crate::simulation::BackendChoice;
 use crate::sweep::report::{self, Curve};
-use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// (label, shape, γ) of each method.
@@ -162,190 +161,26 @@ pub fn error_percent(exact: &RollingDisk, r: &JobResult) -> Option<f64> {
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let scene = Scene::from_str(ROLLING_DISK, "rolling_disk", "rolling_disk", &[])?;
-    let exact = RollingDisk::from_scene(&scene);
     let main = super::main_backend(results);
-    let mine = super::on_backend(results, &main);
+    let runs = super::on_backend(results, &main);
     // The table's methods; the stick and fine runs are reported in the text.
-    let mut methods = super::tag_values(mine.iter().copied(), "method");
+    let mut methods = super::tag_values(runs.iter().copied(), "method");
     methods.retain(|m| *m != "linear-fine" && *m != "linear-stick");
-    let dts = steps(quick);
-    let get = |m: &str, k: usize| {
-        mine.iter().copied().find(|r| {
-            r.job.tag_value("method") == Some(m)
-                && r.job.tag_value("dt_index") == Some((k + 1).to_string().as_str())
-        })
+    let d = Disk {
+        exact: RollingDisk::from_scene(&scene),
+        runs,
+        methods,
+        dts: steps(quick),
+        t_end: t_end(quick),
+        main,
     };
-    let mut charts = Vec::new();
-    let mut md = String::new();
-
-    // --- error against wall time -------------------------------------------
-    let curves: Vec<Curve> = methods
-        .iter()
-        .enumerate()
-        .map(|(k, m)| Curve {
-            label: m.to_string(),
-            points: (0..dts.len())
-                .filter_map(|i| {
-                    let r = get(m, i)?;
-                    Some((r.data()?.wall_seconds, error_percent(&exact, r)?))
-                })
-                .collect(),
-            color: k,
-            dashed: false,
-        })
-        .collect();
-    let (files, _) = report::front_chart(
-        &format!("Rolling disk ({main}): eq. 67 error against wall time, Δt1 = 2Δt2 = 4Δt3"),
-        "error (%)",
-        &curves,
-        &dir.join("study-disk-error-time"),
-    )?;
-    charts.extend(files);
-
-    // --- displacement history at the smallest step ---------------------------
-    let last = dts.len() - 1;
-    let mut c = LineChart::new(
-        "Rolling disk: centre displacement along x at the smallest Δt",
-        "t (s)",
-        "u_x (m)",
-    );
-    for (k, m) in methods.iter().enumerate() {
-        if let Some(r) = get(m, last) {
-            c.series.push(Series::line(*m, history(r), k));
-        }
-    }
-    let t_end = t_end(quick);
-    c.series.push(
-        Series::line(
-            "exact ½ a cos θ t²",
-            (0..=100)
-                .map(|i| {
-                    let t = t_end * i as f64 / 100.0;
-                    (t, exact.displacement(t)[0])
-                })
-                .collect(),
-            7,
-        )
-        .dashed(),
-    );
-    c.size = (800, 480);
-    c.save(&dir.join("study-disk-history"))?;
-    charts.extend(["study-disk-history.png", "study-disk-history.svg"].map(|f| dir.join(f)));
-
-    // --- text --------------------------------------------------------------------
-    let _ = writeln!(
-        md,
-        "A Neo-Hookean disk (ρ = 7800 kg/m³, E = 200 MPa, ν = 0.3, R = {} m, h = 0.025 m, 2 × 2 particles \
-         per cell, NPC) starts at rest on a `friction` wall (μ = 0.5, above the tan θ / 3 that rolling \
-         without slip needs) inclined at θ = {}° under vertical gravity. Exact (paper eq. 64): \
-         a = (2/3) g sin θ = {} m/s² along the plane. The error is eq. 67 in relative form, \
-         100 · sqrt(Σ (u_x − u_x,num)²) / sqrt(Σ u_x²) over the centre-of-mass displacement every {} s \
-         up to t = {} s (the paper's figure gives no dimensions; ours are in `cases/rolling_disk.toml`). \
-         The paper's Table 1 comes from an implicit code on a triangular mesh with h = 0.01, its time \
-         steps unstated; ours are explicit at Δt1 = {} s, Δt2 = Δt1/2, Δt3 = Δt1/4.\n",
-        sig(exact.radius),
-        sig(exact.theta.to_degrees()),
-        sig(exact.accel_along()),
-        SAMPLE,
-        sig(t_end),
-        DT1
-    );
-    let mut header: Vec<String> = vec!["method".into()];
-    for k in 0..dts.len() {
-        header.push(format!("error Δt{} (%)", k + 1));
-        header.push(format!("wall Δt{} (s)", k + 1));
-    }
-    let mut rows: Vec<Vec<String>> = methods
-        .iter()
-        .map(|m| {
-            let mut row = vec![m.to_string()];
-            for k in 0..dts.len() {
-                match get(m, k) {
-                    Some(r) if r.completed() => {
-                        row.push(error_percent(&exact, r).map_or("-".into(), sig));
-                        row.push(r.data().map_or("-".into(), |d| sig(d.wall_seconds)));
-                    }
-                    Some(r) => {
-                        row.push(super::failure_text(r));
-                        row.push("-".into());
-                    }
-                    None => {
-                        row.push("-".into());
-                        row.push("-".into());
-                    }
-                }
-            }
-            row
-        })
-        .collect();
-    for (name, fig) in [
-        ("paper: MPM (implicit)", PAPER_MPM),
-        ("paper: GMM-LME γ = 2.8", PAPER_LME_28),
-    ] {
-        let mut row = vec![name.to_string()];
-        for f in fig.iter().take(dts.len()) {
-            row.push(sig(*f));
-            row.push("-".into());
-        }
-        rows.push(row);
-    }
-    md.push_str(&table(&header, &rows));
+    let mut charts = d.error_time_chart(dir)?;
+    charts.extend(d.history_chart(dir)?);
+    let mut md = d.intro();
+    md.push_str(&d.errors_table());
     md.push('\n');
-    // What the figures say: does Δt matter, does h?
-    let spread: Vec<String> = methods
-        .iter()
-        .filter_map(|m| {
-            let a = error_percent(&exact, get(m, 0)?)?;
-            let b = error_percent(&exact, get(m, last)?)?;
-            Some(format!("{m} {} → {} %", sig(a), sig(b)))
-        })
-        .collect();
-    let _ = writeln!(
-        md,
-        "**Findings.** From Δt1 to Δt{}: {}. The explicit step is bounded by the Courant limit, far \
-         below what the time integration's accuracy needs, so the error left is spatial, and most of it is \
-         the wall's grid contact. The wall acts only on the nodes that a particle touching the plane \
-         reaches (docs/methods.md, \"Walls\"), but at those nodes the rule is decided per node from its \
-         velocity: ahead of the contact the nodes approach and are held, behind it they lift off and are \
-         released, so the wall's normal force sits about a cell ahead of the contact point and acts as a \
-         rolling resistance of the order of h/R (first order in h on a grid-aligned floor, \
-         docs/methods.md; on this inclined plane see the finer run).{}\n",
-        last + 1,
-        spread.join("; "),
-        match (
-            get("linear", 1).and_then(|r| error_percent(&exact, r)),
-            mine.iter()
-                .find(|r| r.job.tag_value("method") == Some("linear-fine"))
-                .and_then(|r| error_percent(&exact, r)),
-        ) {
-            (Some(a), Some(b)) => format!(
-                " Halving h (R/h from 20 to 40, linear at Δt2) takes the error from {} to {} %.",
-                sig(a),
-                sig(b)
-            ),
-            _ => String::new(),
-        }
-    );
-    if let Some(r) = mine
-        .iter()
-        .find(|r| r.job.tag_value("method") == Some("linear-stick"))
-    {
-        let moved = history(r)
-            .last()
-            .map_or(0.0, |&(t, u)| u / exact.displacement(t)[0]);
-        let _ = writeln!(
-            md,
-            "\nWith a `stick` wall instead (linear, Δt1) the disk {}: its centre covers {} % of the exact \
-             distance. A stick wall stops the nodes in contact that approach it and frees those that \
-             lift off, so the disk rolls on it as on the frictional wall.\n",
-            if r.completed() {
-                "completes"
-            } else {
-                "does not complete"
-            },
-            sig(100.0 * moved)
-        );
-    }
+    md.push_str(&d.findings());
+    md.push_str(&d.stick());
     md.push_str(&image(
         "eq. 67 error against wall time",
         "study-disk-error-time.png",
@@ -353,4 +188,225 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     md.push('\n');
     md.push_str(&image("displacement history", "study-disk-history.png"));
     Ok((md, charts))
+}
+
+/// The disk study's runs on one backend and what its report shows of them.
+struct Disk<'a> {
+    exact: RollingDisk,
+    runs: Vec<&'a JobResult>,
+    /// The table's methods (not the fine and stick runs).
+    methods: Vec<&'a str>,
+    dts: Vec<f64>,
+    t_end: f64,
+    /// The backend the report is about.
+    main: String,
+}
+
+impl Disk<'_> {
+    /// The run of method `m` at the time step of index `k` (0: Δt1).
+    fn get(&self, m: &str, k: usize) -> Option<&JobResult> {
+        self.runs.iter().copied().find(|r| {
+            r.job.tag_value("method") == Some(m)
+                && r.job.tag_value("dt_index") == Some((k + 1).to_string().as_str())
+        })
+    }
+
+    /// The run tagged `method = m` (the fine and stick runs).
+    fn tagged(&self, m: &str) -> Option<&JobResult> {
+        self.runs
+            .iter()
+            .copied()
+            .find(|r| r.job.tag_value("method") == Some(m))
+    }
+
+    fn error(&self, r: &JobResult) -> Option<f64> {
+        error_percent(&self.exact, r)
+    }
+
+    /// Eq. 67 error against wall time, one curve per method over the steps.
+    fn error_time_chart(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let curves: Vec<Curve> = self
+            .methods
+            .iter()
+            .enumerate()
+            .map(|(k, m)| Curve {
+                label: m.to_string(),
+                points: (0..self.dts.len())
+                    .filter_map(|i| {
+                        let r = self.get(m, i)?;
+                        Some((r.data()?.wall_seconds, self.error(r)?))
+                    })
+                    .collect(),
+                color: k,
+                dashed: false,
+            })
+            .collect();
+        let (files, _) = report::front_chart(
+            &format!(
+                "Rolling disk ({}): eq. 67 error against wall time, Δt1 = 2Δt2 = 4Δt3",
+                self.main
+            ),
+            "error (%)",
+            &curves,
+            &dir.join("study-disk-error-time"),
+        )?;
+        Ok(files)
+    }
+
+    /// The centre's displacement at the smallest step against the exact one.
+    fn history_chart(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let last = self.dts.len() - 1;
+        let mut c = LineChart::new(
+            "Rolling disk: centre displacement along x at the smallest Δt",
+            "t (s)",
+            "u_x (m)",
+        );
+        for (k, m) in self.methods.iter().enumerate() {
+            if let Some(r) = self.get(m, last) {
+                c.series.push(Series::line(*m, history(r), k));
+            }
+        }
+        c.series.push(
+            Series::line(
+                "exact ½ a cos θ t²",
+                (0..=100)
+                    .map(|i| {
+                        let t = self.t_end * i as f64 / 100.0;
+                        (t, self.exact.displacement(t)[0])
+                    })
+                    .collect(),
+                7,
+            )
+            .dashed(),
+        );
+        c.size = (800, 480);
+        c.save(&dir.join("study-disk-history"))?;
+        Ok(["study-disk-history.png", "study-disk-history.svg"]
+            .map(|f| dir.join(f))
+            .to_vec())
+    }
+
+    /// What was run, the exact solution and the error measure.
+    fn intro(&self) -> String {
+        format!(
+            "A Neo-Hookean disk (ρ = 7800 kg/m³, E = 200 MPa, ν = 0.3, R = {} m, h = 0.025 m, 2 × 2 particles \
+             per cell, NPC) starts at rest on a `friction` wall (μ = 0.5, above the tan θ / 3 that rolling \
+             without slip needs) inclined at θ = {}° under vertical gravity. Exact (paper eq. 64): \
+             a = (2/3) g sin θ = {} m/s² along the plane. The error is eq. 67 in relative form, \
+             100 · sqrt(Σ (u_x − u_x,num)²) / sqrt(Σ u_x²) over the centre-of-mass displacement every {} s \
+             up to t = {} s (the paper's figure gives no dimensions; ours are in `cases/rolling_disk.toml`). \
+             The paper's Table 1 comes from an implicit code on a triangular mesh with h = 0.01, its time \
+             steps unstated; ours are explicit at Δt1 = {} s, Δt2 = Δt1/2, Δt3 = Δt1/4.\n\n",
+            sig(self.exact.radius),
+            sig(self.exact.theta.to_degrees()),
+            sig(self.exact.accel_along()),
+            SAMPLE,
+            sig(self.t_end),
+            DT1
+        )
+    }
+
+    /// Error and wall time of every method at every step, the paper's rows below.
+    fn errors_table(&self) -> String {
+        let n = self.dts.len();
+        let mut header: Vec<String> = vec!["method".into()];
+        for k in 0..n {
+            header.push(format!("error Δt{} (%)", k + 1));
+            header.push(format!("wall Δt{} (s)", k + 1));
+        }
+        let mut rows: Vec<Vec<String>> = self
+            .methods
+            .iter()
+            .map(|m| {
+                let mut row = vec![m.to_string()];
+                for k in 0..n {
+                    match self.get(m, k) {
+                        Some(r) if r.completed() => {
+                            row.push(self.error(r).map_or("-".into(), sig));
+                            row.push(r.data().map_or("-".into(), |d| sig(d.wall_seconds)));
+                        }
+                        Some(r) => {
+                            row.push(super::failure_text(r));
+                            row.push("-".into());
+                        }
+                        None => {
+                            row.push("-".into());
+                            row.push("-".into());
+                        }
+                    }
+                }
+                row
+            })
+            .collect();
+        for (name, fig) in [
+            ("paper: MPM (implicit)", PAPER_MPM),
+            ("paper: GMM-LME γ = 2.8", PAPER_LME_28),
+        ] {
+            let mut row = vec![name.to_string()];
+            for f in fig.iter().take(n) {
+                row.push(sig(*f));
+                row.push("-".into());
+            }
+            rows.push(row);
+        }
+        table(&header, &rows)
+    }
+
+    /// What the figures say: does Δt matter, does h?
+    fn findings(&self) -> String {
+        let last = self.dts.len() - 1;
+        let spread: Vec<String> = self
+            .methods
+            .iter()
+            .filter_map(|m| {
+                let a = self.error(self.get(m, 0)?)?;
+                let b = self.error(self.get(m, last)?)?;
+                Some(format!("{m} {} → {} %", sig(a), sig(b)))
+            })
+            .collect();
+        let finer = match (
+            self.get("linear", 1).and_then(|r| self.error(r)),
+            self.tagged("linear-fine").and_then(|r| self.error(r)),
+        ) {
+            (Some(a), Some(b)) => format!(
+                " Halving h (R/h from 20 to 40, linear at Δt2) takes the error from {} to {} %.",
+                sig(a),
+                sig(b)
+            ),
+            _ => String::new(),
+        };
+        format!(
+            "**Findings.** From Δt1 to Δt{}: {}. The explicit step is bounded by the Courant limit, far \
+             below what the time integration's accuracy needs, so the error left is spatial, and most of it is \
+             the wall's grid contact. The wall acts only on the nodes that a particle touching the plane \
+             reaches (docs/methods.md, \"Walls\"), but at those nodes the rule is decided per node from its \
+             velocity: ahead of the contact the nodes approach and are held, behind it they lift off and are \
+             released, so the wall's normal force sits about a cell ahead of the contact point and acts as a \
+             rolling resistance of the order of h/R (first order in h on a grid-aligned floor, \
+             docs/methods.md; on this inclined plane see the finer run).{finer}\n\n",
+            last + 1,
+            spread.join("; "),
+        )
+    }
+
+    /// The stick wall's run, when there is one.
+    fn stick(&self) -> String {
+        let Some(r) = self.tagged("linear-stick") else {
+            return String::new();
+        };
+        let moved = history(r)
+            .last()
+            .map_or(0.0, |&(t, u)| u / self.exact.displacement(t)[0]);
+        format!(
+            "\nWith a `stick` wall instead (linear, Δt1) the disk {}: its centre covers {} % of the exact \
+             distance. A stick wall stops the nodes in contact that approach it and frees those that \
+             lift off, so the disk rolls on it as on the frictional wall.\n\n",
+            if r.completed() {
+                "completes"
+            } else {
+                "does not complete"
+            },
+            sig(100.0 * moved)
+        )
+    }
 }
