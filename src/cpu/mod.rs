@@ -99,9 +99,13 @@ impl CpuBackend {
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
-                mls::Mls::new(&model.shape, &model.grid, n)
+                let m = mls::Mls::new(&model.shape, &model.grid, n)
                     .expect("shape functions are defined at Gauss points inside a regular grid")
-                    .with_support(model.mls_support)
+                    .with_support(model.mls_support);
+                match model.mls_scope {
+                    crate::scene::MlsScope::Force => m.for_force_correction(),
+                    crate::scene::MlsScope::All => m,
+                }
             }),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
@@ -144,6 +148,10 @@ impl CpuBackend {
             let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 13.0;
             per += 12.0
                 + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
+            if model.mls_scope == crate::scene::MlsScope::Force {
+                // The fit at each particle and its flag.
+                per += 25.0;
+            }
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
@@ -297,7 +305,7 @@ impl CpuBackend {
                 shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
             }
             Stage::P2g => {
-                if let Some(mls) = &mut self.mls {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
                     return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
                 }
                 p2g::p2g(
@@ -353,7 +361,20 @@ impl CpuBackend {
                     t_load,
                 );
                 if let Some(mls) = &mut self.mls {
-                    mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+                    if self.plan.inputs.mls_force {
+                        mls.fit_stress(&m.grid, &p.x, &p.stress);
+                        mls.corrected_forces(
+                            &self.cache,
+                            &p.stress,
+                            &p.mass,
+                            &p.rho,
+                            &body,
+                            &mut self.force,
+                            &mut self.force_scatter,
+                        );
+                    } else {
+                        mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+                    }
                     return Ok(());
                 }
                 forces::forces(
@@ -396,7 +417,7 @@ impl CpuBackend {
                 )?;
             }
             Stage::Remap => {
-                if let Some(mls) = &mut self.mls {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
                     mls.remap(&m.grid, &p.rho, &p.v, &mut self.mv);
                 } else {
                     remap::remap(

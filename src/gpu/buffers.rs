@@ -51,7 +51,11 @@ pub enum Buf {
     CellOrder,
     CellOf,
     MlsOcc,
+    /// Per Gauss point: the fit's c = A⁻¹e₀ (`mls_scope = "all"`) or
+    /// σ_h(x_g) (`"force"`), 3 f32.
     MlsCoef,
+    /// `mls_scope = "force"`: per particle, σ_h(x_p), 3 f32.
+    MlsFit,
     Walls,
     WallMask,
     /// Per node: the walls it touches this step (wall_touch.wgsl).
@@ -63,7 +67,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 36] = [
+    pub const ALL: [Buf; 37] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -95,6 +99,7 @@ impl Buf {
         Buf::CellOf,
         Buf::MlsOcc,
         Buf::MlsCoef,
+        Buf::MlsFit,
         Buf::Walls,
         Buf::WallMask,
         Buf::WallTouch,
@@ -369,6 +374,9 @@ fn grid_and_output_data(
         let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
         data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
         data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
+        if model.mls_scope == crate::scene::MlsScope::Force {
+            data.push((Buf::MlsFit, vec![0u8; 12 * n]));
+        }
     }
 }
 
