@@ -38,7 +38,10 @@ fn exact_forces(shape: &Shape, grid: &Grid, sig: impl Fn([f64; 2]) -> [f64; 3]) 
     let half = grid.h / 2.0;
     let n_half = 2 * (grid.nx - 1);
     let mut f = vec![[0.0; 2]; grid.n_nodes()];
-    let (mut nodes, mut nw) = (vec![0u32; shape.max_nodes()], vec![[0.0; 3]; shape.max_nodes()]);
+    let (mut nodes, mut nw) = (
+        vec![0u32; shape.max_nodes()],
+        vec![[0.0; 3]; shape.max_nodes()],
+    );
     for j in 0..n_half {
         for i in 0..n_half {
             for (qy, wy) in pts.iter().zip(w) {
@@ -98,17 +101,28 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
             }
         }
         let n = x.len();
-        let sig = |x: [f64; 2]| [1e3 * (1.0 + x[0] - 2.0 * x[1]), 3e2 * x[1], -5e2 * x[0] + 1e2];
+        let sig = |x: [f64; 2]| {
+            [
+                1e3 * (1.0 + x[0] - 2.0 * x[1]),
+                3e2 * x[1],
+                -5e2 * x[0] + 1e2,
+            ]
+        };
         let stress: Vec<[f64; 3]> = x.iter().map(|&p| sig(p)).collect();
         // Volumes that do not sum to the square's area: the correction
         // needs none of the particle quadrature's accuracy.
-        let mass: Vec<f64> = (0..n).map(|p| (1.0 + 0.3 * (p % 5) as f64) / n as f64).collect();
+        let mass: Vec<f64> = (0..n)
+            .map(|p| (1.0 + 0.3 * (p % 5) as f64) / n as f64)
+            .collect();
         let rho = vec![1.0; n];
         let mut cache = ShapeCache::new(n, shape.max_nodes());
         lme_mpm::cpu::shape_eval::shape_eval(&shape, &grid, &x, &mut [], &mut cache).unwrap();
         let mut mls = Mls::new(&shape, &grid, n).unwrap().for_force_correction();
         mls.fit_stress(&grid, &x, &stress);
-        assert!(mls.cell_ok.iter().all(|&ok| ok), "{shape:?}: every fit is regular");
+        assert!(
+            mls.cell_ok.iter().all(|&ok| ok),
+            "{shape:?}: every fit is regular"
+        );
         let mut force = vec![[0.0; 2]; grid.n_nodes()];
         let body = |_p: usize| [0.0, 0.0];
         mls.corrected_forces(
@@ -150,8 +164,11 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
                 .fold(0.0f64, f64::max)
                 / scale
         };
-        let (to_gauss, to_exact, particles) =
-            (err(&force, &gauss), err(&force, &exact), err(&plain, &exact));
+        let (to_gauss, to_exact, particles) = (
+            err(&force, &gauss),
+            err(&force, &exact),
+            err(&plain, &exact),
+        );
         println!(
             "{shape:?}: corrected {to_gauss:.2e} from the Gauss rule, {to_exact:.2e} from the \
              exact integral; particles only {particles:.2e}, of max |f|"

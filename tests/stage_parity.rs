@@ -985,7 +985,11 @@ fn stages_match_musl() {
 #[test]
 fn stages_match_mls_force() {
     for (label, sets, cas) in [
-        ("mms bspline2 musl mls force", &["solver.integrator=musl"][..], false),
+        (
+            "mms bspline2 musl mls force",
+            &["solver.integrator=musl"][..],
+            false,
+        ),
         ("mms bspline2 npc mls force, CAS atomics", &[][..], true),
         (
             "mms bspline3 musl mls force",

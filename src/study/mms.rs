@@ -508,7 +508,9 @@ impl Section<'_> {
                         sig(b),
                         if a <= b { "at or below" } else { "above" }
                     ),
-                    (Some(a), None) => format!("{name} {n}: {} vs {GOAL_BASE} not completed", sig(a)),
+                    (Some(a), None) => {
+                        format!("{name} {n}: {} vs {GOAL_BASE} not completed", sig(a))
+                    }
                     _ => format!("{name} {n}: {GOAL_METHOD} did not complete"),
                 });
             }
