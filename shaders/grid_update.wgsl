@@ -6,7 +6,9 @@
 // `correct`: reactions (−f on fixed components, summed per constraint),
 // those components zeroed, then v_I += γ Δt f_I / m_I (FE: γ = 1); then the
 // walls' rules on the corrected velocity, whose change Δv is the wall's
-// force m Δv / (γ Δt), added to f_I and to the wall's reaction.
+// force m Δv / (γ Δt), added to f_I and to the wall's reaction. With
+// LOCAL_DAMPING, before the update each force component of a node with mass
+// loses α |f_i| sign(v_i), v the predicted nodal velocity (Cundall).
 // CPU twin: src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 
@@ -119,6 +121,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     if m > params.mass_eps {
         let gdt = params.npc_gamma * sim.dt;
+#if LOCAL_DAMPING
+        f -= params.local_damping * abs(f) * sign(vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]));
+#endif
         var v = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f;
 #if WALLS
         let mask = wall_mask[n] & wall_touch[n];

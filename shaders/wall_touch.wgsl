@@ -3,7 +3,9 @@
 // l_p = ½ sqrt(m_p / ρ_p) reaches a wall's line, (x_p − point)·n −
 // l_p (|n_x| + |n_y|) ≤ WALL_TOUCH_SLACK l_p, sets the wall's bit on every node of its
 // stencil (weight > 0); `predict` and `correct` apply a wall only on the
-// nodes behind it that touch it. `clear_grid` zeroes the bits.
+// nodes behind it that touch it. `clear_grid` zeroes the bits. With GATES
+// only the walls that act at the step's start time t (appear_at <= t <
+// remove_at) are touched.
 // CPU twin: `wall_touch` and `touching_walls` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -28,8 +30,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let x = x0[p] + u[p];
     let lp = 0.5 * sqrt(mass[p] / rho[p]);
     var bits = 0u;
+#if GATES
+    let t = sim.t + sim.t_lo;
+#endif
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let w = walls[k];
+#if GATES
+        if t < w.appear_at || t >= w.remove_at {
+            continue;
+        }
+#endif
         let d = dot(x - w.point, w.normal);
         if d - lp * (abs(w.normal.x) + abs(w.normal.y)) <= WALL_TOUCH_SLACK * lp {
             bits |= 1u << k;

@@ -13,10 +13,15 @@
 //! corrected velocity, whose change Δv becomes the wall's force
 //! m Δv / (γ Δt), added to f_I (so the particles feel it) and to the wall's
 //! reaction. Fixed components keep their prescribed value.
+//! With `solver.local_damping` α > 0 (Cundall), `correct` first takes
+//! α |f_i| sign(v_i) off each component of the unbalanced force of a node
+//! with mass, v_I the nodal velocity it is about to correct (the
+//! predicted one), before the velocity update, so the nodes and the
+//! particles' FLIP update (`g2p`) feel the damped force.
 //! GPU twin: `shaders/grid_update.wgsl` (built without and with `CORRECT`)
 //! and `shaders/wall_touch.wgsl`.
 
-use super::ShapeCache;
+use super::stage_inputs::ShapeCache;
 use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
 use rayon::prelude::*;
@@ -63,6 +68,28 @@ pub fn wall_velocity(v: [f64; 2], normal: [f64; 2], contact: u32, mu: f64) -> [f
     [k * vt[0], k * vt[1]]
 }
 
+/// Cundall's non-viscous local damping of a nodal force `f` (N) at nodal
+/// velocity `v` (m/s): f_i − α |f_i| sign(v_i) per component, sign(0) = 0
+/// (WGSL's `sign`). It opposes the motion by a share of the unbalanced
+/// force, whatever the frequency, and vanishes at equilibrium (f = 0) and
+/// at rest (v = 0).
+#[inline]
+pub fn local_damping(f: [f64; 2], v: [f64; 2], alpha: f64) -> [f64; 2] {
+    let sign = |x: f64| {
+        if x > 0.0 {
+            1.0
+        } else if x < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    [
+        f[0] - alpha * f[0].abs() * sign(v[0]),
+        f[1] - alpha * f[1].abs() * sign(v[1]),
+    ]
+}
+
 /// The rules of every wall in `mask` (bit k = wall k), in order.
 #[inline]
 fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
@@ -84,17 +111,29 @@ fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
 /// behind the wall that held mass got the rule, so the patch of about
 /// sqrt(2 R h) under a disk dragged on it; docs/methods.md, "Walls").
 /// `touch` is zeroed first (its GPU twin is zeroed by `clear_grid`).
+/// Only the walls that act in the step starting at `t` (s) are touched
+/// (`Wall::active_at`: a gate's `appear_at` ≤ t < `remove_at`), so a
+/// removed gate is nowhere in contact.
 pub fn wall_touch(
     cache: &ShapeCache,
     x: &[[f64; 2]],
     mass: &[f64],
     rho: &[f64],
     walls: &Walls,
+    t: f64,
     touch: &mut [u32],
 ) {
     touch.fill(0);
+    let active = walls
+        .list
+        .iter()
+        .enumerate()
+        .fold(0u32, |bits, (k, w)| bits | (u32::from(w.active_at(t)) << k));
+    if active == 0 {
+        return;
+    }
     for p in 0..x.len() {
-        let bits = touching_walls(x[p], mass[p], rho[p], &walls.list);
+        let bits = touching_walls(x[p], mass[p], rho[p], &walls.list) & active;
         if bits == 0 {
             continue;
         }
@@ -186,7 +225,8 @@ pub fn predict(
 /// −f_I on each fixed component), zeroes those components, corrects the
 /// velocities by `gamma_dt` · f/m, then applies the walls on the nodes
 /// that touch them (`touch`, as in `predict`). `reactions` holds the
-/// constraint groups' then the walls'.
+/// constraint groups' then the walls'. `damping` is Cundall's α
+/// (`local_damping`; 0 leaves the force as it is).
 #[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
@@ -197,6 +237,7 @@ pub fn correct(
     touch: &[u32],
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
+    damping: f64,
     mass_eps: f64,
 ) {
     let (group_r, wall_r) = reactions.split_at_mut(groups.len());
@@ -219,6 +260,9 @@ pub fn correct(
         .for_each(|((n, f), &fx)| {
             zero_fixed(f, fx);
             if n[0] > mass_eps {
+                if damping > 0.0 {
+                    *f = local_damping(*f, [n[1], n[2]], damping);
+                }
                 n[1] += gamma_dt * f[0] / n[0];
                 n[2] += gamma_dt * f[1] / n[0];
             }
@@ -291,6 +335,8 @@ mod tests {
             contact: CONTACT_STICK,
             mu: 0.0,
             nodes: Vec::new(),
+            appear_at: 0.0,
+            remove_at: f64::INFINITY,
         };
         // Domain 0.1 m wide (m / ρ = 0.01): it reaches the line from 0.05 m.
         let walls = [
@@ -304,6 +350,33 @@ mod tests {
         assert_eq!(touching_walls([0.3, 0.05004], 10.0, 1000.0, &walls), 1);
         assert_eq!(touching_walls([0.3, 0.0501], 10.0, 1000.0, &walls), 0);
         assert_eq!(touching_walls([0.3, -0.96], 10.0, 1000.0, &walls), 3);
+    }
+
+    #[test]
+    fn local_damping_opposes_motion() {
+        // α = 0.5: a force along the motion loses half, one against it
+        // grows by half; no motion, no change.
+        assert_eq!(local_damping([2.0, -2.0], [1.0, 1.0], 0.5), [1.0, -3.0]);
+        assert_eq!(local_damping([2.0, -2.0], [0.0, 0.0], 0.5), [2.0, -2.0]);
+        assert_eq!(local_damping([2.0, 0.0], [-1.0, 3.0], 0.5), [3.0, 0.0]);
+    }
+
+    #[test]
+    fn gates_act_between_their_times() {
+        let w = Wall {
+            name: "gate".into(),
+            point: [0.0, 0.0],
+            normal: N,
+            contact: CONTACT_SLIP,
+            mu: 0.0,
+            nodes: Vec::new(),
+            appear_at: 0.1,
+            remove_at: 0.5,
+        };
+        assert!(!w.active_at(0.0));
+        assert!(w.active_at(0.1));
+        assert!(w.active_at(0.4999));
+        assert!(!w.active_at(0.5));
     }
 
     #[test]

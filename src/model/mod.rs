@@ -152,6 +152,12 @@ pub struct Model {
     /// What the fit does (`solver.mls_scope`): the paper's step or only the
     /// internal force's quadrature correction.
     pub mls_scope: MlsScope,
+    /// Share α of PIC in the particle velocity update (`solver.pic_fraction`,
+    /// 0 = FLIP; explicit integrators, `g2p`).
+    pub pic_fraction: f64,
+    /// Cundall's local damping α (`solver.local_damping`, 0 = none;
+    /// explicit integrators, `grid_update::correct`).
+    pub local_damping: f64,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
@@ -262,6 +268,8 @@ impl Model {
             mls: f.solver.mls,
             mls_support: f.solver.mls_support,
             mls_scope: f.solver.mls_scope,
+            pic_fraction: f.solver.pic_fraction,
+            local_damping: f.solver.local_damping,
             probes,
             manufactured,
         })

@@ -27,6 +27,18 @@ pub struct Wall {
     pub mu: f64,
     /// Nodes behind the line.
     pub nodes: Vec<u32>,
+    /// The wall acts for `appear_at` ≤ t < `remove_at` (s), t the step's
+    /// start; 0 and +∞ for a wall that is always there.
+    pub appear_at: f64,
+    pub remove_at: f64,
+}
+
+impl Wall {
+    /// Whether the wall acts in the step that starts at `t` (s).
+    #[inline]
+    pub fn active_at(&self, t: f64) -> bool {
+        self.appear_at <= t && t < self.remove_at
+    }
 }
 
 /// The scene's walls, and per node the bit set of the walls it is behind
@@ -40,6 +52,13 @@ pub struct Walls {
 impl Walls {
     pub fn is_empty(&self) -> bool {
         self.list.is_empty()
+    }
+
+    /// Whether some wall appears or goes during the run (a gate).
+    pub fn timed(&self) -> bool {
+        self.list
+            .iter()
+            .any(|w| w.appear_at > 0.0 || w.remove_at.is_finite())
     }
 
     /// Walls of `scene` on `grid`. A wall with no node behind it is an
@@ -94,6 +113,8 @@ impl Walls {
                 contact,
                 mu,
                 nodes,
+                appear_at: w.appear_at,
+                remove_at: w.remove_at.unwrap_or(f64::INFINITY),
             });
         }
         Ok(Walls { list, mask })
