@@ -54,7 +54,7 @@ fn bin_particle(p: u32, c: ShapeCtx) -> BinParticle {
     let q = (x0[p] + u[p]) * params.inv_h;
     let span = mls_span_of(q.y, params.mls_spans_y) * params.mls_spans_x + mls_span_of(q.x, params.mls_spans_x);
     if mls_occ[span] == 1u {
-        s -= vec3<f32>(mls_fit[3u * p], mls_fit[3u * p + 1u], mls_fit[3u * p + 2u]);
+        s -= vec3<f32>(mls_fit[6u * p], mls_fit[6u * p + 1u], mls_fit[6u * p + 2u]);
     }
 #endif
     return BinParticle(true, m / rho[p], s, m * body_force(p, load_time()));

@@ -5,7 +5,9 @@
 // weight), each point with its own moment matrix. A singular matrix marks
 // the point's integration cell (mls_occ |= 2), which mls_force_gauss and
 // forces (MLS_FORCE) then leave out of both sums. Gauss points: σ_h(x_g)
-// into mls_coef[3g..3g+3]; particles: σ_h(x_p) into mls_fit[3p..3p+3].
+// and c = A⁻¹e₀ into mls_coef[6g..6g+6]; particles: σ_h(x_p) and c into
+// mls_fit[6p..6p+6]. In stage `stress` (update stress first) the same
+// passes give mls_strain.wgsl its c's.
 // CPU twin: `Mls::fit_stress` (src/cpu/mls.rs).
 #include "shared/common.wgsl"
 #include "shared/mls.wgsl"
@@ -25,6 +27,8 @@
 struct Fit {
     ok: bool,
     s: vec3<f32>,
+    // c = A⁻¹e₀ (mls_strain.wgsl's weights φ_q(x) = w (c · [1, Δ])).
+    c: vec3<f32>,
 }
 
 // The fit of σ at x (m, grid-relative).
@@ -69,10 +73,10 @@ fn fit_at(x: vec2<f32>) -> Fit {
     let c02 = a01 * a12 - a02 * a11;
     let det = a00 * c00 + a01 * c01 + a02 * c02;
     if !(a00 > 0.0) || !(det > MLS_SINGULAR_REL * a00 * a00 * a00) {
-        return Fit(false, vec3<f32>(0.0));
+        return Fit(false, vec3<f32>(0.0), vec3<f32>(0.0));
     }
     let c = vec3<f32>(c00, c01, c02) / det;
-    return Fit(true, vec3<f32>(dot(c, m_xx), dot(c, m_yy), dot(c, m_xy)));
+    return Fit(true, vec3<f32>(dot(c, m_xx), dot(c, m_yy), dot(c, m_xy)), c);
 }
 
 @compute @workgroup_size(256)
@@ -84,9 +88,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let x = x0[p] + u[p];
     let f = fit_at(x);
-    mls_fit[3u * p] = f.s.x;
-    mls_fit[3u * p + 1u] = f.s.y;
-    mls_fit[3u * p + 2u] = f.s.z;
+    mls_fit[6u * p] = f.s.x;
+    mls_fit[6u * p + 1u] = f.s.y;
+    mls_fit[6u * p + 2u] = f.s.z;
+    mls_fit[6u * p + 3u] = f.c.x;
+    mls_fit[6u * p + 4u] = f.c.y;
+    mls_fit[6u * p + 5u] = f.c.z;
     if !f.ok {
         let q = x * params.inv_h;
         let span = mls_span_of(q.y, params.mls_spans_y) * params.mls_spans_x + mls_span_of(q.x, params.mls_spans_x);
@@ -97,9 +104,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if sim.running == 0u || g >= mls_n_gauss() {
         return;
     }
-    mls_coef[3u * g] = 0.0;
-    mls_coef[3u * g + 1u] = 0.0;
-    mls_coef[3u * g + 2u] = 0.0;
+    for (var k = 0u; k < 6u; k++) {
+        mls_coef[6u * g + k] = 0.0;
+    }
     let gp = mls_gauss_point(g);
     if atomicLoad(&mls_occ[gp.span]) == 0u {
         return;
@@ -109,8 +116,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         atomicOr(&mls_occ[gp.span], 2u);
         return;
     }
-    mls_coef[3u * g] = f.s.x;
-    mls_coef[3u * g + 1u] = f.s.y;
-    mls_coef[3u * g + 2u] = f.s.z;
+    mls_coef[6u * g] = f.s.x;
+    mls_coef[6u * g + 1u] = f.s.y;
+    mls_coef[6u * g + 2u] = f.s.z;
+    mls_coef[6u * g + 3u] = f.c.x;
+    mls_coef[6u * g + 4u] = f.c.y;
+    mls_coef[6u * g + 5u] = f.c.z;
 #endif
 }

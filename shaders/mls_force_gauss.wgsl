@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if mls_occ[gp.span] != 1u {
         return;
     }
-    let s = vec3<f32>(mls_coef[3u * g], mls_coef[3u * g + 1u], mls_coef[3u * g + 2u]);
+    let s = vec3<f32>(mls_coef[6u * g], mls_coef[6u * g + 1u], mls_coef[6u * g + 2u]);
     let sc = shape_ctx(0u, gp.x);
     for (var k = 0u; k < STENCIL; k++) {
         let nw = shape_node(sc, k);

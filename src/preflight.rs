@@ -388,8 +388,9 @@ fn memory(
         let gp = model::gauss::gauss_points(shape, &grid) as f64;
         mls = 12.0 * n + gp * (16.0 + 8.0 + 2.0 + slots * 28.0 + 8.0 * 13.0);
         if f.solver.mls_scope == crate::scene::MlsScope::Force {
-            // `Mls::for_force_correction`: the fit and its flag per particle.
-            mls += 25.0 * n;
+            // `Mls::for_force_correction`: per particle the fit, its c and
+            // flag, V_p L_p and ΔL twice; per Gauss point ω_g L(x_g).
+            mls += 145.0 * n + 32.0 * gp;
         }
     }
     let probes = f.output.probes.len() as f64;

@@ -144,6 +144,14 @@ pub enum Pass {
     MlsFitGauss,
     MlsFitParticles,
     MlsForceGauss,
+    /// `solver.mls_scope = "force"`, stage `stress`: ω_g L(x_g) at each
+    /// Gauss point (mls_grad.wgsl), then V_p L_p at each particle (built
+    /// with PARTICLES), then each particle's strain-rate correction, the
+    /// transpose of the force's bracket (mls_strain.wgsl), which `Stress`
+    /// (built with MLS_FORCE) adds to L_p.
+    MlsGradGauss,
+    MlsGradParticles,
+    MlsStrain,
     GridCorrect,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
@@ -159,7 +167,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 30] = [
+    pub const ALL: [Pass; 33] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -182,6 +190,9 @@ impl Pass {
         Pass::MlsFitGauss,
         Pass::MlsFitParticles,
         Pass::MlsForceGauss,
+        Pass::MlsGradGauss,
+        Pass::MlsGradParticles,
+        Pass::MlsStrain,
         Pass::GridCorrect,
         Pass::G2p,
         Pass::RemapClear,
@@ -216,6 +227,8 @@ impl Pass {
             Pass::MlsForces => "mls_forces.wgsl",
             Pass::MlsFitGauss | Pass::MlsFitParticles => "mls_fit.wgsl",
             Pass::MlsForceGauss => "mls_force_gauss.wgsl",
+            Pass::MlsGradGauss | Pass::MlsGradParticles => "mls_grad.wgsl",
+            Pass::MlsStrain => "mls_strain.wgsl",
             Pass::RemapClear | Pass::Remap => "remap.wgsl",
             Pass::MlsRemap => "mls_remap.wgsl",
         }
@@ -328,6 +341,7 @@ impl StepPlan {
             lme,
             mls,
             mls_force,
+            musl,
             gather,
             patch,
             walls,
@@ -361,6 +375,27 @@ impl StepPlan {
             Stage::Forces if patch => &[Pass::ForcesPatch],
             Stage::GridPredict if walls => &[Pass::WallTouch, Pass::GridPredict],
             Stage::GridPredict => &[Pass::GridPredict],
+            // The fit at the forces' positions: MUSL's forces came first
+            // this step; update-stress-first fits here (and again in
+            // `forces`, for the new stress).
+            Stage::Stress if mls_force && musl => &[
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
+                Pass::Stress,
+            ],
+            Stage::Stress if mls_force => &[
+                BINS[0],
+                BINS[1],
+                BINS[2],
+                BINS[3],
+                Pass::MlsFitGauss,
+                Pass::MlsFitParticles,
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
+                Pass::Stress,
+            ],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect => &[Pass::GridCorrect],
@@ -446,6 +481,9 @@ mod tests {
                 Pass::MlsFitParticles,
                 Pass::Forces,
                 Pass::MlsForceGauss,
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
             ] {
                 assert!(p.gpu_step.contains(&pass), "{pass:?}");
             }

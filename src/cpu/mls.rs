@@ -90,6 +90,14 @@ pub struct Mls {
     pub part_fit: Vec<[f64; 3]>,
     part_ok: Vec<bool>,
     pub cell_ok: Vec<bool>,
+    /// `"force"` only: per particle, its fit's c = A⁻¹e₀ (zeros where
+    /// singular); per Gauss point, ω_g L(x_g) (zeros outside `cell_ok`);
+    /// per particle in binned order, V_p L_p (zeros outside `cell_ok`) and
+    /// the strain-rate correction (`strain_correction`).
+    part_coef: Vec<[f64; 3]>,
+    gp_l: Vec<[f64; 4]>,
+    part_vl: Vec<[f64; 4]>,
+    part_dl: Vec<[f64; 4]>,
 }
 
 impl Mls {
@@ -138,6 +146,10 @@ impl Mls {
             part_fit: Vec::new(),
             part_ok: Vec::new(),
             cell_ok: Vec::new(),
+            part_coef: Vec::new(),
+            gp_l: Vec::new(),
+            part_vl: Vec::new(),
+            part_dl: Vec::new(),
         })
     }
 
@@ -147,6 +159,10 @@ impl Mls {
         self.part_fit = vec![[0.0; 3]; n];
         self.part_ok = vec![false; n];
         self.cell_ok = vec![false; self.occupied.len()];
+        self.part_coef = vec![[0.0; 3]; n];
+        self.gp_l = vec![[0.0; 4]; self.gp_x.len()];
+        self.part_vl = vec![[0.0; 4]; n];
+        self.part_dl = vec![[0.0; 4]; n];
         self
     }
 
@@ -351,9 +367,10 @@ impl Mls {
             std::mem::take(&mut self.gp_f),
             std::mem::take(&mut self.cell_ok),
         );
-        let (mut part_fit, mut part_ok) = (
+        let (mut part_fit, mut part_ok, mut part_coef) = (
             std::mem::take(&mut self.part_fit),
             std::mem::take(&mut self.part_ok),
+            std::mem::take(&mut self.part_coef),
         );
         let this = &*self;
         coef.par_chunks_mut(4)
@@ -380,11 +397,12 @@ impl Mls {
         part_fit
             .par_iter_mut()
             .zip(part_ok.par_iter_mut())
+            .zip(part_coef.par_iter_mut())
             .zip(x)
             .with_min_len(1024)
-            .for_each(|((f, ok), &xp)| match this.fit_at(grid, xp) {
-                Some((_, v)) => (*f, *ok) = (v, true),
-                None => (*f, *ok) = ([0.0; 3], false),
+            .for_each(|(((f, ok), c), &xp)| match this.fit_at(grid, xp) {
+                Some((cp, v)) => (*f, *ok, *c) = (v, true, cp),
+                None => (*f, *ok, *c) = ([0.0; 3], false, [0.0; 3]),
             });
         for (p, ok) in part_ok.iter().enumerate() {
             if !ok {
@@ -392,7 +410,144 @@ impl Mls {
             }
         }
         (self.coef, self.gp_f, self.cell_ok) = (coef, vals, cell_ok);
-        (self.part_fit, self.part_ok) = (part_fit, part_ok);
+        (self.part_fit, self.part_ok, self.part_coef) = (part_fit, part_ok, part_coef);
+    }
+
+    /// `solver.mls_scope = "force"`, in the `stress` stage, after
+    /// `fit_stress` at the same positions: the transpose of the force's
+    /// bracket applied to the nodal velocities `mv` (after
+    /// `grid_update::predict`), per particle q in particle order,
+    ///   V_q ΔL_q = Σ_{g∈c ok} ω_g φ_q(x_g) L(x_g) − Σ_{p∈c ok} V_p φ_q(x_p) L_p,
+    /// L = Σ_I v_I ⊗ ∇N_I, φ_q(x) = w(x_q − x) c(x)·[1, (x_q − x)/h] the
+    /// fit's weight of particle q at x. Added to L_q, it makes the stress
+    /// power Σ_q V_q σ_q : (L_q + ΔL_q) equal the nodal forces' work
+    /// −Σ_I v_I · f_I (docs/methods.md, "MLS as a force correction"):
+    /// without it the bracket's work is not stored as strain energy.
+    /// `mass`, `rho`: the particles' at the fit's positions.
+    pub fn strain_correction(
+        &mut self,
+        grid: &Grid,
+        cache: &ShapeCache,
+        mv: &[[f64; 3]],
+        mass: &[f64],
+        rho: &[f64],
+        dl: &mut [[f64; 4]],
+    ) {
+        let grad = |nodes: &[u32], w: &[[f64; 3]]| {
+            let mut l = [0.0; 4];
+            for (&node, wk) in nodes.iter().zip(w) {
+                let v = &mv[node as usize];
+                l[0] += v[1] * wk[1];
+                l[1] += v[1] * wk[2];
+                l[2] += v[2] * wk[1];
+                l[3] += v[2] * wk[2];
+            }
+            l
+        };
+        let (mut gp_l, mut part_vl, mut part_dl) = (
+            std::mem::take(&mut self.gp_l),
+            std::mem::take(&mut self.part_vl),
+            std::mem::take(&mut self.part_dl),
+        );
+        let this = &*self;
+        gp_l.par_iter_mut().enumerate().for_each(|(g, o)| {
+            *o = [0.0; 4];
+            if this.cell_ok[g / 4] {
+                let (nodes, w) = this.gp_shape.particle(g);
+                *o = grad(nodes, w).map(|l| l * this.gp_w[g]);
+            }
+        });
+        part_vl
+            .par_iter_mut()
+            .zip(&this.order)
+            .with_min_len(1024)
+            .for_each(|(o, &p)| {
+                let p = p as usize;
+                *o = [0.0; 4];
+                if this.cell_ok[this.cell_of[p][1] as usize] {
+                    let (nodes, w) = cache.particle(p);
+                    *o = grad(nodes, w).map(|l| l * mass[p] / rho[p]);
+                }
+            });
+        let inv_h = 1.0 / grid.h;
+        let sc = this.weight_scale;
+        let reach = 1.5 / sc;
+        let nb = [this.breaks[0].len() - 1, this.breaks[1].len() - 1];
+        let span_range = |b: &[f64], a: f64| {
+            let lo = b.partition_point(|&t| t <= a - reach).saturating_sub(1);
+            let hi = b.partition_point(|&t| t < a + reach).min(b.len() - 1);
+            lo..hi
+        };
+        let (gp_l_ref, part_vl_ref) = (&gp_l, &part_vl);
+        part_dl
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(k, o)| {
+                let xq = [this.packed[k][0], this.packed[k][1]];
+                let u = grid.logical(xq);
+                let mut acc = [0.0; 4];
+                // Gauss points: φ_q(x_g) with the Gauss point's c.
+                for sy in span_range(&this.breaks[1], u[1]) {
+                    for sx in span_range(&this.breaks[0], u[0]) {
+                        let ic = sy * nb[0] + sx;
+                        if !this.cell_ok[ic] {
+                            continue;
+                        }
+                        for g in 4 * ic..4 * ic + 4 {
+                            let d = [
+                                (xq[0] - this.gp_x[g][0]) * inv_h,
+                                (xq[1] - this.gp_x[g][1]) * inv_h,
+                            ];
+                            let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                            if w == 0.0 {
+                                continue;
+                            }
+                            let c = this.coef[g];
+                            let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                            for (a, l) in acc.iter_mut().zip(gp_l_ref[g]) {
+                                *a += phi * l;
+                            }
+                        }
+                    }
+                }
+                // Particles: −φ_q(x_p) with particle p's c.
+                let range = |a: f64, n: usize| {
+                    let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+                    let i1 = ((a + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+                    (i0.min(n - 1), i1)
+                };
+                let (i0, i1) = range(u[0], this.cells[0]);
+                let (j0, j1) = range(u[1], this.cells[1]);
+                for j in j0..=j1 {
+                    let row = j * this.cells[0];
+                    let (s, e) = (this.cell_start[row + i0], this.cell_start[row + i1 + 1]);
+                    for k2 in s as usize..e as usize {
+                        let vl = part_vl_ref[k2];
+                        if vl == [0.0; 4] {
+                            continue;
+                        }
+                        let q = &this.packed[k2];
+                        let d = [(xq[0] - q[0]) * inv_h, (xq[1] - q[1]) * inv_h];
+                        let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let c = this.part_coef[this.order[k2] as usize];
+                        let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                        for (a, l) in acc.iter_mut().zip(vl) {
+                            *a -= phi * l;
+                        }
+                    }
+                }
+                *o = acc;
+            });
+        for (k, &p) in this.order.iter().enumerate() {
+            let p = p as usize;
+            let inv_v = rho[p] / mass[p];
+            dl[p] = part_dl[k].map(|a| a * inv_v);
+        }
+        (self.gp_l, self.part_vl, self.part_dl) = (gp_l, part_vl, part_dl);
     }
 
     /// `solver.mls_scope = "force"`, second half of the `forces` stage,

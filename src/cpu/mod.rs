@@ -46,6 +46,9 @@ pub struct CpuBackend {
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
     pub mls: Option<mls::Mls>,
+    /// `solver.mls_scope = "force"`: per particle, the strain-rate
+    /// correction `Mls::strain_correction` (empty otherwise).
+    mls_dl: Vec<[f64; 4]>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -81,6 +84,11 @@ impl CpuBackend {
                     crate::scene::MlsScope::All => m,
                 }
             }),
+            mls_dl: if model.mls && model.mls_scope == crate::scene::MlsScope::Force {
+                vec![[0.0; 4]; n]
+            } else {
+                Vec::new()
+            },
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -123,8 +131,12 @@ impl CpuBackend {
             per += 12.0
                 + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
             if model.mls_scope == crate::scene::MlsScope::Force {
-                // The fit at each particle and its flag.
-                per += 25.0;
+                // The fit at each particle, its c and flag; V_p L_p and ΔL
+                // in binned order and in particle order; ω_g L(x_g).
+                per += 49.0
+                    + 3.0 * 32.0
+                    + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * 32.0
+                        / n;
             }
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
@@ -314,18 +326,36 @@ impl CpuBackend {
                     self.mass_eps,
                 );
             }
-            Stage::Stress => stress::stress(
-                &self.cache,
-                &self.mv,
-                self.dt,
-                &p.body,
-                &m.materials,
-                &m.body_material,
-                &mut p.stress,
-                &mut p.rho,
-                &mut p.f,
-                &mut p.plastic,
-            )?,
+            Stage::Stress => {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
+                    // MUSL's forces fitted at this step's start, where the
+                    // shape cache still is; update-stress-first fits here.
+                    if m.integrator != Integrator::Musl {
+                        mls.fit_stress(&m.grid, &p.x, &p.stress);
+                    }
+                    mls.strain_correction(
+                        &m.grid,
+                        &self.cache,
+                        &self.mv,
+                        &p.mass,
+                        &p.rho,
+                        &mut self.mls_dl,
+                    );
+                }
+                stress::stress(
+                    &self.cache,
+                    &self.mv,
+                    self.dt,
+                    &p.body,
+                    &m.materials,
+                    &m.body_material,
+                    &mut p.stress,
+                    &mut p.rho,
+                    &mut p.f,
+                    &mut p.plastic,
+                    &self.mls_dl,
+                )?
+            }
             Stage::Forces => {
                 let body = body_force(
                     m.gravity,

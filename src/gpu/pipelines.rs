@@ -40,7 +40,8 @@ fn domain(pass: Pass) -> Domain {
         | Pass::MlsForces
         | Pass::MlsRemap
         | Pass::MlsFitGauss
-        | Pass::MlsForceGauss => Domain::GaussPoints,
+        | Pass::MlsForceGauss
+        | Pass::MlsGradGauss => Domain::GaussPoints,
         Pass::ClearGrid
         | Pass::GridPredict
         | Pass::GridCorrect
@@ -266,7 +267,10 @@ pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
         matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
     )
     .flag("CLEAR", pass == Pass::RemapClear)
-    .flag("PARTICLES", pass == Pass::MlsFitParticles);
+    .flag(
+        "PARTICLES",
+        matches!(pass, Pass::MlsFitParticles | Pass::MlsGradParticles),
+    );
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
