@@ -303,6 +303,7 @@ fn manufactured_vibration_gpu_matches_cpu() {
             "solver.t_end=0.005",
             "solver.shape=bspline2",
             "solver.mls=true",
+            "solver.mls_scope=all",
         ],
         // The paper's update: MUSL with the MLS remap.
         &[
@@ -310,6 +311,7 @@ fn manufactured_vibration_gpu_matches_cpu() {
             "solver.t_end=0.005",
             "solver.shape=bspline2",
             "solver.mls=true",
+            "solver.mls_scope=all",
             "solver.integrator=musl",
         ],
         // MUSL with MLS as the internal force's correction only (issue 28).
