@@ -454,8 +454,9 @@ pub struct SolverSpec {
     /// What the MLS fit does (with `mls = true`): `all` (the paper's step:
     /// mass, momentum, body force and stress fitted and integrated at the
     /// Gauss points, and the remap through them) or `force` (the fit only
-    /// corrects the quadrature of the internal force; every other transfer
-    /// is plain MPM through the particles' own N_I(x_p); docs/methods.md,
+    /// corrects the quadrature of the internal force, and the strain rate
+    /// by its transpose; every other transfer is plain MPM through the
+    /// particles' own N_I(x_p); docs/methods.md,
     /// "MLS as a force correction"). Default `all`.
     #[serde(default)]
     pub mls_scope: MlsScope,
@@ -479,7 +480,8 @@ pub enum MlsScope {
     #[default]
     All,
     /// The fit corrects the internal force's quadrature only:
-    /// f_I = −Σ_p V_p σ_p ∇N_I(x_p) − [Σ_g ω_g σ_h(x_g) ∇N_I(x_g) − Σ_p V_p σ_h(x_p) ∇N_I(x_p)].
+    /// f_I = −Σ_p V_p σ_p ∇N_I(x_p) − [Σ_g ω_g σ_h(x_g) ∇N_I(x_g) − Σ_p V_p σ_h(x_p) ∇N_I(x_p)],
+    /// and the strain rate by the bracket's transpose (`Mls::strain_correction`).
     Force,
 }
 
