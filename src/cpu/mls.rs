@@ -494,18 +494,19 @@ impl Mls {
                         if !this.cell_ok[ic] {
                             continue;
                         }
-                        for g in 4 * ic..4 * ic + 4 {
-                            let d = [
-                                (xq[0] - this.gp_x[g][0]) * inv_h,
-                                (xq[1] - this.gp_x[g][1]) * inv_h,
-                            ];
+                        let gs = 4 * ic..4 * ic + 4;
+                        for ((xg, c), lg) in this.gp_x[gs.clone()]
+                            .iter()
+                            .zip(&this.coef[gs.clone()])
+                            .zip(&gp_l_ref[gs])
+                        {
+                            let d = [(xq[0] - xg[0]) * inv_h, (xq[1] - xg[1]) * inv_h];
                             let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
                             if w == 0.0 {
                                 continue;
                             }
-                            let c = this.coef[g];
                             let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
-                            for (a, l) in acc.iter_mut().zip(gp_l_ref[g]) {
+                            for (a, l) in acc.iter_mut().zip(lg) {
                                 *a += phi * l;
                             }
                         }
@@ -522,18 +523,21 @@ impl Mls {
                 for j in j0..=j1 {
                     let row = j * this.cells[0];
                     let (s, e) = (this.cell_start[row + i0], this.cell_start[row + i1 + 1]);
-                    for k2 in s as usize..e as usize {
-                        let vl = part_vl_ref[k2];
-                        if vl == [0.0; 4] {
+                    let ks = s as usize..e as usize;
+                    for ((vl, q), &p) in part_vl_ref[ks.clone()]
+                        .iter()
+                        .zip(&this.packed[ks.clone()])
+                        .zip(&this.order[ks])
+                    {
+                        if *vl == [0.0; 4] {
                             continue;
                         }
-                        let q = &this.packed[k2];
                         let d = [(xq[0] - q[0]) * inv_h, (xq[1] - q[1]) * inv_h];
                         let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
                         if w == 0.0 {
                             continue;
                         }
-                        let c = this.part_coef[this.order[k2] as usize];
+                        let c = this.part_coef[p as usize];
                         let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
                         for (a, l) in acc.iter_mut().zip(vl) {
                             *a -= phi * l;
