@@ -31,12 +31,13 @@ pub const MAX_PARTICLES: f64 = (1u64 << 28) as f64;
 /// at about 2e6). Used for the hours estimate on every backend: a hardware
 /// GPU is faster, so the estimate errs long.
 /// MLS as the force correction (`solver.mls_scope = "force"`, a fit at
-/// every particle) ran at 1.1e5 on 2 threads at 16 cells (docs/methods.md,
-/// "MLS as a force correction"): 2.5e4 per thread.
+/// every particle and the strain correction's sums) ran at 7.4e4 on 2
+/// threads at 8 cells and 2.3e4 at 32 (beside another run; docs/methods.md,
+/// "MLS as a force correction"): 1.2e4 per thread.
 fn speed_per_thread(shape: &Shape, mls: bool, force: bool) -> f64 {
     match shape {
         Shape::Lme(_) => 4e5,
-        _ if mls && force => 2.5e4,
+        _ if mls && force => 1.2e4,
         _ if mls => 1e6,
         Shape::Bspline(_) => 1e6,
         Shape::Linear | Shape::Ugimp(_) => 2.5e6,
