@@ -28,6 +28,16 @@
 #include "shared/bins.wgsl"
 #include "shared/body_force.wgsl"
 
+#if MLS_FORCE
+// solver.mls_scope = "force": the particles' part of the corrected internal
+// force, −V_p (σ_p − σ_h(x_p)) ∇N_I(x_p), σ_h(x_p) from mls_fit.wgsl, in
+// the integration cells whose fits are all regular (mls_occ == 1); the
+// Gauss points' part is mls_force_gauss.wgsl.
+#include "shared/mls.wgsl"
+@group(0) @binding({{B_MLS_OCC}}) var<storage, read> mls_occ: array<u32>;
+@group(0) @binding({{B_MLS_FIT}}) var<storage, read> mls_fit: array<f32>;
+#endif
+
 // The load time: MUSL takes its forces from σ^t, so the loads at t (eq. 24).
 fn load_time() -> f32 {
 #if MUSL
@@ -39,7 +49,14 @@ fn load_time() -> f32 {
 
 fn bin_particle(p: u32, c: ShapeCtx) -> BinParticle {
     let m = mass[p];
-    let s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+    var s = vec3<f32>(stress[3u * p], stress[3u * p + 1u], stress[3u * p + 2u]);
+#if MLS_FORCE
+    let q = (x0[p] + u[p]) * params.inv_h;
+    let span = mls_span_of(q.y, params.mls_spans_y) * params.mls_spans_x + mls_span_of(q.x, params.mls_spans_x);
+    if mls_occ[span] == 1u {
+        s -= vec3<f32>(mls_fit[6u * p], mls_fit[6u * p + 1u], mls_fit[6u * p + 2u]);
+    }
+#endif
     return BinParticle(true, m / rho[p], s, m * body_force(p, load_time()));
 }
 

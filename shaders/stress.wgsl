@@ -25,6 +25,10 @@
 #if MUSL
 @group(0) @binding({{B_X_START}}) var<storage, read> x_start: array<vec2<f32>>;
 #endif
+#if MLS_FORCE
+// solver.mls_scope = "force": the strain-rate correction (mls_strain.wgsl).
+@group(0) @binding({{B_MLS_DL}}) var<storage, read> mls_dl: array<vec4<f32>>;
+#endif
 @group(0) @binding({{B_RHO}}) var<storage, read_write> rho: array<f32>;
 @group(0) @binding({{B_STRESS}}) var<storage, read_write> stress: array<f32>;
 #if FORCES
@@ -76,6 +80,9 @@ fn update_particle(p: u32, c: ShapeCtx) -> Updated {
             l += vec4<f32>(vn.x * w.dn.x, vn.x * w.dn.y, vn.y * w.dn.x, vn.y * w.dn.y);
         }
     }
+#if MLS_FORCE
+    l += mls_dl[p];
+#endif
     let dt = sim.dt;
 #if DEF_GRAD
     let f = def_grad[p];

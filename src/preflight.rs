@@ -30,9 +30,14 @@ pub const MAX_PARTICLES: f64 = (1u64 << 28) as f64;
 /// LME γ = 2 ran at 9e5 per thread, linear/uGIMP at 5e6, B-splines with MLS
 /// at about 2e6). Used for the hours estimate on every backend: a hardware
 /// GPU is faster, so the estimate errs long.
-fn speed_per_thread(shape: &Shape, mls: bool) -> f64 {
+/// MLS as the force correction (`solver.mls_scope = "force"`, a fit at
+/// every particle and the strain correction's sums) ran at 7.4e4 on 2
+/// threads at 8 cells and 2.3e4 at 32 (beside another run; docs/methods.md,
+/// "MLS as a force correction"): 1.2e4 per thread.
+fn speed_per_thread(shape: &Shape, mls: bool, force: bool) -> f64 {
     match shape {
         Shape::Lme(_) => 4e5,
+        _ if mls && force => 1.2e4,
         _ if mls => 1e6,
         Shape::Bspline(_) => 1e6,
         Shape::Linear | Shape::Ugimp(_) => 2.5e6,
@@ -301,7 +306,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         .map_or(0.0, |v| (t_end / v.max(dt)).floor() + 1.0)
         + f64::from(u8::from(f.output.vtk_final));
 
-    let speed = speed_per_thread(&shape, f.solver.mls) * threads.max(1) as f64;
+    let force = f.solver.mls_scope == crate::scene::MlsScope::Force;
+    let speed = speed_per_thread(&shape, f.solver.mls, force) * threads.max(1) as f64;
     let memory_bytes = memory(scene, &shape, n, lo, nx, ny, threads, samples);
     Ok(Estimate {
         particles: n,
@@ -382,6 +388,11 @@ fn memory(
         let grid = model::Grid::regular(f.grid.h, lo, nx.max(2), ny.max(2));
         let gp = model::gauss::gauss_points(shape, &grid) as f64;
         mls = 12.0 * n + gp * (16.0 + 8.0 + 2.0 + slots * 28.0 + 8.0 * 13.0);
+        if f.solver.mls_scope == crate::scene::MlsScope::Force {
+            // `Mls::for_force_correction`: per particle the fit, its c and
+            // flag, V_p L_p and ΔL twice; per Gauss point ω_g L(x_g).
+            mls += 145.0 * n + 32.0 * gp;
+        }
     }
     let probes = f.output.probes.len() as f64;
     let constraints = f.constraints.len() as f64;

@@ -291,6 +291,7 @@ fn finish(
         cfl: solver.cfl,
         dt: solver.dt,
         mls: solver.mls,
+        mls_scope: solver.mls.then_some(solver.mls_scope),
         h: model.grid.h,
         perturb: model.grid.perturb,
         energy: final_sample
@@ -604,7 +605,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     };
     let shape = if model.mls {
         format!(
-            "{shape}, MLS reconstruction at {} Gauss points",
+            "{shape}, MLS {} at {} Gauss points",
+            match model.mls_scope {
+                crate::scene::MlsScope::All => "reconstruction (the paper's step)",
+                crate::scene::MlsScope::Force => "correction of the internal force's quadrature",
+            },
             crate::model::gauss::gauss_points(&model.shape, g)
         )
     } else {

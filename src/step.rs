@@ -15,6 +15,7 @@
 
 use crate::model::shape::Shape;
 use crate::model::{Integrator, Model};
+use crate::scene::MlsScope;
 
 /// One stage of a step. Each has a CPU twin `src/cpu/<name>.rs` and a
 /// WGSL twin `shaders/<name>.wgsl` of the same name.
@@ -135,6 +136,22 @@ pub enum Pass {
     /// forces.wgsl built with PATCH, as `P2gPatch`.
     ForcesPatch,
     MlsForces,
+    /// `solver.mls_scope = "force"`: the fit of σ at each Gauss point
+    /// (mls_fit.wgsl, one invocation per Gauss point), then at each
+    /// particle (built with PARTICLES); `Forces` then scatters the
+    /// particles' −V_p (σ_p − σ_h(x_p)) ∇N_I(x_p) and `MlsForceGauss` the
+    /// Gauss points' −ω_g σ_h(x_g) ∇N_I(x_g).
+    MlsFitGauss,
+    MlsFitParticles,
+    MlsForceGauss,
+    /// `solver.mls_scope = "force"`, stage `stress`: ω_g L(x_g) at each
+    /// Gauss point (mls_grad.wgsl), then V_p L_p at each particle (built
+    /// with PARTICLES), then each particle's strain-rate correction, the
+    /// transpose of the force's bracket (mls_strain.wgsl), which `Stress`
+    /// (built with MLS_FORCE) adds to L_p.
+    MlsGradGauss,
+    MlsGradParticles,
+    MlsStrain,
     GridCorrect,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
@@ -150,7 +167,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 27] = [
+    pub const ALL: [Pass; 33] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -170,6 +187,12 @@ impl Pass {
         Pass::ForcesGather,
         Pass::ForcesPatch,
         Pass::MlsForces,
+        Pass::MlsFitGauss,
+        Pass::MlsFitParticles,
+        Pass::MlsForceGauss,
+        Pass::MlsGradGauss,
+        Pass::MlsGradParticles,
+        Pass::MlsStrain,
         Pass::GridCorrect,
         Pass::G2p,
         Pass::RemapClear,
@@ -202,6 +225,10 @@ impl Pass {
             Pass::BinFill => "bin_fill.wgsl",
             Pass::MlsP2g => "mls_p2g.wgsl",
             Pass::MlsForces => "mls_forces.wgsl",
+            Pass::MlsFitGauss | Pass::MlsFitParticles => "mls_fit.wgsl",
+            Pass::MlsForceGauss => "mls_force_gauss.wgsl",
+            Pass::MlsGradGauss | Pass::MlsGradParticles => "mls_grad.wgsl",
+            Pass::MlsStrain => "mls_strain.wgsl",
             Pass::RemapClear | Pass::Remap => "remap.wgsl",
             Pass::MlsRemap => "mls_remap.wgsl",
         }
@@ -214,7 +241,13 @@ impl Pass {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PlanInputs {
     pub lme: bool,
+    /// The paper's MLS step (`solver.mls_scope = "all"`): `p2g`, `forces`
+    /// and the remap at Gauss points.
     pub mls: bool,
+    /// MLS as the internal force's quadrature correction only
+    /// (`solver.mls_scope = "force"`): `forces` alone changes; `p2g`, the
+    /// remap and `g2p` stay the particles' own.
+    pub mls_force: bool,
     pub musl: bool,
     /// `p2g` and `forces` gather at nodes over particles binned in `shape_eval`.
     pub gather: bool,
@@ -248,7 +281,8 @@ impl StepPlan {
     pub fn of(model: &Model, gather: bool, patch: bool) -> StepPlan {
         StepPlan::new(PlanInputs {
             lme: matches!(model.shape, Shape::Lme(_)),
-            mls: model.mls,
+            mls: model.mls && model.mls_scope == MlsScope::All,
+            mls_force: model.mls && model.mls_scope == MlsScope::Force,
             musl: model.integrator == Integrator::Musl,
             gather,
             patch,
@@ -258,10 +292,14 @@ impl StepPlan {
 
     pub fn new(inputs: PlanInputs) -> StepPlan {
         let PlanInputs {
-            mls, musl, gather, ..
+            mls,
+            mls_force,
+            musl,
+            gather,
+            ..
         } = inputs;
         let stages = if musl { STEP_MUSL } else { STEP };
-        let fuse_stress = !mls && !musl;
+        let fuse_stress = !mls && !mls_force && !musl;
         let cpu = stages
             .iter()
             .filter_map(|&s| match s {
@@ -302,6 +340,8 @@ impl StepPlan {
         let PlanInputs {
             lme,
             mls,
+            mls_force,
+            musl,
             gather,
             patch,
             walls,
@@ -321,10 +361,41 @@ impl StepPlan {
             Stage::P2g if patch => &[Pass::P2gPatch],
             Stage::P2g => &[Pass::P2g],
             Stage::Forces if mls => &[Pass::MlsForces],
+            Stage::Forces if mls_force => &[
+                BINS[0],
+                BINS[1],
+                BINS[2],
+                BINS[3],
+                Pass::MlsFitGauss,
+                Pass::MlsFitParticles,
+                Pass::Forces,
+                Pass::MlsForceGauss,
+            ],
             Stage::Forces if gather => &[Pass::ForcesGather],
             Stage::Forces if patch => &[Pass::ForcesPatch],
             Stage::GridPredict if walls => &[Pass::WallTouch, Pass::GridPredict],
             Stage::GridPredict => &[Pass::GridPredict],
+            // The fit at the forces' positions: MUSL's forces came first
+            // this step; update-stress-first fits here (and again in
+            // `forces`, for the new stress).
+            Stage::Stress if mls_force && musl => &[
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
+                Pass::Stress,
+            ],
+            Stage::Stress if mls_force => &[
+                BINS[0],
+                BINS[1],
+                BINS[2],
+                BINS[3],
+                Pass::MlsFitGauss,
+                Pass::MlsFitParticles,
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
+                Pass::Stress,
+            ],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect => &[Pass::GridCorrect],
@@ -355,6 +426,7 @@ mod tests {
         StepPlan::new(PlanInputs {
             lme,
             mls,
+            mls_force: false,
             musl,
             gather,
             patch,
@@ -381,6 +453,42 @@ mod tests {
         let p = plan(true, false, false, false, true);
         assert!(p.gpu_step.contains(&Pass::StressForcesPatch));
         assert!(p.gpu_uses(Pass::ForcesPatch) && !p.gpu_uses(Pass::Forces));
+    }
+
+    /// `solver.mls_scope = "force"` changes `forces` alone: p2g, the remap
+    /// and the stress stay the particles' own (fused where they were).
+    #[test]
+    fn the_force_correction_replaces_only_the_forces_passes() {
+        for musl in [false, true] {
+            let p = StepPlan::new(PlanInputs {
+                lme: false,
+                mls: false,
+                mls_force: true,
+                musl,
+                gather: false,
+                patch: false,
+                walls: false,
+            });
+            assert_eq!(p.cpu[2], CpuWork::ShapeEvalP2g);
+            assert!(!p.cpu.contains(&CpuWork::StressForces));
+            assert!(p.cpu.contains(&CpuWork::Stage(Stage::Forces)));
+            for pass in [Pass::MlsP2g, Pass::MlsForces, Pass::MlsRemap] {
+                assert!(!p.gpu_uses(pass), "{pass:?}");
+            }
+            for pass in [
+                Pass::P2g,
+                Pass::MlsFitGauss,
+                Pass::MlsFitParticles,
+                Pass::Forces,
+                Pass::MlsForceGauss,
+                Pass::MlsGradGauss,
+                Pass::MlsGradParticles,
+                Pass::MlsStrain,
+            ] {
+                assert!(p.gpu_step.contains(&pass), "{pass:?}");
+            }
+            assert_eq!(p.gpu_uses(Pass::Remap), musl);
+        }
     }
 
     #[test]

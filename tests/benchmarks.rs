@@ -229,6 +229,7 @@ fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
                     &h,
                     "solver.shape=bspline2",
                     "solver.mls=true",
+                    "solver.mls_scope=all",
                     "solver.t_end=0.02",
                 ],
             );
@@ -267,6 +268,7 @@ fn aligned_vibration_paper_method_figures_as_measured() {
     let paper = [
         "solver.shape=bspline2",
         "solver.mls=true",
+        "solver.mls_scope=all",
         "solver.integrator=musl",
     ];
     let plain = ["solver.shape=bspline2", "solver.integrator=musl"];

@@ -125,6 +125,10 @@ fn variants() -> Vec<Variant> {
                                         plastic: has(StateKind::Plastic),
                                         mms,
                                         mls,
+                                        // The force correction with the
+                                        // manufactured solution, the paper's
+                                        // step without it.
+                                        mls_force: mls && mms,
                                         // Walls and loads in every shape and
                                         // integrator, with one atomic mode.
                                         walls: atomics == AtomicMode::CompareExchange && !mls,
@@ -264,6 +268,7 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::MlsForces
             | Pass::Remap
             | Pass::MlsRemap
+            | Pass::MlsForceGauss
             | Pass::WallTouch
     )
 }

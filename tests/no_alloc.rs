@@ -51,7 +51,23 @@ fn allocations(threads: usize) -> Vec<(String, usize)> {
             // B-spline, Neo-Hookean F, manufactured body force, MLS.
             (
                 "aligned_vibration.toml",
-                &["grid.h=0.125", "solver.mls=true", "solver.shape=bspline2"],
+                &[
+                    "grid.h=0.125",
+                    "solver.mls=true",
+                    "solver.mls_scope=all",
+                    "solver.shape=bspline2",
+                ],
+            ),
+            // MLS as the force correction, with its strain-rate correction.
+            (
+                "aligned_vibration.toml",
+                &[
+                    "grid.h=0.125",
+                    "solver.mls=true",
+                    "solver.mls_scope=force",
+                    "solver.shape=bspline2",
+                    "solver.integrator=musl",
+                ],
             ),
             ("aligned_vibration.toml", &["grid.h=0.125"]),
         ] {

@@ -242,6 +242,19 @@ fn mms_quick_every_method_converges_or_reports_why_not() {
     }
     // bspline2 + MLS completes both and is in the table.
     assert!(md.contains("bspline2-mls"));
+    // MLS as the force correction (issue 28) completes both resolutions,
+    // and the acceptance line names it.
+    for n in ["8", "16"] {
+        let r = results
+            .iter()
+            .find(|r| {
+                r.job.tag_value("method") == Some(lme_mpm::study::mms::GOAL_METHOD)
+                    && r.job.tag_value("cells") == Some(n)
+            })
+            .expect("the corrected mode runs");
+        assert!(r.completed(), "{}: {:?}", r.job.label, r.outcome);
+    }
+    assert!(md.contains("Acceptance figures for bspline2-mlsf"));
 }
 
 /// Bound on the quick disk study's eq. 67 error (percent) on a frictional

@@ -84,6 +84,20 @@ pub struct Mls {
     /// r per Δx/h in the weight: 1.5 / support (the paper's 1/2).
     weight_scale: f64,
     f_scatter: Scatter<2>,
+    /// `solver.mls_scope = "force"` only (empty otherwise): per particle,
+    /// the fit σ_h(x_p) (zeros where singular), and per integration cell,
+    /// whether the correction applies (every fit in it regular).
+    pub part_fit: Vec<[f64; 3]>,
+    part_ok: Vec<bool>,
+    pub cell_ok: Vec<bool>,
+    /// `"force"` only: per particle, its fit's c = A⁻¹e₀ (zeros where
+    /// singular); per Gauss point, ω_g L(x_g) (zeros outside `cell_ok`);
+    /// per particle in binned order, V_p L_p (zeros outside `cell_ok`) and
+    /// the strain-rate correction (`strain_correction`).
+    part_coef: Vec<[f64; 3]>,
+    gp_l: Vec<[f64; 4]>,
+    part_vl: Vec<[f64; 4]>,
+    part_dl: Vec<[f64; 4]>,
 }
 
 impl Mls {
@@ -129,7 +143,27 @@ impl Mls {
             mv_scatter: Scatter::default(),
             weight_scale: 1.5 / SUPPORT_CELLS,
             f_scatter: Scatter::default(),
+            part_fit: Vec::new(),
+            part_ok: Vec::new(),
+            cell_ok: Vec::new(),
+            part_coef: Vec::new(),
+            gp_l: Vec::new(),
+            part_vl: Vec::new(),
+            part_dl: Vec::new(),
         })
+    }
+
+    /// Allocates what `fit_stress` needs (`solver.mls_scope = "force"`).
+    pub fn for_force_correction(mut self) -> Self {
+        let n = self.order.len();
+        self.part_fit = vec![[0.0; 3]; n];
+        self.part_ok = vec![false; n];
+        self.cell_ok = vec![false; self.occupied.len()];
+        self.part_coef = vec![[0.0; 3]; n];
+        self.gp_l = vec![[0.0; 4]; self.gp_x.len()];
+        self.part_vl = vec![[0.0; 4]; n];
+        self.part_dl = vec![[0.0; 4]; n];
+        self
     }
 
     /// The weight's support half-width `cells` (`solver.mls_support`,
@@ -256,6 +290,314 @@ impl Mls {
                 );
             }
         }
+    }
+
+    /// Visits every particle within the weight's reach of the point `at`
+    /// (m), passing its packed data, Δ = (x_p − at)/h and the weight w.
+    #[inline]
+    fn neighbours_at(
+        &self,
+        grid: &Grid,
+        at: [f64; 2],
+        mut visit: impl FnMut(&[f64; 8], [f64; 2], f64),
+    ) {
+        let u = grid.logical(at);
+        let range = |a: f64, n: usize| {
+            let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+            let i1 = ((a + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+            (i0.min(n - 1), i1)
+        };
+        let (i0, i1) = range(u[0], self.cells[0]);
+        let (j0, j1) = range(u[1], self.cells[1]);
+        let inv_h = 1.0 / grid.h;
+        let sc = self.weight_scale;
+        for j in j0..=j1 {
+            let row = j * self.cells[0];
+            let (s, e) = (self.cell_start[row + i0], self.cell_start[row + i1 + 1]);
+            for q in &self.packed[s as usize..e as usize] {
+                let d = [(q[0] - at[0]) * inv_h, (q[1] - at[1]) * inv_h];
+                let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                if w == 0.0 {
+                    continue;
+                }
+                visit(q, d, w);
+            }
+        }
+    }
+
+    /// The fit of the first 3 packed fields at the point `at` with its own
+    /// moment matrix, with c = A⁻¹ e₀; `None` where A is singular.
+    fn fit_at(&self, grid: &Grid, at: [f64; 2]) -> Option<([f64; 3], [f64; 3])> {
+        let mut m = [0.0f64; 6];
+        let mut mom = [[0.0f64; 3]; 3];
+        self.neighbours_at(grid, at, |q, d, w| {
+            let (dx, dy) = (d[0], d[1]);
+            m[0] += w;
+            m[1] += w * dx;
+            m[2] += w * dy;
+            m[3] += w * dx * dx;
+            m[4] += w * dx * dy;
+            m[5] += w * dy * dy;
+            for f in 0..3 {
+                let wf = w * q[2 + f];
+                mom[f][0] += wf;
+                mom[f][1] += wf * dx;
+                mom[f][2] += wf * dy;
+            }
+        });
+        let c = solve_e0(&m)?;
+        Some((c, [dot(&c, &mom[0]), dot(&c, &mom[1]), dot(&c, &mom[2])]))
+    }
+
+    /// `solver.mls_scope = "force"`, first half of the `forces` stage: bins
+    /// the particles, fits σ by MLS at every Gauss point of the occupied
+    /// integration cells (`gp_f[g][0..3]`, `coef`) and at every particle
+    /// (`part_fit`), each with its own moment matrix, and marks in
+    /// `cell_ok` the integration cells whose fits are all regular (Gauss
+    /// points and the particles in them); the correction skips the others
+    /// in both of its sums. Needs `for_force_correction`.
+    pub fn fit_stress(&mut self, grid: &Grid, x: &[[f64; 2]], stress: &[[f64; 3]]) {
+        self.bin(grid, x);
+        self.pack(x, |p| {
+            let s = stress[p];
+            [s[0], s[1], s[2], 0.0, 0.0, 0.0]
+        });
+        let (mut coef, mut vals, mut cell_ok) = (
+            std::mem::take(&mut self.coef),
+            std::mem::take(&mut self.gp_f),
+            std::mem::take(&mut self.cell_ok),
+        );
+        let (mut part_fit, mut part_ok, mut part_coef) = (
+            std::mem::take(&mut self.part_fit),
+            std::mem::take(&mut self.part_ok),
+            std::mem::take(&mut self.part_coef),
+        );
+        let this = &*self;
+        coef.par_chunks_mut(4)
+            .zip(vals.par_chunks_mut(4))
+            .zip(cell_ok.par_iter_mut())
+            .enumerate()
+            .for_each(|(ic, ((c, val), ok))| {
+                c.fill([0.0; 3]);
+                val.fill([0.0; 5]);
+                *ok = this.occupied[ic];
+                if !*ok {
+                    return;
+                }
+                for k in 0..4 {
+                    match this.fit_at(grid, this.gp_x[4 * ic + k]) {
+                        Some((ck, f)) => {
+                            c[k] = ck;
+                            val[k] = [f[0], f[1], f[2], 0.0, 0.0];
+                        }
+                        None => *ok = false,
+                    }
+                }
+            });
+        part_fit
+            .par_iter_mut()
+            .zip(part_ok.par_iter_mut())
+            .zip(part_coef.par_iter_mut())
+            .zip(x)
+            .with_min_len(1024)
+            .for_each(|(((f, ok), c), &xp)| match this.fit_at(grid, xp) {
+                Some((cp, v)) => (*f, *ok, *c) = (v, true, cp),
+                None => (*f, *ok, *c) = ([0.0; 3], false, [0.0; 3]),
+            });
+        for (p, ok) in part_ok.iter().enumerate() {
+            if !ok {
+                cell_ok[this.cell_of[p][1] as usize] = false;
+            }
+        }
+        (self.coef, self.gp_f, self.cell_ok) = (coef, vals, cell_ok);
+        (self.part_fit, self.part_ok, self.part_coef) = (part_fit, part_ok, part_coef);
+    }
+
+    /// `solver.mls_scope = "force"`, in the `stress` stage, after
+    /// `fit_stress` at the same positions: the transpose of the force's
+    /// bracket applied to the nodal velocities `mv` (after
+    /// `grid_update::predict`), per particle q in particle order,
+    ///   V_q ΔL_q = Σ_{g∈c ok} ω_g φ_q(x_g) L(x_g) − Σ_{p∈c ok} V_p φ_q(x_p) L_p,
+    /// L = Σ_I v_I ⊗ ∇N_I, φ_q(x) = w(x_q − x) c(x)·[1, (x_q − x)/h] the
+    /// fit's weight of particle q at x. Added to L_q, it makes the stress
+    /// power Σ_q V_q σ_q : (L_q + ΔL_q) equal the nodal forces' work
+    /// −Σ_I v_I · f_I (docs/methods.md, "MLS as a force correction"):
+    /// without it the bracket's work is not stored as strain energy.
+    /// `mass`, `rho`: the particles' at the fit's positions.
+    pub fn strain_correction(
+        &mut self,
+        grid: &Grid,
+        cache: &ShapeCache,
+        mv: &[[f64; 3]],
+        mass: &[f64],
+        rho: &[f64],
+        dl: &mut [[f64; 4]],
+    ) {
+        let grad = |nodes: &[u32], w: &[[f64; 3]]| {
+            let mut l = [0.0; 4];
+            for (&node, wk) in nodes.iter().zip(w) {
+                let v = &mv[node as usize];
+                l[0] += v[1] * wk[1];
+                l[1] += v[1] * wk[2];
+                l[2] += v[2] * wk[1];
+                l[3] += v[2] * wk[2];
+            }
+            l
+        };
+        let (mut gp_l, mut part_vl, mut part_dl) = (
+            std::mem::take(&mut self.gp_l),
+            std::mem::take(&mut self.part_vl),
+            std::mem::take(&mut self.part_dl),
+        );
+        let this = &*self;
+        gp_l.par_iter_mut().enumerate().for_each(|(g, o)| {
+            *o = [0.0; 4];
+            if this.cell_ok[g / 4] {
+                let (nodes, w) = this.gp_shape.particle(g);
+                *o = grad(nodes, w).map(|l| l * this.gp_w[g]);
+            }
+        });
+        part_vl
+            .par_iter_mut()
+            .zip(&this.order)
+            .with_min_len(1024)
+            .for_each(|(o, &p)| {
+                let p = p as usize;
+                *o = [0.0; 4];
+                if this.cell_ok[this.cell_of[p][1] as usize] {
+                    let (nodes, w) = cache.particle(p);
+                    *o = grad(nodes, w).map(|l| l * mass[p] / rho[p]);
+                }
+            });
+        let inv_h = 1.0 / grid.h;
+        let sc = this.weight_scale;
+        let reach = 1.5 / sc;
+        let nb = [this.breaks[0].len() - 1, this.breaks[1].len() - 1];
+        let span_range = |b: &[f64], a: f64| {
+            let lo = b.partition_point(|&t| t <= a - reach).saturating_sub(1);
+            let hi = b.partition_point(|&t| t < a + reach).min(b.len() - 1);
+            lo..hi
+        };
+        let (gp_l_ref, part_vl_ref) = (&gp_l, &part_vl);
+        part_dl
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(k, o)| {
+                let xq = [this.packed[k][0], this.packed[k][1]];
+                let u = grid.logical(xq);
+                let mut acc = [0.0; 4];
+                // Gauss points: φ_q(x_g) with the Gauss point's c.
+                for sy in span_range(&this.breaks[1], u[1]) {
+                    for sx in span_range(&this.breaks[0], u[0]) {
+                        let ic = sy * nb[0] + sx;
+                        if !this.cell_ok[ic] {
+                            continue;
+                        }
+                        let gs = 4 * ic..4 * ic + 4;
+                        for ((xg, c), lg) in this.gp_x[gs.clone()]
+                            .iter()
+                            .zip(&this.coef[gs.clone()])
+                            .zip(&gp_l_ref[gs])
+                        {
+                            let d = [(xq[0] - xg[0]) * inv_h, (xq[1] - xg[1]) * inv_h];
+                            let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                            if w == 0.0 {
+                                continue;
+                            }
+                            let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                            for (a, l) in acc.iter_mut().zip(lg) {
+                                *a += phi * l;
+                            }
+                        }
+                    }
+                }
+                // Particles: −φ_q(x_p) with particle p's c.
+                let range = |a: f64, n: usize| {
+                    let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+                    let i1 = ((a + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+                    (i0.min(n - 1), i1)
+                };
+                let (i0, i1) = range(u[0], this.cells[0]);
+                let (j0, j1) = range(u[1], this.cells[1]);
+                for j in j0..=j1 {
+                    let row = j * this.cells[0];
+                    let (s, e) = (this.cell_start[row + i0], this.cell_start[row + i1 + 1]);
+                    let ks = s as usize..e as usize;
+                    for ((vl, q), &p) in part_vl_ref[ks.clone()]
+                        .iter()
+                        .zip(&this.packed[ks.clone()])
+                        .zip(&this.order[ks])
+                    {
+                        if *vl == [0.0; 4] {
+                            continue;
+                        }
+                        let d = [(xq[0] - q[0]) * inv_h, (xq[1] - q[1]) * inv_h];
+                        let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let c = this.part_coef[p as usize];
+                        let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                        for (a, l) in acc.iter_mut().zip(vl) {
+                            *a -= phi * l;
+                        }
+                    }
+                }
+                *o = acc;
+            });
+        for (k, &p) in this.order.iter().enumerate() {
+            let p = p as usize;
+            let inv_v = rho[p] / mass[p];
+            dl[p] = part_dl[k].map(|a| a * inv_v);
+        }
+        (self.gp_l, self.part_vl, self.part_dl) = (gp_l, part_vl, part_dl);
+    }
+
+    /// `solver.mls_scope = "force"`, second half of the `forces` stage,
+    /// after `fit_stress`: the nodal forces of plain MPM with the internal
+    /// force's quadrature corrected by the fit,
+    ///   f_I = Σ_p (−V_p σ_p ∇N_I(x_p) + N_I(x_p) m_p b_p)
+    ///       − Σ_c [Σ_{g∈c} ω_g σ_h(x_g) ∇N_I(x_g) − Σ_{p∈c} V_p σ_h(x_p) ∇N_I(x_p)],
+    /// c over the integration cells in `cell_ok`. Added to `force` (zeroed
+    /// by `clear_grid`). `body(p)` is the body force per unit mass (m/s²).
+    #[allow(clippy::too_many_arguments)]
+    pub fn corrected_forces(
+        &mut self,
+        cache: &ShapeCache,
+        stress: &[[f64; 3]],
+        mass: &[f64],
+        rho: &[f64],
+        body: &(dyn Fn(usize) -> [f64; 2] + Sync),
+        force: &mut [[f64; 2]],
+        scatter: &mut Scatter<2>,
+    ) {
+        let (fit, cell_of, cell_ok) = (&self.part_fit, &self.cell_of, &self.cell_ok);
+        scatter.run(force, mass.len(), |p, acc| {
+            let vol = mass[p] / rho[p];
+            let mut s = stress[p];
+            if cell_ok[cell_of[p][1] as usize] {
+                let f = fit[p];
+                s = [s[0] - f[0], s[1] - f[1], s[2] - f[2]];
+            }
+            let g = body(p);
+            let mb = [mass[p] * g[0], mass[p] * g[1]];
+            super::forces::add_particle_forces(cache, p, vol, s, mb, acc);
+        });
+        let (shape, gw, gf) = (&self.gp_shape, &self.gp_w, &self.gp_f);
+        self.f_scatter.run(force, gf.len(), |g, acc| {
+            if !cell_ok[g / 4] {
+                return;
+            }
+            let (nodes, w) = shape.particle(g);
+            let s = gf[g];
+            let om = gw[g];
+            for (&node, wk) in nodes.iter().zip(w) {
+                let o = &mut acc[node as usize];
+                o[0] -= om * (s[0] * wk[1] + s[2] * wk[2]);
+                o[1] -= om * (s[2] * wk[1] + s[1] * wk[2]);
+            }
+        });
     }
 
     /// The fit f_g = Σ_p φ_gp f_p, with this step's coefficients, of the

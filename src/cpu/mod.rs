@@ -46,6 +46,9 @@ pub struct CpuBackend {
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
     pub mls: Option<mls::Mls>,
+    /// `solver.mls_scope = "force"`: per particle, the strain-rate
+    /// correction `Mls::strain_correction` (empty otherwise).
+    mls_dl: Vec<[f64; 4]>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -73,10 +76,19 @@ impl CpuBackend {
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
-                mls::Mls::new(&model.shape, &model.grid, n)
+                let m = mls::Mls::new(&model.shape, &model.grid, n)
                     .expect("shape functions are defined at Gauss points inside a regular grid")
-                    .with_support(model.mls_support)
+                    .with_support(model.mls_support);
+                match model.mls_scope {
+                    crate::scene::MlsScope::Force => m.for_force_correction(),
+                    crate::scene::MlsScope::All => m,
+                }
             }),
+            mls_dl: if model.mls && model.mls_scope == crate::scene::MlsScope::Force {
+                vec![[0.0; 4]; n]
+            } else {
+                Vec::new()
+            },
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -118,6 +130,14 @@ impl CpuBackend {
             let per_gp = 16.0 + 8.0 + 2.0 + slots * (4.0 + 24.0) + 8.0 * 13.0;
             per += 12.0
                 + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * per_gp / n;
+            if model.mls_scope == crate::scene::MlsScope::Force {
+                // The fit at each particle, its c and flag; V_p L_p and ΔL
+                // in binned order and in particle order; ω_g L(x_g).
+                per += 49.0
+                    + 3.0 * 32.0
+                    + crate::model::gauss::gauss_points(&model.shape, &model.grid) as f64 * 32.0
+                        / n;
+            }
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
@@ -271,7 +291,7 @@ impl CpuBackend {
                 shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
             }
             Stage::P2g => {
-                if let Some(mls) = &mut self.mls {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
                     return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
                 }
                 p2g::p2g(
@@ -306,18 +326,36 @@ impl CpuBackend {
                     self.mass_eps,
                 );
             }
-            Stage::Stress => stress::stress(
-                &self.cache,
-                &self.mv,
-                self.dt,
-                &p.body,
-                &m.materials,
-                &m.body_material,
-                &mut p.stress,
-                &mut p.rho,
-                &mut p.f,
-                &mut p.plastic,
-            )?,
+            Stage::Stress => {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
+                    // MUSL's forces fitted at this step's start, where the
+                    // shape cache still is; update-stress-first fits here.
+                    if m.integrator != Integrator::Musl {
+                        mls.fit_stress(&m.grid, &p.x, &p.stress);
+                    }
+                    mls.strain_correction(
+                        &m.grid,
+                        &self.cache,
+                        &self.mv,
+                        &p.mass,
+                        &p.rho,
+                        &mut self.mls_dl,
+                    );
+                }
+                stress::stress(
+                    &self.cache,
+                    &self.mv,
+                    self.dt,
+                    &p.body,
+                    &m.materials,
+                    &m.body_material,
+                    &mut p.stress,
+                    &mut p.rho,
+                    &mut p.f,
+                    &mut p.plastic,
+                    &self.mls_dl,
+                )?
+            }
             Stage::Forces => {
                 let body = body_force(
                     m.gravity,
@@ -328,7 +366,20 @@ impl CpuBackend {
                     t_load,
                 );
                 if let Some(mls) = &mut self.mls {
-                    mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+                    if self.plan.inputs.mls_force {
+                        mls.fit_stress(&m.grid, &p.x, &p.stress);
+                        mls.corrected_forces(
+                            &self.cache,
+                            &p.stress,
+                            &p.mass,
+                            &p.rho,
+                            &body,
+                            &mut self.force,
+                            &mut self.force_scatter,
+                        );
+                    } else {
+                        mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+                    }
                     return Ok(());
                 }
                 forces::forces(
@@ -373,7 +424,7 @@ impl CpuBackend {
                 )?;
             }
             Stage::Remap => {
-                if let Some(mls) = &mut self.mls {
+                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
                     mls.remap(&m.grid, &p.rho, &p.v, &mut self.mv);
                 } else {
                     remap::remap(

@@ -52,6 +52,7 @@ pub fn stress(
     rho: &mut [f64],
     f: &mut [[f64; 4]],
     plastic: &mut [PlasticState],
+    dl: &[[f64; 4]],
 ) -> Result<(), Fault> {
     let n = stress.len();
     let fault = (
@@ -73,6 +74,7 @@ pub fn stress(
                 s,
                 r,
                 (f, q),
+                dl.get(p),
             )
         })
         .reduce(|| None, Fault::first);
@@ -92,6 +94,7 @@ fn update_particle(
     s: &mut [f64; 3],
     r: &mut f64,
     extra: Extra<'_>,
+    dl: Option<&[f64; 4]>,
 ) -> Option<Fault> {
     let (nodes, w) = cache.particle(p);
     // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
@@ -102,6 +105,13 @@ fn update_particle(
         l[1] += v[1] * wk[2];
         l[2] += v[2] * wk[1];
         l[3] += v[2] * wk[2];
+    }
+    // `solver.mls_scope = "force"`: the transpose of the force's bracket
+    // (`Mls::strain_correction`), so that the stress does the forces' work.
+    if let Some(d) = dl {
+        for (a, b) in l.iter_mut().zip(d) {
+            *a += b;
+        }
     }
     // Fields the scene does not keep are stand-ins the models ignore.
     let (mut id, mut q0) = ([1.0, 0.0, 0.0, 1.0], [0.0; 4]);
@@ -146,7 +156,7 @@ pub fn stress_forces(
     let particle =
         |p: usize, s: &mut [f64; 3], r: &mut f64, extra: Extra<'_>, acc: &mut [[f64; 2]]| {
             let material = &materials[body_material[body[p] as usize] as usize];
-            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra) {
+            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra, None) {
                 return Some(fault);
             }
             let g = body_force(p);

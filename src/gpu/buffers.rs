@@ -51,7 +51,17 @@ pub enum Buf {
     CellOrder,
     CellOf,
     MlsOcc,
+    /// Per Gauss point: the fit's c = A⁻¹e₀ (`mls_scope = "all"`, 3 f32)
+    /// or σ_h(x_g) then c (`"force"`, 6 f32).
     MlsCoef,
+    /// `mls_scope = "force"`: per particle, σ_h(x_p) then its fit's c, 6 f32.
+    MlsFit,
+    /// `mls_scope = "force"`: ω_g L(x_g) per Gauss point, then V_p L_p per
+    /// particle, 4 f32 each (mls_grad.wgsl).
+    MlsGrad,
+    /// `mls_scope = "force"`: per particle, the strain-rate correction ΔL
+    /// (xx, xy, yx, yy; mls_strain.wgsl).
+    MlsDl,
     Walls,
     WallMask,
     /// Per node: the walls it touches this step (wall_touch.wgsl).
@@ -63,7 +73,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 36] = [
+    pub const ALL: [Buf; 39] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -95,6 +105,9 @@ impl Buf {
         Buf::CellOf,
         Buf::MlsOcc,
         Buf::MlsCoef,
+        Buf::MlsFit,
+        Buf::MlsGrad,
+        Buf::MlsDl,
         Buf::Walls,
         Buf::WallMask,
         Buf::WallTouch,
@@ -374,7 +387,14 @@ fn grid_and_output_data(
     if model.mls {
         let spans = (params.mls_spans_x * params.mls_spans_y) as usize;
         data.push((Buf::MlsOcc, vec![0u8; 4 * spans]));
-        data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
+        if model.mls_scope == crate::scene::MlsScope::Force {
+            data.push((Buf::MlsCoef, vec![0u8; 24 * 4 * spans]));
+            data.push((Buf::MlsFit, vec![0u8; 24 * n]));
+            data.push((Buf::MlsGrad, vec![0u8; 16 * (4 * spans + n)]));
+            data.push((Buf::MlsDl, vec![0u8; 16 * n]));
+        } else {
+            data.push((Buf::MlsCoef, vec![0u8; 12 * 4 * spans]));
+        }
     }
 }
 

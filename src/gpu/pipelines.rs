@@ -36,7 +36,12 @@ fn domain(pass: Pass) -> Domain {
         Pass::BinClear | Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => {
             Domain::Cells
         }
-        Pass::MlsP2g | Pass::MlsForces | Pass::MlsRemap => Domain::GaussPoints,
+        Pass::MlsP2g
+        | Pass::MlsForces
+        | Pass::MlsRemap
+        | Pass::MlsFitGauss
+        | Pass::MlsForceGauss
+        | Pass::MlsGradGauss => Domain::GaussPoints,
         Pass::ClearGrid
         | Pass::GridPredict
         | Pass::GridCorrect
@@ -72,8 +77,12 @@ pub struct Variant {
     pub plastic: bool,
     /// A manufactured solution's body force is applied.
     pub mms: bool,
-    /// MLS reconstruction at Gauss points.
+    /// MLS at Gauss points (either scope: the bins mark the occupied
+    /// integration cells).
     pub mls: bool,
+    /// `solver.mls_scope = "force"`: the fit corrects the internal force
+    /// only (forces.wgsl built with MLS_FORCE, mls_fit, mls_force_gauss).
+    pub mls_force: bool,
     /// Rigid walls (the `Walls` and `WallMask` buffers).
     pub walls: bool,
     /// Some wall appears or goes during the run (GATES: `wall_touch`
@@ -119,6 +128,7 @@ impl Variant {
             lme_side: lme_side(model),
             mms: model.manufactured.is_some(),
             mls: model.mls,
+            mls_force: model.mls && model.mls_scope == crate::scene::MlsScope::Force,
             walls: !model.walls.is_empty(),
             gates: model.walls.timed(),
             pic: model.pic_fraction > 0.0,
@@ -140,7 +150,8 @@ impl Variant {
     pub fn plan(&self) -> StepPlan {
         StepPlan::new(PlanInputs {
             lme: self.shape == crate::scene::ShapeKind::Lme,
-            mls: self.mls,
+            mls: self.mls && !self.mls_force,
+            mls_force: self.mls_force,
             musl: self.integrator == Integrator::Musl,
             gather: self.gather,
             patch: self.patch,
@@ -170,6 +181,7 @@ impl Variant {
             .flag("PLASTIC", self.plastic)
             .flag("MMS", self.mms)
             .flag("MLS", self.mls)
+            .flag("MLS_FORCE", self.mls_force)
             .flag("WALLS", self.walls)
             .flag("GATES", self.gates)
             .flag("PIC", self.pic)
@@ -254,7 +266,11 @@ pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
         "FORCES",
         matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
     )
-    .flag("CLEAR", pass == Pass::RemapClear);
+    .flag("CLEAR", pass == Pass::RemapClear)
+    .flag(
+        "PARTICLES",
+        matches!(pass, Pass::MlsFitParticles | Pass::MlsGradParticles),
+    );
     preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
@@ -535,6 +551,7 @@ mod tests {
                                 plastic: false,
                                 mms,
                                 mls: false,
+                                mls_force: false,
                                 walls: mms,
                                 gates: mms,
                                 pic: mms,

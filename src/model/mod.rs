@@ -22,7 +22,7 @@ pub use walls::{Wall, Walls};
 use crate::error::SceneError;
 use crate::model::material::Material;
 use crate::model::shape::Shape;
-use crate::scene::{Fix, ImplicitMass, IntegratorKind, NpcPosition, Scene, seed};
+use crate::scene::{Fix, ImplicitMass, IntegratorKind, MlsScope, NpcPosition, Scene, seed};
 
 /// Nodes lighter than this (kg) count as empty. Relative to the lightest
 /// particle: 1e-9 keeps LME tail nodes (N ≳ 1e-6) and drops only round-off.
@@ -149,6 +149,9 @@ pub struct Model {
     pub mls: bool,
     /// MLS weight support half-width (cells, `solver.mls_support`).
     pub mls_support: f64,
+    /// What the fit does (`solver.mls_scope`): the paper's step or only the
+    /// internal force's quadrature correction.
+    pub mls_scope: MlsScope,
     /// Share α of PIC in the particle velocity update (`solver.pic_fraction`,
     /// 0 = FLIP; explicit integrators, `g2p`).
     pub pic_fraction: f64,
@@ -264,6 +267,7 @@ impl Model {
             fixed_dt: f.solver.dt,
             mls: f.solver.mls,
             mls_support: f.solver.mls_support,
+            mls_scope: f.solver.mls_scope,
             pic_fraction: f.solver.pic_fraction,
             local_damping: f.solver.local_damping,
             probes,

@@ -49,7 +49,7 @@ pub fn text(s: &Summary) -> Option<String> {
     if s.status != "completed" {
         return None;
     }
-    let mls = if s.mls {
+    let mls = if s.mls && s.mls_scope != Some(crate::scene::MlsScope::Force) {
         format!(
             " MLS on this case is the known failure: with the paper's weight it errs more \
              than plain B-splines at coarse grids and goes unstable over ten periods ({MLS_FAILURE_DOC})."

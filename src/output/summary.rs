@@ -3,7 +3,7 @@
 //! docs/outputs.md.
 
 use crate::exact::Errors;
-use crate::scene::{ExactKind, IntegratorKind, NpcPosition, SceneFile, ShapeKind};
+use crate::scene::{ExactKind, IntegratorKind, MlsScope, NpcPosition, SceneFile, ShapeKind};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -39,6 +39,8 @@ pub struct Summary {
     pub lme_gamma: Option<f64>,
     /// MLS reconstruction at Gauss points.
     pub mls: bool,
+    /// What the fit did (`solver.mls_scope`); null without MLS.
+    pub mls_scope: Option<MlsScope>,
     pub integrator: IntegratorKind,
     pub npc_gamma: Option<f64>,
     pub npc_position: Option<NpcPosition>,

@@ -451,6 +451,15 @@ pub struct SolverSpec {
     /// r = Δx/(2h); in [1.5, 3].
     #[serde(default = "default_mls_support")]
     pub mls_support: f64,
+    /// What the MLS fit does (with `mls = true`): `all` (the paper's step:
+    /// mass, momentum, body force and stress fitted and integrated at the
+    /// Gauss points, and the remap through them) or `force` (the fit only
+    /// corrects the quadrature of the internal force, and the strain rate
+    /// by its transpose; every other transfer is plain MPM through the
+    /// particles' own N_I(x_p); docs/methods.md,
+    /// "MLS as a force correction"). Default `all`.
+    #[serde(default)]
+    pub mls_scope: MlsScope,
     /// Share α of PIC in the particle velocity update, in [0, 1]:
     /// v_p ← (1 − α) v_FLIP + α v_PIC (explicit integrators). Default 0
     /// (pure FLIP).
@@ -461,6 +470,19 @@ pub struct SolverSpec {
     /// integrators). Default 0 (none).
     #[serde(default)]
     pub local_damping: f64,
+}
+
+/// What the MLS fit reconstructs (`solver.mls_scope`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MlsScope {
+    /// The B-spline paper's step: every transfer through the Gauss points.
+    #[default]
+    All,
+    /// The fit corrects the internal force's quadrature only:
+    /// f_I = −Σ_p V_p σ_p ∇N_I(x_p) − [Σ_g ω_g σ_h(x_g) ∇N_I(x_g) − Σ_p V_p σ_h(x_p) ∇N_I(x_p)],
+    /// and the strain rate by the bracket's transpose (`Mls::strain_correction`).
+    Force,
 }
 
 fn default_mls_support() -> f64 {
