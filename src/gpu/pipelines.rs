@@ -145,6 +145,7 @@ impl Variant {
             gather: self.gather,
             patch: self.patch,
             walls: self.walls,
+            contact: false,
         })
     }
 
