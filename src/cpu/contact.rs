@@ -4,11 +4,12 @@
 //! `offset_nodes` moves each particle's node indices into its body's
 //! field after `shape_eval`, so every other stage runs unchanged.
 //! `detect` (before `predict`): per pair and node where both fields have
-//! mass, the normal n from the fields' mass gradients (from the first body
-//! towards the second) and the gap along n between the two bodies'
-//! particle domains in the node's reach: the pair is in contact at the node
-//! when the domains meet (gap ≤ a round-off slack), not a cell early.
-//! `exchange` (after `predict`, and after `correct` with `as_force`): at
+//! mass, the normal n from the mass gradient of the body with the larger
+//! volume there (from the first body towards the second) and the gap
+//! between the two bodies' particle domains that reach the node (round,
+//! radius ½ sqrt(V_p)): the pair is in contact at the node when the
+//! domains meet (gap ≤ a round-off slack), not a cell early.
+//! `exchange` (after `predict`, and after `correct` with `AsForce`): at
 //! each node, for each two fields with mass (in field order): a declared
 //! pair in contact applies its law on the relative velocity while the
 //! bodies approach; two fields that are not a declared pair move together
@@ -34,9 +35,12 @@ pub struct ContactState {
     /// Per pair node: the unit normal from the first body to the second
     /// (zero where the pair is not in contact).
     pub normal: Vec<[f64; 2]>,
-    /// Per pair node: [furthest reach of the first body along n, nearest
-    /// reach of the second]; the gap is the second minus the first.
-    pub reach: Vec<[f64; 2]>,
+    /// Per pair node: the gap between the two bodies' particle domains
+    /// there (m; negative where they overlap).
+    pub gap: Vec<f64>,
+    /// Scratch: (pair node, side, particle) of the particles reaching a
+    /// node where the pair has a normal.
+    members: Vec<(u32, u8, u32)>,
 }
 
 impl ContactState {
@@ -44,7 +48,8 @@ impl ContactState {
         ContactState {
             grad: vec![[0.0; 3]; c.n_fields * n_nodes],
             normal: vec![[0.0; 2]; c.pairs.len() * n_nodes],
-            reach: vec![[0.0; 2]; c.pairs.len() * n_nodes],
+            gap: vec![f64::INFINITY; c.pairs.len() * n_nodes],
+            members: Vec::new(),
         }
     }
 
@@ -115,7 +120,7 @@ pub fn detect(
         for i in 0..n_nodes {
             let o = k * n_nodes + i;
             st.normal[o] = [0.0; 2];
-            st.reach[o] = [f64::NEG_INFINITY, f64::INFINITY];
+            st.gap[o] = f64::INFINITY;
             if mv[a + i][0] <= mass_eps || mv[b + i][0] <= mass_eps {
                 continue;
             }
@@ -135,14 +140,14 @@ pub fn detect(
             }
         }
     }
-    // Reach of each body's particle domains along the normal of every
-    // node it touches (the support of a square domain: l (|n_x| + |n_y|)).
-    for p in 0..x.len() {
-        let f = c.field_of_body[body[p] as usize];
+    // The particles of each side of a pair that reach each node where
+    // the pair has a normal, grouped by node.
+    st.members.clear();
+    for (p, &bp) in body.iter().enumerate() {
+        let f = c.field_of_body[bp as usize];
         if f == 0 {
             continue;
         }
-        let l = half_width(mass[p], rho[p]);
         let (nodes, w) = cache.particle(p);
         for (k, pair) in c.pairs.iter().enumerate() {
             let side = if pair.fields[0] == f {
@@ -153,35 +158,46 @@ pub fn detect(
                 continue;
             };
             for (&node, wk) in nodes.iter().zip(w) {
-                if wk[0] <= 0.0 {
-                    continue;
-                }
-                let i = node as usize % n_nodes;
-                let o = k * n_nodes + i;
-                let n = st.normal[o];
-                if n == [0.0, 0.0] {
-                    continue;
-                }
-                let centre = x[p][0] * n[0] + x[p][1] * n[1];
-                let ext = l * (n[0].abs() + n[1].abs());
-                let r = &mut st.reach[o];
-                if side == 0 {
-                    r[0] = r[0].max(centre + ext);
-                } else {
-                    r[1] = r[1].min(centre - ext);
+                let o = k * n_nodes + node as usize % n_nodes;
+                if wk[0] > 0.0 && st.normal[o] != [0.0, 0.0] {
+                    st.members.push((o as u32, side, p as u32));
                 }
             }
         }
     }
-    // In contact where the domains meet.
+    st.members.sort_unstable();
+    // The gap at a node: the least distance between the round domains
+    // (radius l_p) of the two sides' particles there. Distances, not
+    // reaches along n: two convex bodies apart have a smaller extent along
+    // a tilted normal than their true gap, which would start contact early.
     let slack = CONTACT_GAP_SLACK
         * mass
             .iter()
             .zip(rho)
             .map(|(m, r)| half_width(*m, *r))
             .fold(f64::INFINITY, f64::min);
-    for (n, r) in st.normal.iter_mut().zip(&st.reach) {
-        if *n != [0.0, 0.0] && r[1] - r[0] > slack {
+    let m = &st.members;
+    let mut start = 0;
+    while start < m.len() {
+        let o = m[start].0;
+        let end = start + m[start..].iter().take_while(|e| e.0 == o).count();
+        let split = start + m[start..end].iter().take_while(|e| e.1 == 0).count();
+        let (side_a, side_b) = (&m[start..split], &m[split..end]);
+        let mut gap = f64::INFINITY;
+        for &(_, _, p) in side_a {
+            let (p, lp) = (p as usize, half_width(mass[p as usize], rho[p as usize]));
+            for &(_, _, q) in side_b {
+                let q = q as usize;
+                let d = (x[p][0] - x[q][0]).hypot(x[p][1] - x[q][1]);
+                gap = gap.min(d - lp - half_width(mass[q], rho[q]));
+            }
+        }
+        st.gap[o as usize] = gap;
+        start = end;
+    }
+    // In contact where the domains meet.
+    for (n, g) in st.normal.iter_mut().zip(&st.gap) {
+        if *n != [0.0, 0.0] && *g > slack {
             *n = [0.0; 2];
         }
     }
@@ -239,8 +255,8 @@ pub struct AsForce<'a> {
 }
 
 /// Applies the contact laws and merges at every node (see the file's
-/// header). `mv` holds [m, vx, vy] per field node. With `as_force =
-/// Some((force, gamma_dt, reactions))` (after `correct`), each velocity
+/// header). `mv` holds [m, vx, vy] per field node. With `as_force`
+/// (after `correct`), each velocity
 /// change m Δv also goes into `force` as m Δv / (γ Δt), so the particles'
 /// update sees it, and each pair's share into its reaction.
 pub fn exchange(
