@@ -210,8 +210,8 @@ pub fn check_state(model: &Model, state: &State) -> Result<()> {
         && p.lambda.len() == q.lambda.len()
         && p.f.len() == q.f.len()
         && p.plastic.len() == q.plastic.len()
-        && state.mv.len() == model.grid.n_nodes()
-        && state.force.len() == model.grid.n_nodes();
+        && state.mv.len() == model.grid.n_nodes() * model.n_fields()
+        && state.force.len() == model.grid.n_nodes() * model.n_fields();
     if same {
         Ok(())
     } else {
@@ -220,7 +220,7 @@ pub fn check_state(model: &Model, state: &State) -> Result<()> {
             q.len(),
             state.mv.len(),
             p.len(),
-            model.grid.n_nodes()
+            model.grid.n_nodes() * model.n_fields()
         )))
     }
 }

@@ -255,6 +255,9 @@ pub struct PlanInputs {
     pub patch: bool,
     /// Rigid walls: the nodes they act on are found before `GridPredict`.
     pub walls: bool,
+    /// Contact pairs: `shape_eval` must offset the nodes into each body's
+    /// field before `p2g` scatters (so the two do not fuse on the CPU).
+    pub contact: bool,
 }
 
 /// The step of one scene, for both backends.
@@ -287,6 +290,7 @@ impl StepPlan {
             gather,
             patch,
             walls: !model.walls.is_empty(),
+            contact: model.contact.is_some(),
         })
     }
 
@@ -296,15 +300,17 @@ impl StepPlan {
             mls_force,
             musl,
             gather,
+            contact,
             ..
         } = inputs;
         let stages = if musl { STEP_MUSL } else { STEP };
         let fuse_stress = !mls && !mls_force && !musl;
+        let fuse_p2g = !mls && !contact;
         let cpu = stages
             .iter()
             .filter_map(|&s| match s {
-                Stage::ShapeEval if !mls => Some(CpuWork::ShapeEvalP2g),
-                Stage::P2g if !mls => None,
+                Stage::ShapeEval if fuse_p2g => Some(CpuWork::ShapeEvalP2g),
+                Stage::P2g if fuse_p2g => None,
                 Stage::Stress if fuse_stress => Some(CpuWork::StressForces),
                 Stage::Forces if fuse_stress => None,
                 s => Some(CpuWork::Stage(s)),
@@ -431,6 +437,7 @@ mod tests {
             gather,
             patch,
             walls: lme,
+            contact: false,
         })
     }
 

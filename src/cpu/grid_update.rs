@@ -188,7 +188,9 @@ fn prescribe(mv: &mut [[f64; 3]], groups: &[ConstraintGroup], t: f64, mass_eps: 
 }
 
 /// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end
-/// time (s); `touch` is `wall_touch`'s (empty without walls).
+/// time (s); `touch` is `wall_touch`'s (empty without walls). With
+/// contact pairs `mv` holds one copy of the nodes per field, stacked
+/// (`model::contact`); `fix` and the walls' mask are per grid node.
 pub fn predict(
     mv: &mut [[f64; 3]],
     fix: &[u8],
@@ -199,26 +201,30 @@ pub fn predict(
     mass_eps: f64,
 ) {
     let wl = &walls.list;
-    mv.par_iter_mut()
-        .zip(fix)
-        .enumerate()
-        .with_min_len(4096)
-        .for_each(|(i, (n, &f))| {
-            if n[0] > mass_eps {
-                let mut v = [n[1] / n[0], n[2] / n[0]];
-                if let Some(&mask) = walls.mask.get(i) {
-                    let mask = mask & touch[i];
-                    if mask != 0 {
-                        v = walls_velocity(v, mask, wl);
+    let n_nodes = fix.len();
+    for (field, mv) in mv.chunks_mut(n_nodes).enumerate() {
+        let base = field * n_nodes;
+        mv.par_iter_mut()
+            .zip(fix)
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, (n, &f))| {
+                if n[0] > mass_eps {
+                    let mut v = [n[1] / n[0], n[2] / n[0]];
+                    if let Some(&mask) = walls.mask.get(i) {
+                        let mask = mask & touch[base + i];
+                        if mask != 0 {
+                            v = walls_velocity(v, mask, wl);
+                        }
                     }
+                    zero_fixed(&mut v, f);
+                    *n = [n[0], v[0], v[1]];
+                } else {
+                    *n = [n[0], 0.0, 0.0];
                 }
-                zero_fixed(&mut v, f);
-                *n = [n[0], v[0], v[1]];
-            } else {
-                *n = [n[0], 0.0, 0.0];
-            }
-        });
-    prescribe(mv, groups, t, mass_eps);
+            });
+        prescribe(mv, groups, t, mass_eps);
+    }
 }
 
 /// Records reactions per constraint group (the force the support exerts,
@@ -240,33 +246,38 @@ pub fn correct(
     damping: f64,
     mass_eps: f64,
 ) {
+    let n_nodes = fix.len();
     let (group_r, wall_r) = reactions.split_at_mut(groups.len());
     for (g, r) in groups.iter().zip(group_r.iter_mut()) {
         *r = [0.0; 2];
-        for &n in &g.nodes {
-            let f = force[n as usize];
-            if g.fix & FIX_X != 0 {
-                r[0] -= f[0];
-            }
-            if g.fix & FIX_Y != 0 {
-                r[1] -= f[1];
+        for field in force.chunks(n_nodes) {
+            for &n in &g.nodes {
+                let f = field[n as usize];
+                if g.fix & FIX_X != 0 {
+                    r[0] -= f[0];
+                }
+                if g.fix & FIX_Y != 0 {
+                    r[1] -= f[1];
+                }
             }
         }
     }
-    mv.par_iter_mut()
-        .zip(force.par_iter_mut())
-        .zip(fix)
-        .with_min_len(4096)
-        .for_each(|((n, f), &fx)| {
-            zero_fixed(f, fx);
-            if n[0] > mass_eps {
-                if damping > 0.0 {
-                    *f = local_damping(*f, [n[1], n[2]], damping);
+    for (mv, force) in mv.chunks_mut(n_nodes).zip(force.chunks_mut(n_nodes)) {
+        mv.par_iter_mut()
+            .zip(force.par_iter_mut())
+            .zip(fix)
+            .with_min_len(4096)
+            .for_each(|((n, f), &fx)| {
+                zero_fixed(f, fx);
+                if n[0] > mass_eps {
+                    if damping > 0.0 {
+                        *f = local_damping(*f, [n[1], n[2]], damping);
+                    }
+                    n[1] += gamma_dt * f[0] / n[0];
+                    n[2] += gamma_dt * f[1] / n[0];
                 }
-                n[1] += gamma_dt * f[0] / n[0];
-                n[2] += gamma_dt * f[1] / n[0];
-            }
-        });
+            });
+    }
     for r in wall_r.iter_mut() {
         *r = [0.0; 2];
     }
@@ -275,8 +286,9 @@ pub fn correct(
     }
     // Each wall's velocity change on its nodes, one wall after another in
     // scene order (a node behind two walls gets both), as on the GPU.
-    for (node, (&mask, &t)) in walls.mask.iter().zip(touch).enumerate() {
-        let mask = mask & t;
+    for (node, &t) in touch.iter().enumerate() {
+        let i = node % n_nodes;
+        let mask = walls.mask[i] & t;
         let n = &mut mv[node];
         if mask == 0 || n[0] <= mass_eps {
             continue;
@@ -289,10 +301,10 @@ pub fn correct(
             }
             let mut new = wall_velocity(v, w.normal, w.contact, w.mu);
             // A constraint wins: its components keep their value.
-            if fix[node] & FIX_X != 0 {
+            if fix[i] & FIX_X != 0 {
                 new[0] = v[0];
             }
-            if fix[node] & FIX_Y != 0 {
+            if fix[i] & FIX_Y != 0 {
                 new[1] = v[1];
             }
             let fw = [

@@ -4,6 +4,7 @@
 
 pub mod cfl;
 pub mod clear_grid;
+pub mod contact;
 pub mod energy;
 pub mod forces;
 pub mod g2p;
@@ -42,6 +43,8 @@ pub struct CpuBackend {
     /// Per node: the walls it touches this step (`grid_update::wall_touch`);
     /// empty without walls.
     pub wall_touch: Vec<u32>,
+    /// Contact pairs' normals and gaps this step; None without pairs.
+    pub contact: Option<contact::ContactState>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -61,18 +64,24 @@ pub struct CpuBackend {
 impl CpuBackend {
     pub fn new(model: Model) -> Self {
         let n = model.particles.len();
-        let nodes = model.grid.n_nodes();
+        let grid_nodes = model.grid.n_nodes();
+        // One copy of the nodes per field (contact pairs), stacked.
+        let nodes = grid_nodes * model.n_fields();
         let min_mass = model.particles.min_mass();
         CpuBackend {
             cache: ShapeCache::new(n, model.shape.max_nodes()),
             mv: vec![[0.0; 3]; nodes],
             force: vec![[0.0; 2]; nodes],
-            reactions: vec![[0.0; 2]; model.constraints.groups.len() + model.walls.list.len()],
+            reactions: vec![[0.0; 2]; model.reaction_names().len()],
             wall_touch: if model.walls.is_empty() {
                 Vec::new()
             } else {
                 vec![0; nodes]
             },
+            contact: model
+                .contact
+                .as_ref()
+                .map(|c| contact::ContactState::new(c, grid_nodes)),
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -288,7 +297,10 @@ impl CpuBackend {
             Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
             Stage::ClearGrid => clear_grid::clear_grid(&mut self.mv, &mut self.force),
             Stage::ShapeEval => {
-                shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
+                shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
+                if let Some(c) = &m.contact {
+                    contact::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
+                }
             }
             Stage::P2g => {
                 if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
@@ -316,6 +328,20 @@ impl CpuBackend {
                         &mut self.wall_touch,
                     );
                 }
+                if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
+                    contact::detect(
+                        &self.cache,
+                        &p.x,
+                        &p.mass,
+                        &p.rho,
+                        &p.body,
+                        c,
+                        &self.mv,
+                        m.grid.n_nodes(),
+                        self.mass_eps,
+                        st,
+                    );
+                }
                 grid_update::predict(
                     &mut self.mv,
                     &m.constraints.fix,
@@ -325,6 +351,9 @@ impl CpuBackend {
                     self.t + self.dt,
                     self.mass_eps,
                 );
+                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
+                    contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);
+                }
             }
             Stage::Stress => {
                 if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
@@ -392,18 +421,37 @@ impl CpuBackend {
                     &mut self.force_scatter,
                 );
             }
-            Stage::GridCorrect => grid_update::correct(
-                &mut self.mv,
-                &mut self.force,
-                &m.constraints.fix,
-                &m.constraints.groups,
-                &m.walls,
-                &self.wall_touch,
-                &mut self.reactions,
-                gamma * self.dt,
-                m.local_damping,
-                self.mass_eps,
-            ),
+            Stage::GridCorrect => {
+                let (fixed, pairs) = self
+                    .reactions
+                    .split_at_mut(m.constraints.groups.len() + m.walls.list.len());
+                grid_update::correct(
+                    &mut self.mv,
+                    &mut self.force,
+                    &m.constraints.fix,
+                    &m.constraints.groups,
+                    &m.walls,
+                    &self.wall_touch,
+                    fixed,
+                    gamma * self.dt,
+                    m.local_damping,
+                    self.mass_eps,
+                );
+                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
+                    contact::exchange(
+                        c,
+                        st,
+                        &mut self.mv,
+                        &m.constraints.fix,
+                        self.mass_eps,
+                        Some(contact::AsForce {
+                            force: &mut self.force,
+                            gamma_dt: gamma * self.dt,
+                            reactions: pairs,
+                        }),
+                    );
+                }
+            }
             Stage::G2p => {
                 let prm = g2p::G2pParams {
                     dt: self.dt,
@@ -435,8 +483,8 @@ impl CpuBackend {
                         &mut self.p2g_scatter,
                     );
                 }
-                // The walls' touch bits stay those of the step's start
-                // (`GridPredict`), as on the GPU.
+                // The walls' touch bits and the contacts stay those of the
+                // step's start (`GridPredict`), as on the GPU.
                 grid_update::predict(
                     &mut self.mv,
                     &m.constraints.fix,
@@ -446,6 +494,9 @@ impl CpuBackend {
                     self.t + self.dt,
                     self.mass_eps,
                 );
+                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
+                    contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);
+                }
             }
         }
         Ok(())

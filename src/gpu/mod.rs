@@ -70,6 +70,13 @@ impl GpuBackend {
             )
             .into());
         }
+        if model.contact.is_some() {
+            return Err(crate::error::SceneError::invalid(
+                "contact",
+                "pairs run on the CPU path only for now (--backend cpu or auto)",
+            )
+            .into());
+        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;

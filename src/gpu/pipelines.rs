@@ -156,6 +156,7 @@ impl Variant {
             gather: self.gather,
             patch: self.patch,
             walls: self.walls,
+            contact: false,
         })
     }
 

@@ -2,6 +2,7 @@
 //! constraints, loads and solver settings, built from a checked `Scene`.
 //! Everything here is backend-neutral; `cpu::` and `gpu::` step it.
 
+pub mod contact;
 pub mod energy;
 pub mod fault;
 pub mod gauss;
@@ -14,6 +15,7 @@ pub mod shape;
 pub mod time_step;
 pub mod walls;
 
+pub use contact::Contacts;
 pub use grid::Grid;
 pub use loads::{AlignedVibration, ExternalForces, Gravity};
 pub use particles::Particles;
@@ -135,6 +137,9 @@ pub struct Model {
     pub constraints: Constraints,
     /// Rigid walls with their contact laws (empty: none).
     pub walls: Walls,
+    /// Contact pairs between bodies and each body's field; None without
+    /// pairs (one shared field, as ever).
+    pub contact: Option<Contacts>,
     pub gravity: Option<Gravity>,
     /// Tractions and point loads as particle forces (None: the scene has none).
     pub external: Option<ExternalForces>,
@@ -259,6 +264,7 @@ impl Model {
             body_names,
             constraints,
             walls,
+            contact: Contacts::from_scene(scene),
             gravity,
             external,
             integrator,
@@ -276,14 +282,25 @@ impl Model {
     }
 
     /// Names of the reactions a sample reports, in order: the constraints',
-    /// then the walls'.
+    /// the walls', then the contact pairs' (the force on the pair's first
+    /// body).
     pub fn reaction_names(&self) -> Vec<String> {
         self.constraints
             .groups
             .iter()
             .map(|g| g.name.clone())
             .chain(self.walls.list.iter().map(|w| w.name.clone()))
+            .chain(
+                self.contact
+                    .iter()
+                    .flat_map(|c| c.pairs.iter().map(|p| p.name.clone())),
+            )
             .collect()
+    }
+
+    /// Copies of the grid's nodal fields (1 without contact pairs).
+    pub fn n_fields(&self) -> usize {
+        self.contact.as_ref().map_or(1, |c| c.n_fields)
     }
 
     /// Material of particle `p`.

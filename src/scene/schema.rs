@@ -30,6 +30,10 @@ pub struct SceneFile {
     /// Rigid walls (half-planes) by name; reactions are reported per wall.
     #[serde(default)]
     pub walls: BTreeMap<String, WallSpec>,
+    /// Contact pairs between bodies by name: each body of a pair moves on
+    /// its own grid velocity field; bodies in no pair share one field.
+    #[serde(default)]
+    pub contact: BTreeMap<String, ContactSpec>,
     /// Distributed loads on a body's boundary by name.
     #[serde(default)]
     pub tractions: BTreeMap<String, TractionSpec>,
@@ -263,6 +267,20 @@ pub struct WallSpec {
     /// Time the wall stops acting (s), > `appear_at` (a gate). Default:
     /// never.
     pub remove_at: Option<f64>,
+}
+
+/// Contact between two bodies: where both have mass at a node and their
+/// particles' domains meet, the law acts on their relative velocity.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// The two bodies (names under `[bodies]`), different.
+    pub bodies: [String; 2],
+    /// `stick` (no relative motion while approaching), `slip`
+    /// (frictionless) or `friction` (Coulomb, needs `friction`).
+    pub law: Contact,
+    /// Coulomb friction coefficient μ ≥ 0, only with `law = "friction"`.
+    pub friction: Option<f64>,
 }
 
 /// A traction on a segment of a body's boundary (dead load).

@@ -70,6 +70,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     check_bodies(&file)?;
     check_constraints(&file)?;
     check_walls(&file)?;
+    check_contact(&file)?;
     check_loads(&file)?;
     check_gravity(&file)?;
     let sample_interval = check_output(&file)?;
@@ -594,6 +595,80 @@ fn check_walls(file: &SceneFile) -> Result<(), SceneError> {
             (_, None) => {}
         }
         check_gate(file, &key, w)?;
+    }
+    Ok(())
+}
+
+/// `[contact.NAME]`: two different bodies of the scene, each pair once,
+/// the law's friction as for walls; the explicit integrators without MLS
+/// (the implicit step and the MLS transfers have one velocity field).
+fn check_contact(file: &SceneFile) -> Result<(), SceneError> {
+    let mut seen: Vec<[&str; 2]> = Vec::new();
+    for (name, c) in &file.contact {
+        let key = format!("contact.{name}");
+        for b in &c.bodies {
+            if !file.bodies.contains_key(b) {
+                return Err(SceneError::invalid(
+                    format!("{key}.bodies"),
+                    format!(
+                        "names {b:?}, which is not a body of the scene (bodies: {})",
+                        file.bodies.keys().cloned().collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+        }
+        let [a, b] = [c.bodies[0].as_str(), c.bodies[1].as_str()];
+        if a == b {
+            return Err(SceneError::invalid(
+                format!("{key}.bodies"),
+                format!("pairs {a:?} with itself; a contact pair needs two different bodies"),
+            ));
+        }
+        let pair = if a < b { [a, b] } else { [b, a] };
+        if seen.contains(&pair) {
+            return Err(SceneError::invalid(
+                format!("{key}.bodies"),
+                format!("pairs {a:?} and {b:?} a second time; declare each pair once"),
+            ));
+        }
+        seen.push(pair);
+        match (c.law, c.friction) {
+            (Contact::Friction, None) => {
+                return Err(SceneError::invalid(
+                    format!("{key}.friction"),
+                    "is required with law = \"friction\" (Coulomb's μ >= 0)",
+                ));
+            }
+            (Contact::Friction, Some(mu)) => {
+                finite(&format!("{key}.friction"), mu)?;
+                if mu < 0.0 {
+                    return Err(SceneError::invalid(
+                        format!("{key}.friction"),
+                        format!("must be >= 0, got {mu}"),
+                    ));
+                }
+            }
+            (_, Some(_)) => {
+                return Err(SceneError::invalid(
+                    format!("{key}.friction"),
+                    "is only read with law = \"friction\"; drop it or set law = \"friction\"",
+                ));
+            }
+            (_, None) => {}
+        }
+        if file.solver.integrator == IntegratorKind::Implicit {
+            return Err(SceneError::invalid(
+                key,
+                "is not available with solver.integrator = \"implicit\" (its Newton step has one \
+                 velocity field); use \"npc\", \"fe\" or \"musl\"",
+            ));
+        }
+        if file.solver.mls {
+            return Err(SceneError::invalid(
+                key,
+                "is not available with solver.mls = true (the MLS transfers have one velocity field)",
+            ));
+        }
     }
     Ok(())
 }

@@ -1,0 +1,381 @@
+//! Contact between bodies (`[contact.NAME]`, issue 24) on the CPU path:
+//! a block sliding on a stiffer elastic slab under tilted gravity (the
+//! relative velocity against g (sin θ − μ cos θ) R(t), at rest for
+//! μ > tan θ), and the single shared field beside it (the block glued).
+
+mod common;
+
+use lme_mpm::backend::Backend;
+use lme_mpm::cpu::CpuBackend;
+use lme_mpm::model::Model;
+use lme_mpm::scene::Scene;
+
+/// Mass-weighted mean velocity of each body (scene order).
+fn body_velocities(b: &mut CpuBackend) -> Vec<[f64; 2]> {
+    let m = b.model();
+    let n = m.body_names.len();
+    let mut acc = vec![[0.0; 3]; n];
+    let p = &m.particles;
+    for i in 0..p.len() {
+        let a = &mut acc[p.body[i] as usize];
+        a[0] += p.mass[i];
+        a[1] += p.mass[i] * p.v[i][0];
+        a[2] += p.mass[i] * p.v[i][1];
+    }
+    acc.iter().map(|a| [a[1] / a[0], a[2] / a[0]]).collect()
+}
+
+/// (t, velocity of each body) every `every` s up to t_end.
+fn history(scene: &Scene, every: f64) -> Vec<(f64, Vec<[f64; 2]>)> {
+    let model = Model::new(scene).unwrap();
+    let t_end = model.t_end;
+    let mut b = CpuBackend::new(model);
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut out = Vec::new();
+    let mut t = 0.0;
+    while t < t_end - 1e-12 {
+        t = (t + every).min(t_end);
+        b.advance(t, &stop).unwrap();
+        out.push((b.time(), body_velocities(&mut b)));
+    }
+    out
+}
+
+/// R(t) of the sine ramp over T/2 (eq. 45): t − T/4 after the ramp.
+fn ramp_integral(t: f64, period: f64) -> f64 {
+    let half = period / 2.0;
+    if t >= half {
+        t - period / 4.0
+    } else {
+        t / 2.0 - (std::f64::consts::PI * t / half).sin() * half / (2.0 * std::f64::consts::PI)
+    }
+}
+
+/// Relative velocity while sliding against g (sin θ − μ cos θ) R(t): the
+/// issue's 3 %. Measured (h = 0.05, linear, NPC): μ = 0.2 −0.11 % at
+/// 0.5 s, μ = 0 −0.03 %, μ = 0.4 −1.7 % (the block's elastic bounce
+/// modulates the normal force and so the friction, as on a wall).
+const SLIDING_TOL: f64 = 0.03;
+/// At rest (μ > tan θ): the relative speed over the frictionless g sin θ
+/// R(t). Measured 2e-4.
+const AT_REST_TOL: f64 = 0.01;
+
+fn exact_rel(mu: f64, t: f64) -> f64 {
+    let th = 30f64.to_radians();
+    9.81 * (th.sin() - mu * th.cos()).max(0.0) * ramp_integral(t, 0.2)
+}
+
+#[test]
+fn block_slides_on_a_slab_at_the_coulomb_rate() {
+    let scene = common::scene("contact_block.toml", &[]);
+    for (t, v) in history(&scene, 0.1) {
+        let rel = v[0][0] - v[1][0];
+        let exact = exact_rel(0.2, t);
+        println!("mu 0.2: t {t:.2} relative {rel:.4} m/s, exact {exact:.4}");
+        if t >= 0.2 {
+            assert!(
+                (rel / exact - 1.0).abs() < SLIDING_TOL,
+                "t = {t}: relative velocity {rel} against {exact}"
+            );
+        }
+    }
+}
+
+#[test]
+fn block_rests_on_a_slab_above_the_friction_angle() {
+    let scene = common::scene(
+        "contact_block.toml",
+        &["contact.interface.friction=0.7", "solver.t_end=0.3"],
+    );
+    let free = |t: f64| exact_rel(0.0, t);
+    for (t, v) in history(&scene, 0.1) {
+        let rel = (v[0][0] - v[1][0]).hypot(v[0][1] - v[1][1]);
+        println!("mu 0.7: t {t:.2} relative speed {rel:.2e} m/s");
+        assert!(rel < AT_REST_TOL * free(t), "t = {t}: {rel} m/s");
+    }
+}
+
+#[test]
+fn one_shared_field_glues_the_block_to_the_slab() {
+    // The same scene without the pair: one velocity field, no slip.
+    let text = std::fs::read_to_string(common::case("contact_block.toml")).unwrap();
+    let start = text.find("[contact.interface]").unwrap();
+    let end = start + text[start..].find("\n\n").unwrap();
+    let glued = format!("{}{}", &text[..start], &text[end..]);
+    let scene = Scene::from_str(
+        &glued,
+        "glued",
+        "glued",
+        &[lme_mpm::scene::Override::parse("solver.t_end=0.2").unwrap()],
+    )
+    .unwrap();
+    let (t, v) = history(&scene, 0.2).pop().unwrap();
+    let rel = v[0][0] - v[1][0];
+    println!(
+        "one field: t {t:.2} relative {rel:.4} m/s against {:.4} sliding",
+        exact_rel(0.2, t)
+    );
+    assert!(rel.abs() < 0.05 * exact_rel(0.2, t), "{rel}");
+}
+
+/// Per body (scene order): mass, centre of mass, its velocity, and the
+/// angular velocity about it, Σ m (r × v) / Σ m |r|² (rad/s).
+#[derive(Debug, Clone, Copy)]
+struct Rigid {
+    mass: f64,
+    centre: [f64; 2],
+    v: [f64; 2],
+    omega: f64,
+}
+
+fn rigid(b: &mut CpuBackend) -> Vec<Rigid> {
+    let m = b.model();
+    let p = &m.particles;
+    let n = m.body_names.len();
+    let mut out = vec![
+        Rigid {
+            mass: 0.0,
+            centre: [0.0; 2],
+            v: [0.0; 2],
+            omega: 0.0
+        };
+        n
+    ];
+    for i in 0..p.len() {
+        let r = &mut out[p.body[i] as usize];
+        let mi = p.mass[i];
+        r.mass += mi;
+        for d in 0..2 {
+            r.centre[d] += mi * p.x[i][d];
+            r.v[d] += mi * p.v[i][d];
+        }
+    }
+    for r in &mut out {
+        for d in 0..2 {
+            r.centre[d] /= r.mass;
+            r.v[d] /= r.mass;
+        }
+    }
+    let mut ang = vec![[0.0; 2]; n];
+    for i in 0..p.len() {
+        let b = p.body[i] as usize;
+        let r = [p.x[i][0] - out[b].centre[0], p.x[i][1] - out[b].centre[1]];
+        let v = [p.v[i][0] - out[b].v[0], p.v[i][1] - out[b].v[1]];
+        ang[b][0] += p.mass[i] * (r[0] * v[1] - r[1] * v[0]);
+        ang[b][1] += p.mass[i] * (r[0] * r[0] + r[1] * r[1]);
+    }
+    for (r, a) in out.iter_mut().zip(ang) {
+        r.omega = a[0] / a[1];
+    }
+    out
+}
+
+/// Overlap of the two bodies' particle domains along the line of their
+/// centres (m; negative: apart).
+fn overlap(b: &mut CpuBackend, r: &[Rigid]) -> f64 {
+    let m = b.model();
+    let p = &m.particles;
+    let d = [
+        r[1].centre[0] - r[0].centre[0],
+        r[1].centre[1] - r[0].centre[1],
+    ];
+    let len = d[0].hypot(d[1]);
+    let u = [d[0] / len, d[1] / len];
+    let (mut reach0, mut reach1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for i in 0..p.len() {
+        let l = 0.5 * (p.mass[i] / p.rho[i]).sqrt();
+        let s = p.x[i][0] * u[0] + p.x[i][1] * u[1];
+        if p.body[i] == 0 {
+            reach0 = reach0.max(s + l);
+        } else {
+            reach1 = reach1.min(s - l);
+        }
+    }
+    reach0 - reach1
+}
+
+/// The collision's figures: first time the pair's reaction is non-zero,
+/// the largest overlap, and the bodies at the end.
+struct Collision {
+    onset: Option<f64>,
+    max_overlap: f64,
+    end: Vec<Rigid>,
+    momentum_drift: f64,
+}
+
+fn collide(scene: &Scene) -> Collision {
+    let model = Model::new(scene).unwrap();
+    let t_end = model.t_end;
+    let mut b = CpuBackend::new(model);
+    let start = rigid(&mut b);
+    let p0 = [
+        start[0].mass * start[0].v[0] + start[1].mass * start[1].v[0],
+        start[0].mass * start[0].v[1] + start[1].mass * start[1].v[1],
+    ];
+    let (mut onset, mut max_overlap, mut drift) = (None, f64::NEG_INFINITY, 0.0f64);
+    while b.time() < t_end {
+        let t0 = b.time();
+        b.step().unwrap();
+        let s = b.sample().unwrap();
+        if onset.is_none() && s.reactions.last().is_some_and(|r| r != &[0.0, 0.0]) {
+            onset = Some(t0);
+        }
+        let r = rigid(&mut b);
+        max_overlap = max_overlap.max(overlap(&mut b, &r));
+        let p = [
+            r[0].mass * r[0].v[0] + r[1].mass * r[1].v[0],
+            r[0].mass * r[0].v[1] + r[1].mass * r[1].v[1],
+        ];
+        drift = drift.max((p[0] - p0[0]).abs().max((p[1] - p0[1]).abs()));
+    }
+    Collision {
+        onset,
+        max_overlap,
+        end: rigid(&mut b),
+        momentum_drift: drift / (start[0].mass * 1.0),
+    }
+}
+
+/// The scene `name` without its `[contact.*]` table: one shared field.
+fn without_contact(name: &str, table: &str, sets: &[&str]) -> Scene {
+    let text = std::fs::read_to_string(common::case(name)).unwrap();
+    let start = text.find(table).unwrap();
+    let end = start + text[start..].find("\n\n").unwrap();
+    let one = format!("{}{}", &text[..start], &text[end..]);
+    let o: Vec<_> = sets
+        .iter()
+        .map(|s| lme_mpm::scene::Override::parse(s).unwrap())
+        .collect();
+    Scene::from_str(&one, "one field", "one_field", &o).unwrap()
+}
+
+/// Line of centres at impact in `contact_disks.toml` (30° off x) and its
+/// tangent.
+const U: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
+const T: [f64; 2] = [-0.5, 0.866_025_403_784_438_6];
+
+#[test]
+fn frictionless_disks_bounce_apart_head_on() {
+    let scene = common::scene(
+        "contact_disks.toml",
+        &["bodies.right.disks=[[0.75, 0.5, 0.2]]"],
+    );
+    let c = collide(&scene);
+    let [l, r] = [c.end[0], c.end[1]];
+    println!(
+        "head-on: onset {:?} s (surfaces meet at 0.025 s), max overlap {:.4} m, left v {:?} \
+         omega {:.2e}, right v {:?} omega {:.2e}, momentum drift {:.1e}",
+        c.onset, c.max_overlap, l.v, l.omega, r.v, r.omega, c.momentum_drift
+    );
+    // Contact starts when the domains meet: within a tenth of a cell of
+    // closing (2 m/s) before 0.025 s, not a cell early. Measured 0.02405.
+    let onset = c.onset.expect("the disks never touched");
+    assert!(
+        (0.025 - 0.1 * 0.025 / 2.0..0.0275).contains(&onset),
+        "{onset}"
+    );
+    // Measured 0.0034 m (h = 0.025).
+    assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
+    // The exchange conserves momentum: measured 3e-15 of one disk's.
+    assert!(c.momentum_drift < 1e-12, "{}", c.momentum_drift);
+    // They bounce apart along x, without spin or sideways motion.
+    assert!(l.v[0] < -0.5 && r.v[0] > 0.5, "{:?} {:?}", l.v, r.v);
+    for b in [l, r] {
+        assert!(b.omega.abs() < 1e-9 && b.v[1].abs() < 1e-9, "{b:?}");
+    }
+}
+
+#[test]
+fn frictionless_disks_off_centre_against_one_shared_field() {
+    let c = collide(&common::scene("contact_disks.toml", &[]));
+    let one = collide(&without_contact(
+        "contact_disks.toml",
+        "[contact.impact]",
+        &[],
+    ));
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+    for (name, c) in [("contact pair", &c), ("one field", &one)] {
+        let [l, r] = [c.end[0], c.end[1]];
+        println!(
+            "off-centre, {name}: left v.u {:.3} v.t {:.3} omega R {:.3}; right v.u {:.3} v.t {:.3} \
+             omega R {:.3} (exact frictionless: v.t -0.5 / 0.5, omega 0); max overlap {:.4} m; \
+             momentum drift {:.1e}",
+            dot(l.v, U),
+            dot(l.v, T),
+            l.omega * 0.2,
+            dot(r.v, U),
+            dot(r.v, T),
+            r.omega * 0.2,
+            c.max_overlap,
+            c.momentum_drift
+        );
+    }
+    assert!(c.momentum_drift < 1e-12, "{}", c.momentum_drift);
+    assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
+    let sep = |c: &Collision| dot(c.end[1].v, U) - dot(c.end[0].v, U);
+    assert!(sep(&c) > 0.5, "{}", sep(&c));
+    // Not asserted yet, because it does not hold: the issue's "neither
+    // spins up". Measured omega R = 0.39 / 0.48 of the impact speed and
+    // v.t = -0.30 / 0.30 (exact -0.5 / 0.5), against 0.24 / 0.38 with one
+    // shared field: the mass-gradient normals tilt across the contact
+    // patch (with the exact line of centres as the normal, omega R is
+    // 0.05). docs/methods.md, "Contact between bodies".
+}
+
+#[test]
+fn bad_contact_pairs_are_refused_naming_the_key() {
+    let text = std::fs::read_to_string(common::case("contact_block.toml")).unwrap();
+    let with = |table: &str, sets: &[&str]| {
+        let start = text.find("[contact.interface]").unwrap();
+        let end = start + text[start..].find("\n\n").unwrap();
+        let t = format!("{}{table}{}", &text[..start], &text[end..]);
+        let o: Vec<_> = sets
+            .iter()
+            .map(|s| lme_mpm::scene::Override::parse(s).unwrap())
+            .collect();
+        Scene::from_str(&t, "bad", "bad", &o)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    for (table, sets, key) in [
+        (
+            "[contact.i]\nbodies = [\"block\", \"floor\"]\nlaw = \"slip\"",
+            vec![],
+            "contact.i.bodies",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"block\"]\nlaw = \"slip\"",
+            vec![],
+            "contact.i.bodies",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"slab\"]\nlaw = \"slip\"\n[contact.j]\nbodies = [\"slab\", \"block\"]\nlaw = \"stick\"",
+            vec![],
+            "contact.j.bodies",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"slab\"]\nlaw = \"friction\"\nfriction = -0.1",
+            vec![],
+            "contact.i.friction",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"slab\"]\nlaw = \"friction\"",
+            vec![],
+            "contact.i.friction",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"slab\"]\nlaw = \"slip\"\nfriction = 0.3",
+            vec![],
+            "contact.i.friction",
+        ),
+        (
+            "[contact.i]\nbodies = [\"block\", \"slab\"]\nlaw = \"slip\"",
+            vec!["solver.integrator=implicit"],
+            "contact.i",
+        ),
+    ] {
+        let e = with(table, &sets);
+        assert!(e.contains(key), "{table}: {e}");
+    }
+}
