@@ -475,6 +475,7 @@ mod tests {
                 gather: false,
                 patch: false,
                 walls: false,
+                contact: false,
             });
             assert_eq!(p.cpu[2], CpuWork::ShapeEvalP2g);
             assert!(!p.cpu.contains(&CpuWork::StressForces));
