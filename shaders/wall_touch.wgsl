@@ -1,10 +1,10 @@
-// Stage `grid_update`, walls only, before `predict`: which walls each node
-// touches this step. A particle whose (square) domain of half-width
-// l_p = ½ sqrt(m_p / ρ_p) reaches a wall's line, (x_p − point)·n −
-// l_p (|n_x| + |n_y|) ≤ WALL_TOUCH_SLACK l_p, sets the wall's bit on every node of its
-// stencil (weight > 0); `predict` and `correct` apply a wall only on the
-// nodes behind it that touch it. `clear_grid` zeroes the bits.
-// CPU twin: `wall_touch` and `touching_walls` in src/cpu/grid_update.rs.
+// Stage `grid_update`, walls only, before `predict`: per node, the weight
+// S_I = Σ_p N_Ip of the particles in contact with a wall, those whose
+// (square) domain of half-width l_p = ½ sqrt(m_p / ρ_p) reaches past the
+// wall's contact line: l_p (|n_x| + |n_y|) − (x_p − point)·n − offset > 0
+// (a particle in contact with two walls counts twice). `wall_contact`
+// reads it; `clear_grid` zeroes it.
+// CPU twin: `wall_touch` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -14,10 +14,8 @@
 @group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
 @group(0) @binding({{B_WALLS}}) var<storage, read> walls: array<Wall>;
-@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<atomic<u32>>;
-
-// Keep in sync with `cpu::grid_update::WALL_TOUCH_SLACK`.
-const WALL_TOUCH_SLACK: f32 = 1e-3;
+@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<{{ATOMIC_T}}>;
+#include "shared/atomics.wgsl" ARR=wall_touch FN=touch_add
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -27,15 +25,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let x = x0[p] + u[p];
     let lp = 0.5 * sqrt(mass[p] / rho[p]);
-    var bits = 0u;
+    var count = 0u;
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let w = walls[k];
-        let d = dot(x - w.point, w.normal);
-        if d - lp * (abs(w.normal.x) + abs(w.normal.y)) <= WALL_TOUCH_SLACK * lp {
-            bits |= 1u << k;
+        if lp * (abs(w.normal.x) + abs(w.normal.y)) - dot(x - w.point, w.normal) - w.offset > 0.0 {
+            count += 1u;
         }
     }
-    if bits == 0u {
+    if count == 0u {
         return;
     }
     let c = shape_ctx(p, x);
@@ -43,8 +40,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let span = shape_span(c, r);
         for (var k = span.x; k < span.y; k++) {
             let w = shape_node(c, k);
-            if w.ok && w.n > 0.0 {
-                atomicOr(&wall_touch[w.node], bits);
+            if w.ok && w.n != 0.0 {
+                touch_add(w.node, f32(count) * w.n);
             }
         }
     }

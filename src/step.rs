@@ -118,8 +118,8 @@ pub enum Pass {
     /// component of the stencil.
     P2gPatch,
     MlsP2g,
-    /// Walls only: the walls each node touches (wall_touch.wgsl), before
-    /// `GridPredict`.
+    /// Walls only: the weight of the particles in contact per node
+    /// (wall_touch.wgsl), before `GridPredict`.
     WallTouch,
     GridPredict,
     Stress,
@@ -135,6 +135,9 @@ pub enum Pass {
     /// forces.wgsl built with PATCH, as `P2gPatch`.
     ForcesPatch,
     MlsForces,
+    /// Walls only: the walls' forces at the contact points
+    /// (wall_contact.wgsl), before `GridCorrect`.
+    WallContact,
     GridCorrect,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
@@ -150,7 +153,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 27] = [
+    pub const ALL: [Pass; 28] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -170,6 +173,7 @@ impl Pass {
         Pass::ForcesGather,
         Pass::ForcesPatch,
         Pass::MlsForces,
+        Pass::WallContact,
         Pass::GridCorrect,
         Pass::G2p,
         Pass::RemapClear,
@@ -189,6 +193,7 @@ impl Pass {
             Pass::LmeNewton => "lme_newton.wgsl",
             Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
             Pass::WallTouch => "wall_touch.wgsl",
+            Pass::WallContact => "wall_contact.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
@@ -327,6 +332,7 @@ impl StepPlan {
             Stage::GridPredict => &[Pass::GridPredict],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
+            Stage::GridCorrect if walls => &[Pass::WallContact, Pass::GridCorrect],
             Stage::GridCorrect => &[Pass::GridCorrect],
             Stage::G2p => &[Pass::G2p],
             Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],

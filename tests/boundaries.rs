@@ -1,5 +1,5 @@
 //! Walls, prescribed velocities, tractions and point loads against exact
-//! answers: the wall rules on an inclined normal, a block sliding on a
+//! answers: a block sliding on a
 //! frictional plane (both geometries, sliding and at rest; CPU and GPU), a
 //! suddenly loaded bar (stress behind the front), a column under a
 //! surcharge and its weight (σ_yy = −p − ρ0 g (H − Y)), and a disk rolling
@@ -9,12 +9,10 @@ mod common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;
-use lme_mpm::cpu::grid_update::wall_velocity;
 use lme_mpm::exact::Errors;
 use lme_mpm::exact::sliding::SlidingErrors;
 use lme_mpm::gpu::GpuBackend;
 use lme_mpm::model::Model;
-use lme_mpm::model::walls::{CONTACT_FRICTION, CONTACT_SLIP, CONTACT_STICK};
 use lme_mpm::scene::{Override, Scene};
 use lme_mpm::simulation::Simulation;
 use lme_mpm::solver::{Recorder, RunStatus, Schedule};
@@ -50,35 +48,6 @@ fn sliding(sim: &mut Simulation) -> SlidingErrors {
     match sim.score().unwrap() {
         Some(Errors::Sliding(e)) => e,
         other => panic!("not a sliding score: {other:?}"),
-    }
-}
-
-#[test]
-fn wall_rules_on_an_inclined_normal() {
-    let th = 30f64.to_radians();
-    let n = [-th.sin(), th.cos()];
-    let t = [th.cos(), th.sin()];
-    let v = |a: f64, b: f64| [a * t[0] + b * n[0], a * t[1] + b * n[1]];
-    let close = |x: [f64; 2], y: [f64; 2]| (x[0] - y[0]).abs() + (x[1] - y[1]).abs() < 1e-12;
-    // Approaching at 2 m/s with 3 m/s along the wall.
-    let u = v(3.0, -2.0);
-    assert_eq!(wall_velocity(u, n, CONTACT_STICK, 0.0), [0.0, 0.0]);
-    assert!(close(wall_velocity(u, n, CONTACT_SLIP, 0.0), v(3.0, 0.0)));
-    // μ Δv_n = 0.25 * 2 = 0.5 comes off the tangential 3.
-    assert!(close(
-        wall_velocity(u, n, CONTACT_FRICTION, 0.25),
-        v(2.5, 0.0)
-    ));
-    // μ Δv_n = 2 * 2 ≥ 3: it sticks.
-    assert!(close(
-        wall_velocity(u, n, CONTACT_FRICTION, 2.0),
-        [0.0, 0.0]
-    ));
-    // Separating (v·n > 0) and resting (v·n = 0) velocities are free.
-    for w in [v(3.0, 1.0), v(-1.0, 0.0)] {
-        for c in [CONTACT_SLIP, CONTACT_FRICTION] {
-            assert_eq!(wall_velocity(w, n, c, 0.5), w);
-        }
     }
 }
 

@@ -1040,8 +1040,9 @@ fn stages_match_two_materials() {
 /// overlaps a wall, a ramped prescribed velocity, a ramped traction and a
 /// point load (tests/scenes/boundaries.toml), at t = 0.7 s (mid-ramp), on
 /// three shape families, both integrators, a perturbed grid and CAS
-/// atomics. Random particle velocities put wall nodes in every branch of
-/// the contact rules (approach and separation, stick and slide).
+/// atomics. Random particle positions and velocities put particles in
+/// contact with every wall, approaching and separating, sticking and
+/// sliding (the contact forces' every branch).
 #[test]
 fn stages_match_boundaries() {
     let text = include_str!("scenes/boundaries.toml");

@@ -145,14 +145,15 @@ const CONTACT_FRICTION: u32 = 2u;
 
 // A rigid wall: the line through `point` (m, grid-relative) with unit
 // normal `normal` into the material; `contact` is CONTACT_*, `mu` Coulomb's
-// coefficient (friction only). Its nodes are marked in `wall_mask`.
+// coefficient (friction only); `stiffness` the penalty k (Pa/m) and
+// `offset` (m) how far past the line contact starts (src/model/walls.rs).
 struct Wall {
     point: vec2<f32>,
     normal: vec2<f32>,
     mu: f32,
     contact: u32,
-    _pad0: u32,
-    _pad1: u32,
+    stiffness: f32,
+    offset: f32,
 }
 
 // Linear invocation index over a 2D dispatch (large counts exceed 65535

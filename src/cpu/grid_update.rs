@@ -1,24 +1,28 @@
 //! Stage `grid_update`, in two passes around the force computation.
-//! `wall_touch` (walls only, before `predict`): the walls each node is in
-//! contact with, from where the body is: a node touches wall k when a
-//! particle whose domain reaches the wall line holds it in its stencil.
+//! `wall_touch` (walls only, before `predict`): per node, the weight S_I of
+//! the particles in contact with a wall (their domain reaches past its
+//! contact line).
 //! `predict`: nodal velocity from the scattered momentum, v_I = q_I / m_I,
-//! then the walls' contact rules (each wall the node is behind and
-//! touches, in scene order), then the Dirichlet conditions (fixed components set to the
-//! constraint's prescribed velocity at the step's end, zero by default):
-//! a constraint wins over a wall.
-//! `correct`: reactions on fixed nodes, their force components zeroed, then
-//! v_I += γ Δt f_I / m_I (NPC corrector; FE is γ = 1: the nodal momentum
-//! update p_I += Δt f_I of Zhang et al.); then the walls' rules on the
-//! corrected velocity, whose change Δv becomes the wall's force
-//! m Δv / (γ Δt), added to f_I (so the particles feel it) and to the wall's
-//! reaction. Fixed components keep their prescribed value.
-//! GPU twin: `shaders/grid_update.wgsl` (built without and with `CORRECT`)
-//! and `shaders/wall_touch.wgsl`.
+//! then the Dirichlet conditions (fixed components set to the
+//! constraint's prescribed velocity at the step's end, zero by default).
+//! `wall_contact` (walls only, before `correct`): the walls' forces at the
+//! contact points, the particles in contact: a penalty normal force with
+//! some damping, and Coulomb friction capped by it that stops the slip of
+//! the body at the point (docs/methods.md, "Walls"); onto the nodes with
+//! the particle's weights, and into the walls' reactions.
+//! `correct`: the walls' forces added to f_I, reactions on fixed nodes,
+//! their force components zeroed, then v_I += γ Δt f_I / m_I (NPC
+//! corrector; FE is γ = 1: the nodal momentum update p_I += Δt f_I of
+//! Zhang et al.). Fixed components keep their prescribed value: a
+//! constraint wins over a wall.
+//! GPU twins: `shaders/grid_update.wgsl` (built without and with
+//! `CORRECT`), `shaders/wall_touch.wgsl` and `shaders/wall_contact.wgsl`.
 
 use super::ShapeCache;
-use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
-use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
+use crate::model::walls::{
+    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, wall_penetration,
+};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Walls};
 use rayon::prelude::*;
 
 pub use crate::model::MASS_EPS_REL;
@@ -33,99 +37,113 @@ fn zero_fixed(v: &mut [f64], fix: u8) {
     }
 }
 
-/// A wall's contact rule on a node velocity `v` (m/s), for a node in
-/// contact: a separating or resting velocity (v·n ≥ 0) is free under every
-/// law; an approaching one loses its normal component, and then stick
-/// stops it (no slip where in contact, so a disk can roll: the nodes that
-/// lift off behind the contact are released), slip keeps the tangential
-/// part, and friction applies Coulomb's law with the normal velocity
-/// change Δv_n = −v·n as the impulse per unit mass: a tangential velocity
-/// |v_t| ≤ μ Δv_n stops, a larger one loses μ Δv_n along −v_t/|v_t|.
-#[inline]
-pub fn wall_velocity(v: [f64; 2], normal: [f64; 2], contact: u32, mu: f64) -> [f64; 2] {
-    let vn = v[0] * normal[0] + v[1] * normal[1];
-    if vn >= 0.0 {
-        return v;
-    }
-    if contact == CONTACT_STICK {
-        return [0.0, 0.0];
-    }
-    let vt = [v[0] - vn * normal[0], v[1] - vn * normal[1]];
-    if contact != CONTACT_FRICTION {
-        return vt;
-    }
-    let dvn = -vn;
-    let speed = vt[0].hypot(vt[1]);
-    if speed <= mu * dvn {
-        return [0.0, 0.0];
-    }
-    let k = 1.0 - mu * dvn / speed;
-    [k * vt[0], k * vt[1]]
-}
-
-/// The rules of every wall in `mask` (bit k = wall k), in order.
-#[inline]
-fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
-    for (k, w) in walls.iter().enumerate() {
-        if mask & (1 << k) != 0 {
-            v = wall_velocity(v, w.normal, w.contact, w.mu);
-        }
-    }
-    v
-}
-
-/// Per node, the bit set of the walls it touches (bit k = wall k): the
-/// nodes of the stencil (weight > 0) of every particle p whose domain
-/// reaches the wall line, (x_p − point)·n − l_p (|n_x| + |n_y|) ≤ s l_p
-/// (s = `WALL_TOUCH_SLACK`), with
-/// l_p = ½ sqrt(m_p / ρ_p) the half-width of its (square) domain. A node
-/// behind a wall that no touching particle reaches is free: the body is
-/// not at the wall there, whatever its velocity (before, every node
-/// behind the wall that held mass got the rule, so the patch of about
-/// sqrt(2 R h) under a disk dragged on it; docs/methods.md, "Walls").
-/// `touch` is zeroed first (its GPU twin is zeroed by `clear_grid`).
+/// Per node, the contact weight S_I = Σ_p N_Ip over the particles in
+/// contact with a wall (`wall_penetration` > 0; a particle in contact
+/// with two walls counts twice). `touch` is zeroed first (its GPU twin is
+/// zeroed by `clear_grid`).
 pub fn wall_touch(
     cache: &ShapeCache,
     x: &[[f64; 2]],
     mass: &[f64],
     rho: &[f64],
     walls: &Walls,
-    touch: &mut [u32],
+    touch: &mut [f64],
 ) {
-    touch.fill(0);
+    touch.fill(0.0);
     for p in 0..x.len() {
-        let bits = touching_walls(x[p], mass[p], rho[p], &walls.list);
-        if bits == 0 {
+        let lp = half_width(mass[p], rho[p]);
+        let count = walls
+            .list
+            .iter()
+            .filter(|w| wall_penetration(x[p], lp, w) > 0.0)
+            .count();
+        if count == 0 {
             continue;
         }
         let (nodes, w) = cache.particle(p);
         for (&n, wk) in nodes.iter().zip(w) {
-            if wk[0] > 0.0 {
-                touch[n as usize] |= bits;
-            }
+            touch[n as usize] += count as f64 * wk[0];
         }
     }
 }
 
-/// Slack of the touch test, relative to the particle's half-width: a
-/// domain whose edge lies on the line (a body seeded against a wall with
-/// the uniform layout) touches it on both backends, whatever the f32
-/// round-off of the GPU's positions (about 1e-7 of the grid's size).
-pub const WALL_TOUCH_SLACK: f64 = 1e-3;
-
-/// The walls (bit k = wall k) that the domain of a particle at `x` (m)
-/// with mass `m` and density `rho` reaches.
-#[inline]
-pub fn touching_walls(x: [f64; 2], m: f64, rho: f64, walls: &[Wall]) -> u32 {
-    let lp = 0.5 * (m / rho).sqrt();
-    let mut bits = 0;
-    for (k, w) in walls.iter().enumerate() {
-        let d = (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1];
-        if d - lp * (w.normal[0].abs() + w.normal[1].abs()) <= WALL_TOUCH_SLACK * lp {
-            bits |= 1 << k;
+/// The walls' forces at their contact points: every particle in contact
+/// with a wall gets a normal force F_n = k pen 2 l_p (penalty) and a
+/// tangential force that stops the slip of the body's velocity at the
+/// particle (stick), capped by μ F_n (friction), or none (slip); the force
+/// goes to the particle's nodes with its weights, into `wall_force`, and
+/// to the wall's reaction. The body's velocity at the particle is the
+/// corrected one without the walls, Σ N (v_I + γΔt f_I / m_I), and the
+/// tangential force that stops it is −v_t / w with
+/// w = γΔt Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
+/// contact pull on the same nodes).
+#[allow(clippy::too_many_arguments)]
+pub fn wall_contact(
+    cache: &ShapeCache,
+    x: &[[f64; 2]],
+    mass: &[f64],
+    rho: &[f64],
+    mv: &[[f64; 3]],
+    force: &[[f64; 2]],
+    walls: &Walls,
+    touch: &[f64],
+    wall_force: &mut [[f64; 2]],
+    wall_r: &mut [[f64; 2]],
+    gamma_dt: f64,
+    mass_eps: f64,
+) {
+    wall_force.fill([0.0; 2]);
+    for r in wall_r.iter_mut() {
+        *r = [0.0; 2];
+    }
+    for p in 0..x.len() {
+        let lp = half_width(mass[p], rho[p]);
+        for (k, wl) in walls.list.iter().enumerate() {
+            let pen = wall_penetration(x[p], lp, wl);
+            if pen <= 0.0 {
+                continue;
+            }
+            let (nodes, wt) = cache.particle(p);
+            let (mut v, mut w) = ([0.0; 2], 0.0);
+            for (&n, wk) in nodes.iter().zip(wt) {
+                let node = &mv[n as usize];
+                if node[0] > mass_eps {
+                    let f = force[n as usize];
+                    v[0] += wk[0] * (node[1] + gamma_dt * f[0] / node[0]);
+                    v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
+                    w += wk[0] * touch[n as usize] / node[0];
+                }
+            }
+            if w <= 0.0 {
+                continue;
+            }
+            w *= gamma_dt;
+            let nrm = wl.normal;
+            let vn = v[0] * nrm[0] + v[1] * nrm[1];
+            let fnorm = (wl.stiffness * pen * 2.0 * lp - WALL_DAMPING * vn / w).max(0.0);
+            let vt = [v[0] - vn * nrm[0], v[1] - vn * nrm[1]];
+            let mu = match wl.contact {
+                CONTACT_STICK => STICK_MU,
+                CONTACT_FRICTION => wl.mu,
+                _ => 0.0,
+            };
+            // Coulomb: the force that stops the slip, at most μ F_n.
+            let mut ft = [-vt[0] / w, -vt[1] / w];
+            let mag = ft[0].hypot(ft[1]);
+            let cap = mu * fnorm;
+            if mag > cap {
+                ft = [ft[0] * cap / mag, ft[1] * cap / mag];
+            }
+            let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
+            wall_r[k][0] += fw[0];
+            wall_r[k][1] += fw[1];
+            for (&n, wk) in nodes.iter().zip(wt) {
+                let o = &mut wall_force[n as usize];
+                o[0] += wk[0] * fw[0];
+                o[1] += wk[0] * fw[1];
+            }
         }
     }
-    bits
 }
 
 /// Prescribed velocities at time `t` (s) on the fixed components of the
@@ -154,25 +172,15 @@ pub fn predict(
     mv: &mut [[f64; 3]],
     fix: &[u8],
     groups: &[ConstraintGroup],
-    walls: &Walls,
-    touch: &[u32],
     t: f64,
     mass_eps: f64,
 ) {
-    let wl = &walls.list;
     mv.par_iter_mut()
         .zip(fix)
-        .enumerate()
         .with_min_len(4096)
-        .for_each(|(i, (n, &f))| {
+        .for_each(|(n, &f)| {
             if n[0] > mass_eps {
                 let mut v = [n[1] / n[0], n[2] / n[0]];
-                if let Some(&mask) = walls.mask.get(i) {
-                    let mask = mask & touch[i];
-                    if mask != 0 {
-                        v = walls_velocity(v, mask, wl);
-                    }
-                }
                 zero_fixed(&mut v, f);
                 *n = [n[0], v[0], v[1]];
             } else {
@@ -182,25 +190,30 @@ pub fn predict(
     prescribe(mv, groups, t, mass_eps);
 }
 
-/// Records reactions per constraint group (the force the support exerts,
-/// −f_I on each fixed component), zeroes those components, corrects the
-/// velocities by `gamma_dt` · f/m, then applies the walls on the nodes
-/// that touch them (`touch`, as in `predict`). `reactions` holds the
-/// constraint groups' then the walls'.
+/// Adds the walls' forces (`wall_contact`'s `wall_force`; empty without
+/// walls) to the nodal forces, records reactions per constraint group
+/// (the force the support exerts, −f_I on each fixed component), zeroes
+/// those components, then corrects the velocities by `gamma_dt` · f/m.
+/// `reactions` holds the constraint groups' (the walls' are
+/// `wall_contact`'s).
 #[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
     force: &mut [[f64; 2]],
     fix: &[u8],
     groups: &[ConstraintGroup],
-    walls: &Walls,
-    touch: &[u32],
+    wall_force: &[[f64; 2]],
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
     mass_eps: f64,
 ) {
-    let (group_r, wall_r) = reactions.split_at_mut(groups.len());
-    for (g, r) in groups.iter().zip(group_r.iter_mut()) {
+    if !wall_force.is_empty() {
+        force.par_iter_mut().zip(wall_force).with_min_len(4096).for_each(|(f, w)| {
+            f[0] += w[0];
+            f[1] += w[1];
+        });
+    }
+    for (g, r) in groups.iter().zip(reactions.iter_mut()) {
         *r = [0.0; 2];
         for &n in &g.nodes {
             let f = force[n as usize];
@@ -223,110 +236,72 @@ pub fn correct(
                 n[2] += gamma_dt * f[1] / n[0];
             }
         });
-    for r in wall_r.iter_mut() {
-        *r = [0.0; 2];
-    }
-    if walls.is_empty() {
-        return;
-    }
-    // Each wall's velocity change on its nodes, one wall after another in
-    // scene order (a node behind two walls gets both), as on the GPU.
-    for (node, (&mask, &t)) in walls.mask.iter().zip(touch).enumerate() {
-        let mask = mask & t;
-        let n = &mut mv[node];
-        if mask == 0 || n[0] <= mass_eps {
-            continue;
-        }
-        let m = n[0];
-        let mut v = [n[1], n[2]];
-        for (k, w) in walls.list.iter().enumerate() {
-            if mask & (1 << k) == 0 {
-                continue;
-            }
-            let mut new = wall_velocity(v, w.normal, w.contact, w.mu);
-            // A constraint wins: its components keep their value.
-            if fix[node] & FIX_X != 0 {
-                new[0] = v[0];
-            }
-            if fix[node] & FIX_Y != 0 {
-                new[1] = v[1];
-            }
-            let fw = [
-                m * (new[0] - v[0]) / gamma_dt,
-                m * (new[1] - v[1]) / gamma_dt,
-            ];
-            wall_r[k][0] += fw[0];
-            wall_r[k][1] += fw[1];
-            force[node][0] += fw[0];
-            force[node][1] += fw[1];
-            v = new;
-        }
-        n[1] = v[0];
-        n[2] = v[1];
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Wall;
     use crate::model::walls::CONTACT_SLIP;
 
-    const N: [f64; 2] = [0.0, 1.0];
-
-    #[test]
-    fn stick_stops_approach_and_frees_separation() {
-        assert_eq!(
-            wall_velocity([1.0, -2.0], N, CONTACT_STICK, 0.0),
-            [0.0, 0.0]
-        );
-        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_STICK, 0.0), [1.0, 2.0]);
-    }
-
-    #[test]
-    fn touch_from_the_particle_domain() {
+    /// One particle at `x` on one node (weight 1) of mass 2 kg moving at
+    /// `v` (m/s), against a level wall at y = 0 with k = 1e6 Pa/m; the
+    /// particle's domain is 0.1 m wide (m / ρ = 0.01). Returns the wall's
+    /// force on the material (N per unit thickness).
+    fn contact(x: [f64; 2], v: [f64; 2], law: u32, mu: f64) -> [f64; 2] {
         let wall = Wall {
             name: "w".into(),
             point: [0.0, 0.0],
-            normal: N,
-            contact: CONTACT_STICK,
-            mu: 0.0,
+            normal: [0.0, 1.0],
+            contact: law,
+            mu,
             nodes: Vec::new(),
+            stiffness: 1e6,
+            offset: 0.0,
         };
-        // Domain 0.1 m wide (m / ρ = 0.01): it reaches the line from 0.05 m.
-        let walls = [
-            wall.clone(),
-            Wall {
-                point: [0.0, -1.0],
-                ..wall
-            },
-        ];
-        assert_eq!(touching_walls([0.3, 0.05], 10.0, 1000.0, &walls), 1);
-        assert_eq!(touching_walls([0.3, 0.05004], 10.0, 1000.0, &walls), 1);
-        assert_eq!(touching_walls([0.3, 0.0501], 10.0, 1000.0, &walls), 0);
-        assert_eq!(touching_walls([0.3, -0.96], 10.0, 1000.0, &walls), 3);
+        let walls = Walls {
+            list: vec![wall],
+            mask: vec![1],
+        };
+        let mut cache = ShapeCache::new(1, 1);
+        cache.count[0] = 1;
+        cache.w[0] = [1.0, 0.0, 0.0];
+        let (xs, mass, rho) = ([x], [10.0], [1000.0]);
+        let mut touch = [0.0];
+        wall_touch(&cache, &xs, &mass, &rho, &walls, &mut touch);
+        let mv = [[2.0, v[0], v[1]]];
+        let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
+        wall_contact(
+            &cache, &xs, &mass, &rho, &mv, &[[0.0; 2]], &walls, &touch, &mut wf, &mut r, 0.01,
+            1e-9,
+        );
+        assert_eq!(wf[0], r[0]);
+        r[0]
     }
 
     #[test]
-    fn slip_removes_approach_only() {
-        assert_eq!(wall_velocity([1.0, -2.0], N, CONTACT_SLIP, 0.0), [1.0, 0.0]);
-        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_SLIP, 0.0), [1.0, 2.0]);
+    fn penalty_pushes_only_where_the_domain_reaches_past_the_line() {
+        // Reaches 0.05 m: 0.01 m past the line at y = 0.04 m.
+        assert_eq!(contact([0.3, 0.06], [0.0, 0.0], CONTACT_SLIP, 0.0), [0.0, 0.0]);
+        let f = contact([0.3, 0.04], [0.0, 0.0], CONTACT_SLIP, 0.0);
+        // k pen 2 l_p = 1e6 · 0.01 · 0.1.
+        assert!((f[1] - 1e3).abs() < 1e-9 && f[0] == 0.0, "{f:?}");
+        // Approaching at 1 m/s adds the damping: WALL_DAMPING · 1 / w,
+        // w = γΔt S/m = 0.01 / 2.
+        let f = contact([0.3, 0.04], [0.0, -1.0], CONTACT_SLIP, 0.0);
+        assert!((f[1] - 1e3 - WALL_DAMPING * 200.0).abs() < 1e-9, "{f:?}");
     }
 
     #[test]
-    fn friction_is_coulomb() {
-        // Δv_n = 2, μ Δv_n = 1: a tangential speed of 3 loses 1, 0.5 stops.
-        assert_eq!(
-            wall_velocity([3.0, -2.0], N, CONTACT_FRICTION, 0.5),
-            [2.0, 0.0]
-        );
-        assert_eq!(
-            wall_velocity([-0.5, -2.0], N, CONTACT_FRICTION, 0.5),
-            [0.0, 0.0]
-        );
-        // Separating: untouched.
-        assert_eq!(
-            wall_velocity([3.0, 2.0], N, CONTACT_FRICTION, 0.5),
-            [3.0, 2.0]
-        );
+    fn friction_is_coulomb_at_the_contact_point_and_stick_stops_the_slip() {
+        // Stopping 1 m/s of slip takes 1 / w = 200 N; μ F_n = 0.1 · 1e3.
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_FRICTION, 0.1);
+        assert!((f[0] + 100.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_FRICTION, 0.5);
+        assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_STICK, 0.0);
+        assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_SLIP, 0.0);
+        assert_eq!(f[0], 0.0);
     }
 }

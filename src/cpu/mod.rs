@@ -65,9 +65,12 @@ pub struct CpuBackend {
     pub force: Vec<[f64; 2]>,
     /// Per constraint group: reaction (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
-    /// Per node: the walls it touches this step (`grid_update::wall_touch`);
+    /// Per node: the weight of the particles in contact with a wall this
+    /// step (`grid_update::wall_touch`); empty without walls.
+    pub wall_touch: Vec<f64>,
+    /// Per node: the walls' forces this step (`grid_update::wall_contact`);
     /// empty without walls.
-    pub wall_touch: Vec<u32>,
+    pub wall_force: Vec<[f64; 2]>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -94,7 +97,12 @@ impl CpuBackend {
             wall_touch: if model.walls.is_empty() {
                 Vec::new()
             } else {
-                vec![0; nodes]
+                vec![0.0; nodes]
+            },
+            wall_force: if model.walls.is_empty() {
+                Vec::new()
+            } else {
+                vec![[0.0; 2]; nodes]
             },
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
@@ -148,11 +156,11 @@ impl CpuBackend {
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
         // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask,
-        // touch bits and node lists.
+        // contact weights, forces and node lists.
         let walls = if model.walls.is_empty() {
             0.0
         } else {
-            8.0 * model.grid.n_nodes() as f64
+            (4.0 + 8.0 + 16.0) * model.grid.n_nodes() as f64
                 + 4.0
                     * model
                         .walls
@@ -325,8 +333,6 @@ impl CpuBackend {
                     &mut self.mv,
                     &m.constraints.fix,
                     &m.constraints.groups,
-                    &m.walls,
-                    &self.wall_touch,
                     self.t + self.dt,
                     self.mass_eps,
                 );
@@ -366,17 +372,35 @@ impl CpuBackend {
                     &mut self.force_scatter,
                 );
             }
-            Stage::GridCorrect => grid_update::correct(
-                &mut self.mv,
-                &mut self.force,
-                &m.constraints.fix,
-                &m.constraints.groups,
-                &m.walls,
-                &self.wall_touch,
-                &mut self.reactions,
-                gamma * self.dt,
-                self.mass_eps,
-            ),
+            Stage::GridCorrect => {
+                let (group_r, wall_r) = self.reactions.split_at_mut(m.constraints.groups.len());
+                if !m.walls.is_empty() {
+                    grid_update::wall_contact(
+                        &self.cache,
+                        &p.x,
+                        &p.mass,
+                        &p.rho,
+                        &self.mv,
+                        &self.force,
+                        &m.walls,
+                        &self.wall_touch,
+                        &mut self.wall_force,
+                        wall_r,
+                        gamma * self.dt,
+                        self.mass_eps,
+                    );
+                }
+                grid_update::correct(
+                    &mut self.mv,
+                    &mut self.force,
+                    &m.constraints.fix,
+                    &m.constraints.groups,
+                    &self.wall_force,
+                    group_r,
+                    gamma * self.dt,
+                    self.mass_eps,
+                )
+            }
             Stage::G2p => {
                 let prm = g2p::G2pParams {
                     dt: self.dt,
@@ -407,14 +431,10 @@ impl CpuBackend {
                         &mut self.p2g_scatter,
                     );
                 }
-                // The walls' touch bits stay those of the step's start
-                // (`GridPredict`), as on the GPU.
                 grid_update::predict(
                     &mut self.mv,
                     &m.constraints.fix,
                     &m.constraints.groups,
-                    &m.walls,
-                    &self.wall_touch,
                     self.t + self.dt,
                     self.mass_eps,
                 );

@@ -53,8 +53,10 @@ pub enum Buf {
     MlsOcc,
     MlsCoef,
     Walls,
-    WallMask,
-    /// Per node: the walls it touches this step (wall_touch.wgsl).
+    /// Per node: the walls' forces this step (wall_contact.wgsl).
+    WallForce,
+    /// Per node: the weight of the particles in contact with a wall this
+    /// step (wall_touch.wgsl).
     WallTouch,
     ExtForce,
     /// MUSL: each particle's position at the step's start (grid-relative),
@@ -96,7 +98,7 @@ impl Buf {
         Buf::MlsOcc,
         Buf::MlsCoef,
         Buf::Walls,
-        Buf::WallMask,
+        Buf::WallForce,
         Buf::WallTouch,
         Buf::ExtForce,
         Buf::XStart,
@@ -336,14 +338,12 @@ fn grid_and_output_data(
                 normal: f32x2(w.normal),
                 mu: w.mu as f32,
                 contact: w.contact,
-                _pad: [0; 2],
+                stiffness: w.stiffness as f32,
+                offset: w.offset as f32,
             })
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
-        data.push((
-            Buf::WallMask,
-            bytemuck::cast_slice(&model.walls.mask).to_vec(),
-        ));
+        data.push((Buf::WallForce, vec![0u8; 8 * g.n_nodes()]));
         data.push((Buf::WallTouch, vec![0u8; 4 * g.n_nodes()]));
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();

@@ -119,7 +119,10 @@ pub struct GpuWall {
     pub normal: [f32; 2],
     pub mu: f32,
     pub contact: u32,
-    pub _pad: [u32; 2],
+    /// Penalty stiffness k (Pa/m, `Wall::stiffness`).
+    pub stiffness: f32,
+    /// Contact line's offset (m, `Wall::offset`).
+    pub offset: f32,
 }
 const _: () = assert!(std::mem::size_of::<GpuWall>() == 32);
 

@@ -74,7 +74,7 @@ pub struct Variant {
     pub mms: bool,
     /// MLS reconstruction at Gauss points.
     pub mls: bool,
-    /// Rigid walls (the `Walls` and `WallMask` buffers).
+    /// Rigid walls (the `Walls`, `WallTouch` and `WallForce` buffers).
     pub walls: bool,
     /// Tractions or point loads (the `ExtForce` buffer).
     pub ext_force: bool,

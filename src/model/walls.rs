@@ -5,13 +5,38 @@
 //! (`cpu::grid_update::wall_velocity` and its WGSL twin) from this list.
 
 use crate::error::SceneError;
-use crate::model::Grid;
+use crate::model::{Grid, Particles};
 use crate::scene::{Contact, Scene};
 
 /// Contact law code shared with WGSL (`Wall::contact`, shaders/shared/types.wgsl).
 pub const CONTACT_STICK: u32 = 0;
 pub const CONTACT_SLIP: u32 = 1;
 pub const CONTACT_FRICTION: u32 = 2;
+
+/// The walls' penalty stiffness k relative to the stiffest material's
+/// P-wave modulus M over the grid spacing h: k = WALL_PENALTY M / h (Pa/m).
+/// Measured (docs/methods.md, "Walls"): 0.1 left the suddenly loaded
+/// block bouncing on the wall (at μ = 1.0 it slid at 0.17 m/s) and the
+/// disk on the grid-aligned floor 10 % off; 0.01 put the inclined disk 5 %
+/// off; 0.03 with `WALL_DAMPING` meets both within the figures of the
+/// methods table.
+pub const WALL_PENALTY: f64 = 0.03;
+
+/// Normal damping of the contact, as the fraction of the body's normal
+/// velocity at a contact point that one step's damping force would stop
+/// (F_d = −WALL_DAMPING v_n / w; `cpu::grid_update::wall_contact`). Without
+/// it the elastic block rings on the penalty spring, and at each release
+/// gravity pulls it down the slope; 0.1 and more slows the rolling disk
+/// (the force grows where the rim approaches the wall, ahead of the
+/// contact: 6.4 % at R/h 10 against 4.5 %).
+pub const WALL_DAMPING: f64 = 0.05;
+
+/// A stick wall holds a contact point as friction with this μ: no slip
+/// while the tangential force stays below 20 times the normal one.
+/// Uncapped, points that barely touch the wall (no normal force) held
+/// the disk's rim and it rolled 78 % short; 2, 5 and 20 give 4.4, 4.0 and
+/// 3.9 % (inclined, R/h 10, linear), as friction with μ = 0.5 does.
+pub const STICK_MU: f64 = 20.0;
 
 /// One wall.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,6 +52,14 @@ pub struct Wall {
     pub mu: f64,
     /// Nodes behind the line.
     pub nodes: Vec<u32>,
+    /// Penalty stiffness k (Pa per m of penetration, i.e. N/m per m of
+    /// wall length per m of penetration): `WALL_PENALTY` × the stiffest
+    /// material's P-wave modulus / h (`Walls::set_stiffness`).
+    pub stiffness: f64,
+    /// How far (m) the particles' domains reached past the line at the
+    /// start (the deepest): contact is measured from there, so a body
+    /// seeded against the wall starts unloaded (`Walls::set_contact`).
+    pub offset: f64,
 }
 
 /// The scene's walls, and per node the bit set of the walls it is behind
@@ -40,6 +73,25 @@ pub struct Walls {
 impl Walls {
     pub fn is_empty(&self) -> bool {
         self.list.is_empty()
+    }
+
+    /// Sets every wall's penalty stiffness from the largest P-wave
+    /// modulus M = λ + 2μ (Pa) of the scene's materials and the spacing
+    /// `h` (m), k = `WALL_PENALTY` M / h,
+    /// and the offset of each wall: how deep the deepest particle's domain
+    /// reaches past its line at the start (`Wall::offset`).
+    pub fn set_contact(&mut self, p_wave_modulus: f64, h: f64, particles: &Particles) {
+        for w in &mut self.list {
+            w.stiffness = WALL_PENALTY * p_wave_modulus / h;
+            w.offset = 0.0;
+            let deepest = (0..particles.len())
+                .map(|p| {
+                    let lp = half_width(particles.mass[p], particles.rho[p]);
+                    wall_penetration(particles.x[p], lp, w)
+                })
+                .fold(0.0, f64::max);
+            w.offset = deepest;
+        }
     }
 
     /// Walls of `scene` on `grid`. A wall with no node behind it is an
@@ -94,8 +146,27 @@ impl Walls {
                 contact,
                 mu,
                 nodes,
+                stiffness: 0.0,
+                offset: 0.0,
             });
         }
         Ok(Walls { list, mask })
     }
+}
+
+/// Half-width l_p = ½ sqrt(m_p / ρ_p) (m) of a particle's square domain
+/// (mass `m`, kg per unit thickness; density `rho`, kg/m³).
+#[inline]
+pub fn half_width(m: f64, rho: f64) -> f64 {
+    0.5 * (m / rho).sqrt()
+}
+
+/// How far (m) the square domain (half-width `lp`, m) of a particle at
+/// `x` (m) reaches past the wall's contact line, the wall line moved by
+/// its offset: l_p (|n_x| + |n_y|) − (x − point)·n − offset. Positive:
+/// the particle is in contact.
+#[inline]
+pub fn wall_penetration(x: [f64; 2], lp: f64, w: &Wall) -> f64 {
+    let d = (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1];
+    lp * (w.normal[0].abs() + w.normal[1].abs()) - d - w.offset
 }
