@@ -302,18 +302,20 @@ t_end = 0.5
 sample_interval = 0.1
 "#;
 
-/// The disk's centre displacement at 0.5 s within 20 % of the exact
-/// rolling distance (a = (2/3) g sin θ). Measured 17.5 % on the friction
-/// wall and 18.1 % on the stick wall (2026-11-25); before the walls acted
-/// only on the nodes the body touches, 49.6 % (every node behind the wall
-/// under the disk's lower cells was held) and the stick wall glued it.
-/// What is left is the node rule's rolling resistance (docs/methods.md,
-/// "Walls"); issue 23's 5 % is not met.
-const DISK_R10_BOUND: f64 = 0.20;
-/// Most the stick wall's relative error may differ from the friction
-/// wall's: both hold the contact without slip (μ = 0.5 > tan θ / 3), so
-/// the disk must roll alike on both. Measured 0.6 points.
-const DISK_STICK_GAP: f64 = 0.02;
+/// The disk's centre displacement at 0.5 s within 8 % of the exact
+/// rolling distance (a = (2/3) g sin θ). Measured 6.65 % on the friction
+/// wall and 2.21 % on the stick wall (2026-11-25, walls at the contact
+/// points); 17.5 % and 18.1 % with the node rule before, 49.6 % when
+/// every node behind the wall under the disk was held. Issue 23's 5 % is
+/// met on the stick wall, not on friction (μ = 0.5): the contact's edge
+/// points, where the normal force is small, slip (docs/methods.md,
+/// "Walls").
+const DISK_R10_BOUND: f64 = 0.08;
+/// The stick wall rolls the disk at least as far as the friction wall,
+/// within this much (both ought to roll without slip; the stick wall
+/// also holds the edge points that slip on μ = 0.5). Measured: stick
+/// 4.4 points ahead.
+const DISK_STICK_SLACK: f64 = 0.005;
 
 #[test]
 fn disk_rolls_on_friction_and_stick_walls_on_a_grid_line() {
@@ -338,7 +340,7 @@ fn disk_rolls_on_friction_and_stick_walls_on_a_grid_line() {
         assert!(e.u_x_rel_error < DISK_R10_BOUND, "{law}: {e:?}");
     }
     assert!(
-        (stick.u_x_rel_error - friction.u_x_rel_error).abs() < DISK_STICK_GAP,
+        stick.u_x_rel_error < friction.u_x_rel_error + DISK_STICK_SLACK,
         "stick {stick:?} against friction {friction:?}"
     );
 }

@@ -232,7 +232,10 @@ fn every_pass_validates_in_every_variant() {
                 assert!(has(Buf::WallForce), "{pass:?} {v:?}: walls' forces unread");
             }
             if v.walls && matches!(pass, Pass::WallContact) {
-                assert!(has(Buf::WallTouch), "{pass:?} {v:?}: contact weights unread");
+                assert!(
+                    has(Buf::WallTouch),
+                    "{pass:?} {v:?}: contact weights unread"
+                );
             }
             if v.ext_force && matches!(pass, Pass::Forces | Pass::ForcesGather) {
                 assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");

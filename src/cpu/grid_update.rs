@@ -168,13 +168,7 @@ fn prescribe(mv: &mut [[f64; 3]], groups: &[ConstraintGroup], t: f64, mass_eps: 
 
 /// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end
 /// time (s); `touch` is `wall_touch`'s (empty without walls).
-pub fn predict(
-    mv: &mut [[f64; 3]],
-    fix: &[u8],
-    groups: &[ConstraintGroup],
-    t: f64,
-    mass_eps: f64,
-) {
+pub fn predict(mv: &mut [[f64; 3]], fix: &[u8], groups: &[ConstraintGroup], t: f64, mass_eps: f64) {
     mv.par_iter_mut()
         .zip(fix)
         .with_min_len(4096)
@@ -208,10 +202,14 @@ pub fn correct(
     mass_eps: f64,
 ) {
     if !wall_force.is_empty() {
-        force.par_iter_mut().zip(wall_force).with_min_len(4096).for_each(|(f, w)| {
-            f[0] += w[0];
-            f[1] += w[1];
-        });
+        force
+            .par_iter_mut()
+            .zip(wall_force)
+            .with_min_len(4096)
+            .for_each(|(f, w)| {
+                f[0] += w[0];
+                f[1] += w[1];
+            });
     }
     for (g, r) in groups.iter().zip(reactions.iter_mut()) {
         *r = [0.0; 2];
@@ -272,7 +270,17 @@ mod tests {
         let mv = [[2.0, v[0], v[1]]];
         let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
         wall_contact(
-            &cache, &xs, &mass, &rho, &mv, &[[0.0; 2]], &walls, &touch, &mut wf, &mut r, 0.01,
+            &cache,
+            &xs,
+            &mass,
+            &rho,
+            &mv,
+            &[[0.0; 2]],
+            &walls,
+            &touch,
+            &mut wf,
+            &mut r,
+            0.01,
             1e-9,
         );
         assert_eq!(wf[0], r[0]);
@@ -282,7 +290,10 @@ mod tests {
     #[test]
     fn penalty_pushes_only_where_the_domain_reaches_past_the_line() {
         // Reaches 0.05 m: 0.01 m past the line at y = 0.04 m.
-        assert_eq!(contact([0.3, 0.06], [0.0, 0.0], CONTACT_SLIP, 0.0), [0.0, 0.0]);
+        assert_eq!(
+            contact([0.3, 0.06], [0.0, 0.0], CONTACT_SLIP, 0.0),
+            [0.0, 0.0]
+        );
         let f = contact([0.3, 0.04], [0.0, 0.0], CONTACT_SLIP, 0.0);
         // k pen 2 l_p = 1e6 · 0.01 · 0.1.
         assert!((f[1] - 1e3).abs() < 1e-9 && f[0] == 0.0, "{f:?}");
