@@ -1,6 +1,7 @@
 //! Walls, prescribed velocities, tractions and point loads against exact
-//! answers: a block sliding on a
-//! frictional plane (both geometries, sliding and at rest; CPU and GPU), a
+//! answers: a block sliding on a frictional plane (both geometries,
+//! sliding and at rest; CPU and GPU), issue 23's suddenly loaded block
+//! (at rest for μ > tan θ, sliding otherwise), a
 //! suddenly loaded bar (stress behind the front), a column under a
 //! surcharge and its weight (σ_yy = −p − ρ0 g (H − Y)), and a disk rolling
 //! on friction and stick walls on a grid line.
@@ -73,6 +74,63 @@ fn sliding_block_matches_exact_on_cpu() {
                 AT_REST_TOL
             };
             assert!(e.velocity_rel_error < tol, "{case} {sets:?}: {e:?}");
+        }
+    }
+}
+
+/// Issue 23's suddenly loaded block: E = 1 MPa, 1 m × 0.5 m, h = 0.05 m,
+/// gravity tilted 30° applied at once (no ramp), so the elastic block
+/// rings on the wall. It must rest (|v| below `SUDDEN_REST_SPEED`) for
+/// μ = 0.7 and 1.0 (> tan 30°), and slide within `SUDDEN_SLIDE_TOL` of
+/// g (sin θ − μ cos θ) t for μ = 0.5. Measured (2026-11-25, walls at the
+/// contact points): 0.0002 and 0.0019 m/s, and 2.4 % fast; with the
+/// node rule before, 0.24 and 0.11 m/s, and 58 % fast.
+const SUDDEN_BLOCK: &str = r#"
+exact = "sliding_block"
+[grid]
+h = 0.05
+origin = [0.0, 0.0]
+margin = 0.5
+[materials.block]
+model = "linear_elastic"
+density = 1000.0
+E = 1e6
+nu = 0.3
+[bodies.block]
+material = "block"
+rects = [[0.0, 0.0, 1.0, 0.5]]
+[walls.floor]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+contact = "friction"
+friction = 0.7
+[gravity]
+g = [4.905, -8.495709211]
+ramp = "none"
+[solver]
+shape = "linear"
+t_end = 0.5
+[output]
+sample_interval = 0.1
+"#;
+/// Issue 23's bound on the resting block's speed (m/s).
+const SUDDEN_REST_SPEED: f64 = 0.02;
+/// Issue 23's bound on the sliding block's velocity, relative.
+const SUDDEN_SLIDE_TOL: f64 = 0.03;
+
+#[test]
+fn suddenly_loaded_block_rests_or_slides_as_coulomb_says() {
+    for mu in ["0.7", "1.0", "0.5"] {
+        let set = format!("walls.floor.friction={mu}");
+        let scene = scene_of(SUDDEN_BLOCK, &[set.as_str()]);
+        let model = Model::new(&scene).unwrap();
+        let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
+        let e = sliding(&mut sim);
+        println!("sudden block mu = {mu}: {e:?}");
+        if e.velocity_exact > 0.0 {
+            assert!(e.velocity_rel_error < SUDDEN_SLIDE_TOL, "mu {mu}: {e:?}");
+        } else {
+            assert!(e.velocity.abs() < SUDDEN_REST_SPEED, "mu {mu}: {e:?}");
         }
     }
 }

@@ -79,18 +79,35 @@ impl Walls {
     /// modulus M = λ + 2μ (Pa) of the scene's materials and the spacing
     /// `h` (m), k = `WALL_PENALTY` M / h,
     /// and the offset of each wall: how deep the deepest particle's domain
-    /// reaches past its line at the start (`Wall::offset`).
+    /// reaches past its line at the start (`Wall::offset`), less the
+    /// penetration that carries the initial compression of the particles
+    /// there (a geostatic body's weight on its floor).
     pub fn set_contact(&mut self, p_wave_modulus: f64, h: f64, particles: &Particles) {
         for w in &mut self.list {
             w.stiffness = WALL_PENALTY * p_wave_modulus / h;
             w.offset = 0.0;
-            let deepest = (0..particles.len())
+            let pens: Vec<(f64, f64)> = (0..particles.len())
                 .map(|p| {
                     let lp = half_width(particles.mass[p], particles.rho[p]);
-                    wall_penetration(particles.x[p], lp, w)
+                    (wall_penetration(particles.x[p], lp, w), lp)
                 })
-                .fold(0.0, f64::max);
-            w.offset = deepest;
+                .collect();
+            let deepest = pens.iter().map(|q| q.0).fold(0.0, f64::max);
+            // The particles flush with that line and in compression across
+            // it (a geostatic body) start carrying their traction: the
+            // line moves back by the penetration σ_nn / k the least
+            // compressed of them needs (zero for a stress-free body).
+            let n = w.normal;
+            let preload = pens
+                .iter()
+                .zip(&particles.stress)
+                .filter(|((pen, lp), _)| *pen >= deepest - 1e-6 * lp)
+                .map(|(_, s)| {
+                    let snn = s[0] * n[0] * n[0] + 2.0 * s[2] * n[0] * n[1] + s[1] * n[1] * n[1];
+                    (-snn).max(0.0) / w.stiffness
+                })
+                .fold(f64::INFINITY, f64::min);
+            w.offset = deepest - if preload.is_finite() { preload } else { 0.0 };
         }
     }
 
