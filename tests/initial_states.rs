@@ -164,7 +164,7 @@ fn geostatic_column_stays_at_rest() {
         let s = worst_sigma_yy(&m);
         println!(
             "geostatic {shape}: mean |v| {mean:.3e} m/s over 1 s (largest {max:.3e}; bound {bound:.3e}, \
-             not met); σ_yy off by {s:.2e} ρgH"
+             not met); σ_yy off by {s:.2e} ρgH (bound {SIGMA_REL:.0e}, not met)"
         );
         if shape == "linear" {
             assert!(
