@@ -4,6 +4,7 @@
 //      predicted as NPC_POSITION_* says. Positions live as x0 + u, and u is a
 //      compensated (Kahan) sum u − u_lo: a slow, steady motion would otherwise
 //      lose the same fraction of every small increment to f32 rounding.
+// PIC: v = (1 − α) v_FLIP + α Σ N v_I, α = params.pic_fraction.
 // CPU twin: src/cpu/g2p.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -43,7 +44,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
+#if PIC
+    let vp = (1.0 - params.pic_fraction) * (v[p] + dt * acc) + params.pic_fraction * vel;
+#else
     let vp = v[p] + dt * acc;
+#endif
     var du = dt * vel;
 #if NPC
 #if !NPC_POSITION_CORRECTED

@@ -5,6 +5,9 @@
 // reactions (−f on fixed components, summed per constraint), those
 // components zeroed (a constraint wins over a wall), then
 // v_I += γ Δt f_I / m_I (FE: γ = 1).
+// With LOCAL_DAMPING, before the update each force component of a node
+// with mass (the walls' forces included) loses α |f_i| sign(v_i), v the
+// predicted nodal velocity (Cundall).
 // CPU twin: src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 
@@ -91,6 +94,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     if m > params.mass_eps {
         let gdt = params.npc_gamma * sim.dt;
+#if LOCAL_DAMPING
+        f -= params.local_damping * abs(f) * sign(vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]));
+#endif
         var v = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f;
         node_acc[b + 1u] = v.x;
         node_acc[b + 2u] = v.y;

@@ -8,7 +8,8 @@
 // force −v̂_t / w that stops the slip there, at most μ F_n (stick: μ =
 // STICK_MU; slip: 0). F goes onto the nodes with the particle's weights
 // (`wall_force`, which `correct` adds to f_I) and into the wall's
-// reaction. `clear_grid` zeroes `wall_force`.
+// reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
+// that act at the step's start time t (appear_at <= t < remove_at) push.
 // CPU twin: `wall_contact` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -39,8 +40,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let x = x0[p] + u[p];
     let lp = 0.5 * sqrt(mass[p] / rho[p]);
     let gdt = params.npc_gamma * sim.dt;
+#if GATES
+    let t = sim.t + sim.t_lo;
+#endif
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let wl = walls[k];
+#if GATES
+        if t < wl.appear_at || t >= wl.remove_at {
+            continue;
+        }
+#endif
         let pen = lp * (abs(wl.normal.x) + abs(wl.normal.y)) - dot(x - wl.point, wl.normal) - wl.offset;
         if pen <= 0.0 {
             continue;

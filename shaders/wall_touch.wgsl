@@ -3,7 +3,8 @@
 // (square) domain of half-width l_p = ½ sqrt(m_p / ρ_p) reaches past the
 // wall's contact line: l_p (|n_x| + |n_y|) − (x_p − point)·n − offset > 0
 // (a particle in contact with two walls counts twice). `wall_contact`
-// reads it; `clear_grid` zeroes it.
+// reads it; `clear_grid` zeroes it. With GATES only the walls that act at
+// the step's start time t (appear_at <= t < remove_at) are in contact.
 // CPU twin: `wall_touch` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
@@ -26,8 +27,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let x = x0[p] + u[p];
     let lp = 0.5 * sqrt(mass[p] / rho[p]);
     var count = 0u;
+#if GATES
+    let t = sim.t + sim.t_lo;
+#endif
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let w = walls[k];
+#if GATES
+        if t < w.appear_at || t >= w.remove_at {
+            continue;
+        }
+#endif
         if lp * (abs(w.normal.x) + abs(w.normal.y)) - dot(x - w.point, w.normal) - w.offset > 0.0 {
             count += 1u;
         }

@@ -194,6 +194,10 @@ fn finish(
     schedule.final_checkpoint = scene.file.output.final_checkpoint;
     let t_drive = Instant::now();
     writer.started = Some((t_drive, sim.backend_ref().time(), steps0));
+    if writer.lines.is_some() {
+        // A log says when stepping begins, after the set-up.
+        writer.progress_line(sim.backend_ref().time(), scene.solver().t_end, steps0);
+    }
     let driven = sim.drive_from(schedule, writer, cursor);
     writer.finish_progress();
     // From here to summary.json no signal ends the process.

@@ -128,6 +128,12 @@ fn variants() -> Vec<Variant> {
                                         // Walls and loads in every shape and
                                         // integrator, with one atomic mode.
                                         walls: atomics == AtomicMode::CompareExchange && !mls,
+                                        // Gates, the PIC blend and local damping
+                                        // where the walls are.
+                                        gates: atomics == AtomicMode::CompareExchange && !mls,
+                                        pic: atomics == AtomicMode::CompareExchange && !mls,
+                                        local_damping: atomics == AtomicMode::CompareExchange
+                                            && !mls,
                                         ext_force: atomics == AtomicMode::CompareExchange && !mls,
                                         // Gather where it can, except with several
                                         // materials and float atomics (the scatter).
@@ -302,7 +308,7 @@ fn shared_structs_match_rust_layouts() {
         gravity, ramp_period, npc_gamma, p2g_accel, edge_margin, grid_w, grid_hgt, lme_beta, lme_r2, lme_tol,
         lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials, fixed_dt, mms_amp, mms_origin,
         mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off,
-        mls_weight_scale);
+        mls_weight_scale, pic_fraction, local_damping);
     assert_eq!(wgsl_struct(&module, "Params"), params);
     let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
@@ -310,7 +316,8 @@ fn shared_structs_match_rust_layouts() {
     assert_eq!(wgsl_struct(&module, "Material"), mat);
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix, vx, vy, ramp_time);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
-    let wall = rust_fields!(GpuWall; point, normal, mu, contact, stiffness, offset);
+    let wall =
+        rust_fields!(GpuWall; point, normal, mu, contact, stiffness, offset, appear_at, remove_at);
     assert_eq!(wgsl_struct(&module, "Wall"), wall);
 }
 

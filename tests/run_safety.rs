@@ -792,34 +792,51 @@ fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
 
 #[test]
 fn a_second_signal_long_after_the_first_ends_a_long_step_with_the_folder_saying_so() {
-    // One static Newton step of the cantilever at h = 2.5 cm takes about
-    // 10 s (5e4 particles): the first SIGTERM waits for its end; a second
+    // One static Newton step of the cantilever at h = 1.5 cm takes about
+    // 11 s on two cores (1.4e5 particles, 1.4 GB; at h = 2.5 cm it took
+    // under 3 s, too close to the test's 3 s of signals, and CI saw the
+    // step end first): the first SIGTERM waits for its end; a second
     // one past the grace of 2 s ends the process at once, and the folder
     // must then say `interrupted` and hold no lock. Before: the second
     // signal ended it with summary.json `running` and a stale lock.
     let out = tmp("late-second");
+    // Not quiet: stderr (a pipe) gets progress lines, the first when
+    // stepping begins. A signal before it (during the set-up) would stop
+    // the run at the first step boundary, which is not what is tested.
     let mut child = bin()
-        .args(["run", "--backend", "cpu", "--quiet", "--out"])
+        .args(["run", "--backend", "cpu", "--out"])
         .arg(&out)
         .arg(common::case("cantilever.toml"))
-        .args(["--set", "grid.h=0.025"])
+        .args(["--set", "grid.h=0.015"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let started = std::time::Instant::now();
-    while !std::fs::read_to_string(out.join("summary.json")).is_ok_and(|t| t.contains("running")) {
-        assert!(started.elapsed().as_secs() < 120, "the run never started");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    let pipe = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut all = String::new();
+        for line in std::io::BufRead::lines(std::io::BufReader::new(pipe)) {
+            let line = line.unwrap_or_default();
+            if line.starts_with("progress:") {
+                let _ = tx.send(());
+            }
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(120))
+        .expect("no progress line: the run never began stepping");
+    // Past the t = 0 sample, inside the first (10 s) step.
+    std::thread::sleep(std::time::Duration::from_millis(500));
     signal(child.id(), &["-TERM"]);
     std::thread::sleep(std::time::Duration::from_millis(2500));
     let sent = std::time::Instant::now();
     signal(child.id(), &["-TERM"]);
     let status = child.wait().unwrap();
     let waited = sent.elapsed().as_secs_f64();
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    let err = reader.join().unwrap();
     assert_eq!(status.code(), Some(143), "{err}");
     let s = summary(&out);
     assert_eq!(s["status"], "interrupted", "{s}");

@@ -1086,6 +1086,58 @@ fn stages_match_boundaries() {
     }
 }
 
+/// Gates, the PIC blend and local damping (issue 23 item 3) on the
+/// boundaries scene at t = 0.7 s: the right wall was removed at 0.5 s, the
+/// left one appeared at 0.6 s, the floor stays; `solver.pic_fraction` and
+/// `solver.local_damping` on FE, NPC and MUSL. On the CPU the removed wall
+/// exerts nothing and the others do (so the gate is what the twins agree
+/// on, not a wall that happened to be idle).
+#[test]
+fn stages_match_gates_pic_and_damping() {
+    let text = include_str!("scenes/boundaries.toml");
+    let gated = [
+        "walls.right.remove_at=0.5",
+        "walls.left.appear_at=0.6",
+        "solver.pic_fraction=0.3",
+        "solver.local_damping=0.7",
+    ];
+    for (label, sets, cas) in [
+        (
+            "gates, linear fe",
+            &["solver.shape=linear", "solver.integrator=fe"][..],
+            false,
+        ),
+        ("gates, lme npc", &["solver.shape=lme"][..], false),
+        (
+            "gates, bspline2 musl, CAS atomics",
+            &["solver.shape=bspline2", "solver.integrator=musl"][..],
+            true,
+        ),
+    ] {
+        let all: Vec<&str> = gated.iter().chain(sets).copied().collect();
+        let m = random_model_of(text, &all, 13);
+        assert!(m.pic_fraction > 0.0 && m.local_damping > 0.0, "{label}");
+        let mut cpu = CpuBackend::new(m.clone());
+        cpu.set_time(0.7);
+        for &stage in stages(m.integrator)
+            .iter()
+            .take_while(|s| **s != Stage::G2p)
+        {
+            cpu.run_stage(stage).unwrap();
+        }
+        let groups = m.constraints.groups.len();
+        for (w, r) in m.walls.list.iter().zip(&cpu.reactions[groups..]) {
+            let f = r[0].hypot(r[1]);
+            if w.name == "right" {
+                assert_eq!(f, 0.0, "{label}: the removed gate acts");
+            } else {
+                assert!(f > 0.0, "{label}: wall {} idle", w.name);
+            }
+        }
+        parity_of(label, m, cas, GpuOptions::default(), 0.7);
+    }
+}
+
 /// Plastic materials (Mohr–Coulomb, Drucker–Prager) with random stresses
 /// of ±100 kPa against c = 10 kPa: most particles yield in every region
 /// (plane, edges, apex, tension), and the stress stage's twins must agree.

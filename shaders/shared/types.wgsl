@@ -79,8 +79,10 @@ struct Params {
     mls_break_off: f32,
     // r per |Δx|/h in the MLS weight: 1.5 / solver.mls_support (the paper's 0.5).
     mls_weight_scale: f32,
-    _pad_p0: u32,
-    _pad_p1: u32,
+    // Share α of PIC in g2p's velocity update (flag PIC), in [0, 1].
+    pic_fraction: f32,
+    // Cundall's local damping α (flag LOCAL_DAMPING), in [0, 1).
+    local_damping: f32,
     _pad_p2: u32,
 }
 
@@ -154,6 +156,10 @@ struct Wall {
     contact: u32,
     stiffness: f32,
     offset: f32,
+    // The wall acts for appear_at <= t < remove_at (s), t the step's start
+    // (flag GATES).
+    appear_at: f32,
+    remove_at: f32,
 }
 
 // Linear invocation index over a 2D dispatch (large counts exceed 65535

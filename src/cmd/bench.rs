@@ -1,7 +1,10 @@
 //! `lme-mpm bench`: its arguments and handler (throughput points, the peer
 //! command, bench.csv and the chart), over `lme_mpm::bench`.
 
-use crate::*;
+use super::common::{adapter_without_gpu, fail};
+use lme_mpm::run::BackendChoice;
+use std::path::PathBuf;
+use std::process::ExitCode;
 
 /// `lme-mpm bench`'s arguments.
 #[derive(clap::Args, Debug)]

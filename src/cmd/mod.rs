@@ -2,4 +2,5 @@
 //! bench); `main.rs` keeps the command line and the short ones.
 
 pub mod bench;
+pub mod common;
 pub mod sweep;

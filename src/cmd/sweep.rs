@@ -1,7 +1,14 @@
 //! `lme-mpm sweep`: its arguments and handler (plan, run locally, emit
 //! jobs, collect), over `lme_mpm::sweep`.
 
-use crate::*;
+use super::common::{Signals, fail};
+use lme_mpm::Error;
+use lme_mpm::run::BackendChoice;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
 #[derive(clap::Args)]
 pub struct SweepArgs {

@@ -2,7 +2,7 @@
 //! f_I = Σ_p (−V_p σ_p ∇N_I + N_I m_p b) (paper eq. 14; V_p = m_p / ρ_p).
 //! GPU twin: `shaders/forces.wgsl`.
 
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 
 /// `body(p)` is particle p's body force per unit mass at this step (m/s²):
 /// gravity, plus a manufactured solution's source term when there is one.

@@ -5,9 +5,13 @@
 //!      momentum update; B-spline paper eqs. 29–30).
 //! NPC: a_p = Σ N f/m;  v_p += Δt a_p;  x_p += Δt Σ N v_I + ½ Δt² a_p, with
 //!      v_I the corrected or the predicted nodal velocity (`NpcPosition`).
+//! With `solver.pic_fraction` α > 0 the new particle velocity is the blend
+//! (1 − α) v_FLIP + α v_PIC, v_FLIP the update above and v_PIC = Σ N v_I
+//! with v_I the nodal velocity after the momentum update (the corrected
+//! one for NPC); positions are untouched (docs/methods.md, "PIC blend").
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::ShapeCache;
+use super::stage_inputs::ShapeCache;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
 use crate::model::{Grid, Integrator};
@@ -21,6 +25,8 @@ pub struct G2pParams {
     pub mass_eps: f64,
     /// Distance (m) a particle must keep from the grid's edge.
     pub edge_margin: f64,
+    /// Share α of PIC in the velocity update, in [0, 1]; 0 = FLIP.
+    pub pic_fraction: f64,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -50,8 +56,16 @@ pub fn g2p(
                     vel[1] += wk[0] * n[2];
                 }
             }
-            v[0] += dt * acc[0];
-            v[1] += dt * acc[1];
+            if prm.pic_fraction > 0.0 {
+                // Blend of the FLIP update and Σ N v_I (the same v_I as
+                // the positions' before NPC's own changes to `vel`).
+                let a = prm.pic_fraction;
+                v[0] = (1.0 - a) * (v[0] + dt * acc[0]) + a * vel[0];
+                v[1] = (1.0 - a) * (v[1] + dt * acc[1]) + a * vel[1];
+            } else {
+                v[0] += dt * acc[0];
+                v[1] += dt * acc[1];
+            }
             match prm.integrator {
                 // MUSL moves as FE does (B-spline paper eqs. 29–30);
                 // `cpu::implicit` steps implicit models, so that arm is unused.

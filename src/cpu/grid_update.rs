@@ -15,10 +15,17 @@
 //! corrector; FE is γ = 1: the nodal momentum update p_I += Δt f_I of
 //! Zhang et al.). Fixed components keep their prescribed value: a
 //! constraint wins over a wall.
+//! With `solver.local_damping` α > 0 (Cundall), `correct` first takes
+//! α |f_i| sign(v_i) off each component of the unbalanced force of a node
+//! with mass (the walls' forces included), v_I the nodal velocity it is
+//! about to correct (the predicted one), before the velocity update, so
+//! the nodes and the particles' FLIP update (`g2p`) feel the damped force.
+//! Only the walls that act in the step (`Wall::active_at`: a gate's
+//! `appear_at` ≤ t < `remove_at`) are in contact.
 //! GPU twins: `shaders/grid_update.wgsl` (built without and with
 //! `CORRECT`), `shaders/wall_touch.wgsl` and `shaders/wall_contact.wgsl`.
 
-use super::ShapeCache;
+use super::stage_inputs::ShapeCache;
 use crate::model::walls::{
     CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, wall_penetration,
 };
@@ -37,16 +44,41 @@ fn zero_fixed(v: &mut [f64], fix: u8) {
     }
 }
 
+/// Cundall's non-viscous local damping of a nodal force `f` (N) at nodal
+/// velocity `v` (m/s): f_i − α |f_i| sign(v_i) per component, sign(0) = 0
+/// (WGSL's `sign`). It opposes the motion by a share of the unbalanced
+/// force, whatever the frequency, and vanishes at equilibrium (f = 0) and
+/// at rest (v = 0).
+#[inline]
+pub fn local_damping(f: [f64; 2], v: [f64; 2], alpha: f64) -> [f64; 2] {
+    let sign = |x: f64| {
+        if x > 0.0 {
+            1.0
+        } else if x < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    [
+        f[0] - alpha * f[0].abs() * sign(v[0]),
+        f[1] - alpha * f[1].abs() * sign(v[1]),
+    ]
+}
+
 /// Per node, the contact weight S_I = Σ_p N_Ip over the particles in
 /// contact with a wall (`wall_penetration` > 0; a particle in contact
-/// with two walls counts twice). `touch` is zeroed first (its GPU twin is
-/// zeroed by `clear_grid`).
+/// with two walls counts twice). Only the walls that act in the step
+/// starting at `t` (s) count (`Wall::active_at`), so a removed gate, or
+/// one not there yet, is nowhere in contact. `touch` is zeroed first (its
+/// GPU twin is zeroed by `clear_grid`).
 pub fn wall_touch(
     cache: &ShapeCache,
     x: &[[f64; 2]],
     mass: &[f64],
     rho: &[f64],
     walls: &Walls,
+    t: f64,
     touch: &mut [f64],
 ) {
     touch.fill(0.0);
@@ -55,7 +87,7 @@ pub fn wall_touch(
         let count = walls
             .list
             .iter()
-            .filter(|w| wall_penetration(x[p], lp, w) > 0.0)
+            .filter(|w| w.active_at(t) && wall_penetration(x[p], lp, w) > 0.0)
             .count();
         if count == 0 {
             continue;
@@ -76,7 +108,8 @@ pub fn wall_touch(
 /// corrected one without the walls, Σ N (v_I + γΔt f_I / m_I), and the
 /// tangential force that stops it is −v_t / w with
 /// w = γΔt Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
-/// contact pull on the same nodes).
+/// contact pull on the same nodes). Only the walls that act in the step
+/// starting at `t` (s) push (`Wall::active_at`).
 #[allow(clippy::too_many_arguments)]
 pub fn wall_contact(
     cache: &ShapeCache,
@@ -86,6 +119,7 @@ pub fn wall_contact(
     mv: &[[f64; 3]],
     force: &[[f64; 2]],
     walls: &Walls,
+    t: f64,
     touch: &[f64],
     wall_force: &mut [[f64; 2]],
     wall_r: &mut [[f64; 2]],
@@ -99,6 +133,9 @@ pub fn wall_contact(
     for p in 0..x.len() {
         let lp = half_width(mass[p], rho[p]);
         for (k, wl) in walls.list.iter().enumerate() {
+            if !wl.active_at(t) {
+                continue;
+            }
             let pen = wall_penetration(x[p], lp, wl);
             if pen <= 0.0 {
                 continue;
@@ -189,7 +226,8 @@ pub fn predict(mv: &mut [[f64; 3]], fix: &[u8], groups: &[ConstraintGroup], t: f
 /// (the force the support exerts, −f_I on each fixed component), zeroes
 /// those components, then corrects the velocities by `gamma_dt` · f/m.
 /// `reactions` holds the constraint groups' (the walls' are
-/// `wall_contact`'s).
+/// `wall_contact`'s). `damping` is Cundall's α (`local_damping`; 0 leaves
+/// the force as it is).
 #[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
@@ -199,6 +237,7 @@ pub fn correct(
     wall_force: &[[f64; 2]],
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
+    damping: f64,
     mass_eps: f64,
 ) {
     if !wall_force.is_empty() {
@@ -230,6 +269,9 @@ pub fn correct(
         .for_each(|((n, f), &fx)| {
             zero_fixed(f, fx);
             if n[0] > mass_eps {
+                if damping > 0.0 {
+                    *f = local_damping(*f, [n[1], n[2]], damping);
+                }
                 n[1] += gamma_dt * f[0] / n[0];
                 n[2] += gamma_dt * f[1] / n[0];
             }
@@ -247,6 +289,20 @@ mod tests {
     /// particle's domain is 0.1 m wide (m / ρ = 0.01). Returns the wall's
     /// force on the material (N per unit thickness).
     fn contact(x: [f64; 2], v: [f64; 2], law: u32, mu: f64) -> [f64; 2] {
+        contact_at(x, v, law, mu, 0.0, f64::INFINITY, 0.0)
+    }
+
+    /// `contact` against a gate there for `appear_at` ≤ t < `remove_at`,
+    /// at time `t` (s).
+    fn contact_at(
+        x: [f64; 2],
+        v: [f64; 2],
+        law: u32,
+        mu: f64,
+        appear_at: f64,
+        remove_at: f64,
+        t: f64,
+    ) -> [f64; 2] {
         let wall = Wall {
             name: "w".into(),
             point: [0.0, 0.0],
@@ -256,6 +312,8 @@ mod tests {
             nodes: Vec::new(),
             stiffness: 1e6,
             offset: 0.0,
+            appear_at,
+            remove_at,
         };
         let walls = Walls {
             list: vec![wall],
@@ -266,7 +324,7 @@ mod tests {
         cache.w[0] = [1.0, 0.0, 0.0];
         let (xs, mass, rho) = ([x], [10.0], [1000.0]);
         let mut touch = [0.0];
-        wall_touch(&cache, &xs, &mass, &rho, &walls, &mut touch);
+        wall_touch(&cache, &xs, &mass, &rho, &walls, t, &mut touch);
         let mv = [[2.0, v[0], v[1]]];
         let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
         wall_contact(
@@ -277,6 +335,7 @@ mod tests {
             &mv,
             &[[0.0; 2]],
             &walls,
+            t,
             &touch,
             &mut wf,
             &mut r,
@@ -314,5 +373,24 @@ mod tests {
         assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
         let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_SLIP, 0.0);
         assert_eq!(f[0], 0.0);
+    }
+
+    #[test]
+    fn gates_push_only_between_their_times() {
+        // Pressed 0.01 m into a gate there for 0.1 <= t < 0.5 s.
+        let at = |t| contact_at([0.3, 0.04], [0.0, 0.0], CONTACT_SLIP, 0.0, 0.1, 0.5, t);
+        assert_eq!(at(0.0), [0.0, 0.0]);
+        assert!((at(0.1)[1] - 1e3).abs() < 1e-9);
+        assert!((at(0.4999)[1] - 1e3).abs() < 1e-9);
+        assert_eq!(at(0.5), [0.0, 0.0]);
+    }
+
+    #[test]
+    fn local_damping_opposes_motion() {
+        // α = 0.5: a force along the motion loses half, one against it
+        // grows by half; no motion, no change.
+        assert_eq!(local_damping([2.0, -2.0], [1.0, 1.0], 0.5), [1.0, -3.0]);
+        assert_eq!(local_damping([2.0, -2.0], [0.0, 0.0], 0.5), [2.0, -2.0]);
+        assert_eq!(local_damping([2.0, 0.0], [-1.0, 3.0], 0.5), [3.0, 0.0]);
     }
 }

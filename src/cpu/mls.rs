@@ -26,7 +26,7 @@
 //! Particles are binned by grid cell each step (a counting sort) to find
 //! those within 3h. GPU twin: `shaders/mls_*.wgsl`.
 
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::gauss::{breaks, gauss_point};

@@ -14,6 +14,7 @@ pub mod p2g;
 pub mod remap;
 pub mod scatter;
 pub mod shape_eval;
+pub mod stage_inputs;
 pub mod stress;
 
 use crate::backend::{Backend, Halt, Sample, State, stop_requested};
@@ -22,36 +23,9 @@ use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
 use crate::step::{CpuWork, Stage, StepPlan};
 use scatter::Scatter;
+pub use stage_inputs::ShapeCache;
+pub(crate) use stage_inputs::body_force;
 use std::sync::atomic::AtomicBool;
-
-/// N and ∇N of every particle for the current step: `stride` slots per
-/// particle, `count[p]` of them used.
-#[derive(Debug, Clone)]
-pub struct ShapeCache {
-    pub stride: usize,
-    pub count: Vec<u16>,
-    pub nodes: Vec<u32>,
-    /// [N, ∂N/∂x, ∂N/∂y] per slot.
-    pub w: Vec<[f64; 3]>,
-}
-
-impl ShapeCache {
-    pub fn new(particles: usize, stride: usize) -> Self {
-        ShapeCache {
-            stride,
-            count: vec![0; particles],
-            nodes: vec![0; particles * stride],
-            w: vec![[0.0; 3]; particles * stride],
-        }
-    }
-
-    /// The nodes and weights of particle `p`.
-    #[inline]
-    pub fn particle(&self, p: usize) -> (&[u32], &[[f64; 3]]) {
-        let (o, n) = (p * self.stride, self.count[p] as usize);
-        (&self.nodes[o..o + n], &self.w[o..o + n])
-    }
-}
 
 /// Runs a `Model` on the CPU.
 pub struct CpuBackend {
@@ -326,6 +300,7 @@ impl CpuBackend {
                         &p.mass,
                         &p.rho,
                         &m.walls,
+                        self.t,
                         &mut self.wall_touch,
                     );
                 }
@@ -383,6 +358,7 @@ impl CpuBackend {
                         &self.mv,
                         &self.force,
                         &m.walls,
+                        self.t,
                         &self.wall_touch,
                         &mut self.wall_force,
                         wall_r,
@@ -398,6 +374,7 @@ impl CpuBackend {
                     &self.wall_force,
                     group_r,
                     gamma * self.dt,
+                    m.local_damping,
                     self.mass_eps,
                 )
             }
@@ -407,6 +384,7 @@ impl CpuBackend {
                     integrator: m.integrator,
                     mass_eps: self.mass_eps,
                     edge_margin: m.shape.edge_margin(),
+                    pic_fraction: m.pic_fraction,
                 };
                 g2p::g2p(
                     &self.cache,
@@ -441,33 +419,6 @@ impl CpuBackend {
             }
         }
         Ok(())
-    }
-}
-
-/// Body force per unit mass on particle `i` at time `t` (m/s²): gravity
-/// with its ramp, plus a manufactured solution's load at the particle's
-/// reference position, plus the particle's share of the tractions and
-/// point loads divided by its mass (the stages multiply by m_p again).
-pub(crate) fn body_force<'a>(
-    gravity: Option<crate::model::Gravity>,
-    mms: &'a Option<crate::model::AlignedVibration>,
-    ext: &'a Option<crate::model::ExternalForces>,
-    x0: &'a [[f64; 2]],
-    mass: &'a [f64],
-    t: f64,
-) -> impl Fn(usize) -> [f64; 2] + Sync + 'a {
-    let g = gravity.map_or([0.0; 2], |g| g.at(t));
-    move |i: usize| {
-        let mut b = g;
-        if let Some(s) = mms {
-            let s = s.body_force(x0[i], t);
-            b = [b[0] + s[0], b[1] + s[1]];
-        }
-        if let Some(e) = ext {
-            let f = e.at(i, t);
-            b = [b[0] + f[0] / mass[i], b[1] + f[1] / mass[i]];
-        }
-        b
     }
 }
 

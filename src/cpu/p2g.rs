@@ -3,7 +3,7 @@
 //! NPC: q_I = Σ N m_p (v_p + (1 − γ) Δt a_p) (paper eq. 27, the stable form).
 //! GPU twin: `shaders/p2g.wgsl`.
 
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 
 /// `a` is empty for FE; `a_factor` = (1 − γ) Δt for NPC.
 pub fn p2g(

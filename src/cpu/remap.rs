@@ -6,7 +6,7 @@
 //! `grid_update::predict` then divides by the mass and applies the walls
 //! and Dirichlet conditions (eq. 33). GPU twin: `shaders/remap.wgsl`.
 
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 
 /// Zeroes the nodal momentum of `mv`, keeping the masses (the first step
 /// of the remap on both paths; GPU twin: `remap.wgsl` built with `CLEAR`).

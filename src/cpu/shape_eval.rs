@@ -5,7 +5,7 @@
 //! inline in each GPU pass.
 
 use super::p2g::{add_particle, particle_velocity};
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::Shape;

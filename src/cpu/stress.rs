@@ -8,7 +8,7 @@
 //! GPU twin: `shaders/stress.wgsl`.
 
 use super::forces::add_particle_forces;
-use super::{ShapeCache, scatter::Scatter};
+use super::{scatter::Scatter, stage_inputs::ShapeCache};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::{Material, PlasticState};
 use rayon::iter::Either;

@@ -4,11 +4,11 @@
 //! below is the one place binding numbers are defined: WGSL files write
 //! `@binding({{B_X0}})`, the preprocessor fills in the number.
 
-use super::GpuOptions;
 use super::context::GpuContext;
 use super::layout::{
     GPU_PARAM_SLOTS, GpuConstraint, GpuMaterial, GpuWall, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
 };
+use super::options::GpuOptions;
 use crate::error::{Error, Result, SceneError};
 use crate::model::material::Material;
 use crate::model::shape::Shape;
@@ -340,6 +340,13 @@ fn grid_and_output_data(
                 contact: w.contact,
                 stiffness: w.stiffness as f32,
                 offset: w.offset as f32,
+                appear_at: w.appear_at as f32,
+                // A finite "never" (WGSL may assume no infinities).
+                remove_at: if w.remove_at.is_finite() {
+                    w.remove_at as f32
+                } else {
+                    f32::MAX
+                },
             })
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));

@@ -47,8 +47,8 @@ pub struct Params {
     pub mls_spans_y: u32,
     pub mls_break_off: f32,
     pub mls_weight_scale: f32,
-    pub _pad_p0: u32,
-    pub _pad_p1: u32,
+    pub pic_fraction: f32,
+    pub local_damping: f32,
     pub _pad_p2: u32,
 }
 const _: () = assert!(std::mem::size_of::<Params>() == 176);
@@ -111,7 +111,8 @@ const _: () = assert!(std::mem::size_of::<GpuConstraint>() == 32);
 
 /// A wall (shaders/shared/types.wgsl `Wall`): its line through `point`
 /// (m, grid-relative), unit normal into the material, contact code
-/// (`model::walls::CONTACT_*`) and μ.
+/// (`model::walls::CONTACT_*`) and μ; it acts for `appear_at` ≤ t <
+/// `remove_at` (s; `f32::MAX` for never removed).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuWall {
@@ -123,8 +124,10 @@ pub struct GpuWall {
     pub stiffness: f32,
     /// Contact line's offset (m, `Wall::offset`).
     pub offset: f32,
+    pub appear_at: f32,
+    pub remove_at: f32,
 }
-const _: () = assert!(std::mem::size_of::<GpuWall>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuWall>() == 40);
 
 /// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
 pub const NODE_STRIDE: usize = 5;

@@ -9,6 +9,7 @@
 pub mod buffers;
 pub mod context;
 pub mod layout;
+pub mod options;
 pub mod pipelines;
 pub mod preprocess;
 
@@ -21,6 +22,7 @@ use crate::model::{Integrator, Model, Particles};
 use buffers::{Buf, Buffers};
 use context::{AtomicMode, GpuContext};
 use layout::*;
+pub use options::GpuOptions;
 use pipelines::{Pass, Pipelines};
 use std::sync::atomic::AtomicBool;
 
@@ -34,55 +36,6 @@ const MAX_BATCH: u64 = 512;
 /// Checked to converge in ≤ 8 iterations for γ 0.8–10 on regular and
 /// perturbed grids of 1M particles (the CPU's f64 Newton uses 1e-10 h).
 pub const LME_TOL_F32: f64 = 2e-6;
-
-/// Choices of the GPU path that are not part of the scene.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct GpuOptions {
-    /// LME: store N and ∇N per particle and search-box slot in `lme_newton`
-    /// instead of recomputing them from (λ, log Z, J⁻¹) in each pass. Off by
-    /// default: docs/performance.md has the measurement that decided it.
-    pub lme_stored: bool,
-    /// `p2g` and `forces` as node-centred gathers over particles binned by
-    /// cell (`Some(true)`) or as particle-centred scatters with float
-    /// atomics (`Some(false)`); `None` picks what measured faster
-    /// (docs/performance.md): the gather for linear shapes on a regular
-    /// grid, the scatter for the rest, whose wider stencils make each
-    /// node visit more particles and evaluate each one's shape anew.
-    /// MUSL and MLS always scatter.
-    pub gather: Option<bool>,
-    /// `p2g` and `forces` scattered per bin of particles that share their
-    /// stencil (`Some(true)`: one invocation per bin sums its particles in
-    /// registers, then one atomic per node of the stencil) or per particle
-    /// (`Some(false)`); `None` picks what measured faster
-    /// (docs/performance.md): per bin for B-splines and LME. Only linear
-    /// shapes and B-splines on a regular grid and LME on any grid, where
-    /// they do not gather, without MLS or MUSL.
-    pub patch: Option<bool>,
-}
-
-impl GpuOptions {
-    /// Whether `p2g` and `forces` gather (`pipelines::Variant::gather`).
-    pub fn gathers(&self, model: &Model) -> bool {
-        let auto = matches!(model.shape, Shape::Linear) && !model.grid.is_perturbed();
-        self.gather.unwrap_or(auto) && !model.mls && model.integrator != Integrator::Musl
-    }
-
-    /// Whether `p2g` and `forces` scatter per bin (`pipelines::Variant::patch`).
-    pub fn patches(&self, model: &Model) -> bool {
-        // A bin's particles share their stencil: for linear shapes and
-        // B-splines its cell on a regular grid; for LME its search box, a
-        // box of logical node indices on any grid.
-        let shares = match model.shape {
-            Shape::Lme(_) => true,
-            Shape::Linear | Shape::Bspline(_) => !model.grid.is_perturbed(),
-            Shape::Ugimp(_) => false,
-        };
-        let fits =
-            shares && !model.mls && model.integrator != Integrator::Musl && !self.gathers(model);
-        let auto = matches!(model.shape, Shape::Bspline(_) | Shape::Lme(_));
-        self.patch.unwrap_or(auto) && fits
-    }
-}
 
 /// Runs a `Model` on a GPU adapter.
 pub struct GpuBackend {
@@ -474,8 +427,8 @@ pub fn params(model: &Model) -> Params {
         mls_spans_y: mls_spans[1],
         mls_break_off,
         mls_weight_scale: (1.5 / model.mls_support) as f32,
-        _pad_p0: 0,
-        _pad_p1: 0,
+        pic_fraction: model.pic_fraction as f32,
+        local_damping: model.local_damping as f32,
         _pad_p2: 0,
     }
 }

@@ -76,6 +76,14 @@ pub struct Variant {
     pub mls: bool,
     /// Rigid walls (the `Walls`, `WallTouch` and `WallForce` buffers).
     pub walls: bool,
+    /// Some wall appears or goes during the run (GATES: `wall_touch`
+    /// compares the step's time with the wall's `appear_at`/`remove_at`).
+    pub gates: bool,
+    /// `solver.pic_fraction` > 0 (PIC: `g2p` blends Σ N v_I in).
+    pub pic: bool,
+    /// `solver.local_damping` > 0 (LOCAL_DAMPING: `grid_update` built
+    /// with `CORRECT` damps the nodal force).
+    pub local_damping: bool,
     /// Tractions or point loads (the `ExtForce` buffer).
     pub ext_force: bool,
     /// `p2g` and `forces` as node-centred gathers over particles binned by
@@ -94,7 +102,7 @@ pub struct Variant {
 }
 
 impl Variant {
-    pub fn of(model: &Model, atomics: AtomicMode, opts: &super::GpuOptions) -> Variant {
+    pub fn of(model: &Model, atomics: AtomicMode, opts: &super::options::GpuOptions) -> Variant {
         Variant {
             materials: model
                 .materials
@@ -112,6 +120,9 @@ impl Variant {
             mms: model.manufactured.is_some(),
             mls: model.mls,
             walls: !model.walls.is_empty(),
+            gates: model.walls.timed(),
+            pic: model.pic_fraction > 0.0,
+            local_damping: model.local_damping > 0.0,
             ext_force: model.external.is_some(),
             gather: opts.gathers(model),
             patch: opts.patches(model),
@@ -160,6 +171,9 @@ impl Variant {
             .flag("MMS", self.mms)
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
+            .flag("GATES", self.gates)
+            .flag("PIC", self.pic)
+            .flag("LOCAL_DAMPING", self.local_damping)
             .flag("EXT_FORCE", self.ext_force)
             .flag("ANCHOR_BINS", self.gather || self.patch)
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
@@ -325,7 +339,7 @@ impl Pipelines {
         ctx: &GpuContext,
         model: &Model,
         buffers: &Buffers,
-        opts: &super::GpuOptions,
+        opts: &super::options::GpuOptions,
     ) -> Result<Pipelines> {
         let variant = Variant::of(model, ctx.atomics, opts);
         let plan = variant.plan();
@@ -522,6 +536,9 @@ mod tests {
                                 mms,
                                 mls: false,
                                 walls: mms,
+                                gates: mms,
+                                pic: mms,
+                                local_damping: mms,
                                 ext_force: mms,
                                 gather: false,
                                 bspline_small_grid: perturbed,

@@ -149,6 +149,12 @@ pub struct Model {
     pub mls: bool,
     /// MLS weight support half-width (cells, `solver.mls_support`).
     pub mls_support: f64,
+    /// Share α of PIC in the particle velocity update (`solver.pic_fraction`,
+    /// 0 = FLIP; explicit integrators, `g2p`).
+    pub pic_fraction: f64,
+    /// Cundall's local damping α (`solver.local_damping`, 0 = none;
+    /// explicit integrators, `grid_update::correct`).
+    pub local_damping: f64,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
@@ -266,6 +272,8 @@ impl Model {
             fixed_dt: f.solver.dt,
             mls: f.solver.mls,
             mls_support: f.solver.mls_support,
+            pic_fraction: f.solver.pic_fraction,
+            local_damping: f.solver.local_damping,
             probes,
             manufactured,
         })

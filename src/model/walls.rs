@@ -60,6 +60,18 @@ pub struct Wall {
     /// start (the deepest): contact is measured from there, so a body
     /// seeded against the wall starts unloaded (`Walls::set_contact`).
     pub offset: f64,
+    /// The wall acts for `appear_at` ≤ t < `remove_at` (s), t the step's
+    /// start; 0 and +∞ for a wall that is always there.
+    pub appear_at: f64,
+    pub remove_at: f64,
+}
+
+impl Wall {
+    /// Whether the wall acts in the step that starts at `t` (s).
+    #[inline]
+    pub fn active_at(&self, t: f64) -> bool {
+        self.appear_at <= t && t < self.remove_at
+    }
 }
 
 /// The scene's walls, and per node the bit set of the walls it is behind
@@ -81,11 +93,18 @@ impl Walls {
     /// and the offset of each wall: how deep the deepest particle's domain
     /// reaches past its line at the start (`Wall::offset`), less the
     /// penetration that carries the initial compression of the particles
-    /// there (a geostatic body's weight on its floor).
+    /// there (a geostatic body's weight on its floor). A wall that appears
+    /// later (`appear_at` > 0) keeps offset 0: the seeding says nothing of
+    /// where the body will be when it appears.
     pub fn set_contact(&mut self, p_wave_modulus: f64, h: f64, particles: &Particles) {
         for w in &mut self.list {
             w.stiffness = WALL_PENALTY * p_wave_modulus / h;
             w.offset = 0.0;
+            // A gate that appears later meets the body where it is then,
+            // not where it was seeded: its line is its contact line.
+            if w.appear_at > 0.0 {
+                continue;
+            }
             let pens: Vec<(f64, f64)> = (0..particles.len())
                 .map(|p| {
                     let lp = half_width(particles.mass[p], particles.rho[p]);
@@ -109,6 +128,13 @@ impl Walls {
                 .fold(f64::INFINITY, f64::min);
             w.offset = deepest - if preload.is_finite() { preload } else { 0.0 };
         }
+    }
+
+    /// Whether some wall appears or goes during the run (a gate).
+    pub fn timed(&self) -> bool {
+        self.list
+            .iter()
+            .any(|w| w.appear_at > 0.0 || w.remove_at.is_finite())
     }
 
     /// Walls of `scene` on `grid`. A wall with no node behind it is an
@@ -165,6 +191,8 @@ impl Walls {
                 nodes,
                 stiffness: 0.0,
                 offset: 0.0,
+                appear_at: w.appear_at,
+                remove_at: w.remove_at.unwrap_or(f64::INFINITY),
             });
         }
         Ok(Walls { list, mask })

@@ -14,19 +14,6 @@ pub use schema::*;
 use crate::error::SceneError;
 use std::path::Path;
 
-/// A checked scene. Fields are the schema's, with defaults resolved.
-#[derive(Debug, Clone)]
-pub struct Scene {
-    /// Output folder name (file stem unless `name` is set).
-    pub name: String,
-    /// The file after overrides and defaults (echoed into `summary.json`).
-    pub file: SceneFile,
-    /// `grid.margin`, resolved (m).
-    pub margin: f64,
-    /// `output.sample_interval`, resolved (s).
-    pub sample_interval: f64,
-}
-
 impl Scene {
     /// Reads `path`, applies `overrides` in order, and checks the result.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
@@ -65,37 +52,6 @@ impl Scene {
                 .map_err(|e: toml::de::Error| parse_err(e.to_string()))?
         };
         validate::check(file, default_name)
-    }
-
-    pub fn solver(&self) -> &SolverSpec {
-        &self.file.solver
-    }
-
-    /// Bodies in a fixed order (by name); a particle's `body` indexes this.
-    pub fn bodies(&self) -> impl Iterator<Item = (&String, &BodySpec)> {
-        self.file.bodies.iter()
-    }
-
-    /// Materials in a fixed order (by name).
-    pub fn materials(&self) -> impl Iterator<Item = (&String, &MaterialSpec)> {
-        self.file.materials.iter()
-    }
-
-    /// Index of a material by name in `materials()` order.
-    pub fn material_index(&self, name: &str) -> usize {
-        self.file
-            .materials
-            .keys()
-            .position(|k| k == name)
-            .expect("validated: every body names an existing material")
-    }
-
-    /// Particle layout of a body, resolving the shape-dependent default.
-    pub fn layout(&self, body: &BodySpec) -> Layout {
-        body.layout.unwrap_or(match self.file.solver.shape {
-            ShapeKind::Ugimp => Layout::Uniform,
-            _ => Layout::Gauss,
-        })
     }
 }
 

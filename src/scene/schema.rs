@@ -257,6 +257,12 @@ pub struct WallSpec {
     pub contact: Contact,
     /// Coulomb friction coefficient μ ≥ 0, only with `contact = "friction"`.
     pub friction: Option<f64>,
+    /// Time the wall starts to act (s), ≥ 0. Default 0 (from the start).
+    #[serde(default)]
+    pub appear_at: f64,
+    /// Time the wall stops acting (s), > `appear_at` (a gate). Default:
+    /// never.
+    pub remove_at: Option<f64>,
 }
 
 /// A traction on a segment of a body's boundary (dead load).
@@ -445,6 +451,16 @@ pub struct SolverSpec {
     /// r = Δx/(2h); in [1.5, 3].
     #[serde(default = "default_mls_support")]
     pub mls_support: f64,
+    /// Share α of PIC in the particle velocity update, in [0, 1]:
+    /// v_p ← (1 − α) v_FLIP + α v_PIC (explicit integrators). Default 0
+    /// (pure FLIP).
+    #[serde(default)]
+    pub pic_fraction: f64,
+    /// Cundall's non-viscous local damping α, in [0, 1): each component of
+    /// the unbalanced nodal force loses α |f| sign(v) (explicit
+    /// integrators). Default 0 (none).
+    #[serde(default)]
+    pub local_damping: f64,
 }
 
 fn default_mls_support() -> f64 {
@@ -575,4 +591,50 @@ pub struct ManufacturedSpec {
     pub solution: ManufacturedKind,
     /// Displacement amplitude A (m), below L/(2π) so that det F stays positive.
     pub amplitude: f64,
+}
+
+/// A checked scene. Fields are the schema's, with defaults resolved.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Output folder name (file stem unless `name` is set).
+    pub name: String,
+    /// The file after overrides and defaults (echoed into `summary.json`).
+    pub file: SceneFile,
+    /// `grid.margin`, resolved (m).
+    pub margin: f64,
+    /// `output.sample_interval`, resolved (s).
+    pub sample_interval: f64,
+}
+
+impl Scene {
+    pub fn solver(&self) -> &SolverSpec {
+        &self.file.solver
+    }
+
+    /// Bodies in a fixed order (by name); a particle's `body` indexes this.
+    pub fn bodies(&self) -> impl Iterator<Item = (&String, &BodySpec)> {
+        self.file.bodies.iter()
+    }
+
+    /// Materials in a fixed order (by name).
+    pub fn materials(&self) -> impl Iterator<Item = (&String, &MaterialSpec)> {
+        self.file.materials.iter()
+    }
+
+    /// Index of a material by name in `materials()` order.
+    pub fn material_index(&self, name: &str) -> usize {
+        self.file
+            .materials
+            .keys()
+            .position(|k| k == name)
+            .expect("validated: every body names an existing material")
+    }
+
+    /// Particle layout of a body, resolving the shape-dependent default.
+    pub fn layout(&self, body: &BodySpec) -> Layout {
+        body.layout.unwrap_or(match self.file.solver.shape {
+            ShapeKind::Ugimp => Layout::Uniform,
+            _ => Layout::Gauss,
+        })
+    }
 }

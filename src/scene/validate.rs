@@ -137,6 +137,46 @@ fn check_solver(file: &SceneFile) -> Result<(), SceneError> {
             format!("must be in (0, 1e-2], got {}", s.lme_tol),
         ));
     }
+    check_dissipation(s)
+}
+
+/// `solver.pic_fraction` in [0, 1] and `solver.local_damping` in [0, 1),
+/// both explicit only (the implicit step has no FLIP update and no
+/// unbalanced nodal force to damp).
+fn check_dissipation(s: &SolverSpec) -> Result<(), SceneError> {
+    finite("solver.pic_fraction", s.pic_fraction)?;
+    if !(0.0..=1.0).contains(&s.pic_fraction) {
+        return Err(SceneError::invalid(
+            "solver.pic_fraction",
+            format!(
+                "must be in [0, 1] (0 = FLIP, 1 = PIC), got {}",
+                s.pic_fraction
+            ),
+        ));
+    }
+    finite("solver.local_damping", s.local_damping)?;
+    if !(s.local_damping >= 0.0 && s.local_damping < 1.0) {
+        return Err(SceneError::invalid(
+            "solver.local_damping",
+            format!(
+                "must be in [0, 1) (1 would remove every unbalanced force), got {}",
+                s.local_damping
+            ),
+        ));
+    }
+    if s.integrator == IntegratorKind::Implicit {
+        for (key, v) in [
+            ("solver.pic_fraction", s.pic_fraction),
+            ("solver.local_damping", s.local_damping),
+        ] {
+            if v != 0.0 {
+                return Err(SceneError::invalid(
+                    key,
+                    "is read by the explicit integrators only (fe, npc, musl); drop it with integrator = \"implicit\"",
+                ));
+            }
+        }
+    }
     Ok(())
 }
 
@@ -552,6 +592,52 @@ fn check_walls(file: &SceneFile) -> Result<(), SceneError> {
                 ));
             }
             (_, None) => {}
+        }
+        check_gate(file, &key, w)?;
+    }
+    Ok(())
+}
+
+/// A wall's `appear_at` and `remove_at` (s): finite, ≥ 0, and the wall
+/// acts for appear_at ≤ t < remove_at, so appear_at < remove_at. The
+/// implicit step holds its walls' contact states through Newton and does
+/// not read them.
+fn check_gate(file: &SceneFile, key: &str, w: &WallSpec) -> Result<(), SceneError> {
+    let timed = w.appear_at != 0.0 || w.remove_at.is_some();
+    if timed && file.solver.integrator == IntegratorKind::Implicit {
+        let k = if w.remove_at.is_some() {
+            "remove_at"
+        } else {
+            "appear_at"
+        };
+        return Err(SceneError::invalid(
+            format!("{key}.{k}"),
+            "is read by the explicit integrators only (fe, npc, musl)",
+        ));
+    }
+    finite(&format!("{key}.appear_at"), w.appear_at)?;
+    if w.appear_at < 0.0 {
+        return Err(SceneError::invalid(
+            format!("{key}.appear_at"),
+            format!("must be >= 0 (s), got {}", w.appear_at),
+        ));
+    }
+    if let Some(r) = w.remove_at {
+        finite(&format!("{key}.remove_at"), r)?;
+        if r < 0.0 {
+            return Err(SceneError::invalid(
+                format!("{key}.remove_at"),
+                format!("must be >= 0 (s), got {r}"),
+            ));
+        }
+        if w.appear_at >= r {
+            return Err(SceneError::invalid(
+                format!("{key}.appear_at"),
+                format!(
+                    "must be below remove_at ({r} s): the wall acts for appear_at <= t < remove_at, got {}",
+                    w.appear_at
+                ),
+            ));
         }
     }
     Ok(())

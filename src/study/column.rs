@@ -4,7 +4,8 @@
 //! and 2.0 s, run-out and final height with their change between meshes;
 //! and the cohesionless variant against the experimental run-out scaling of
 //! 2D granular collapses, (L_f − L_0)/L_0 ≈ 1.2 H/W (Lajeunesse et al.
-//! 2005; Lube et al. 2005).
+//! 2005; Lube et al. 2005): released from geostatic rest by a gate, for
+//! a = 0.5, 1 and 2, with pure FLIP and with 1 % PIC.
 
 use super::runner::{Job, JobResult};
 use super::{Method, backend_slug, image, sig, table};
@@ -34,6 +35,20 @@ pub const MESHES: [f64; 2] = [0.05, 0.025];
 pub const COLUMN: (f64, f64) = (2.0, 4.0);
 /// Cohesionless column: width and height (m), from `cases/granular_collapse.toml`.
 pub const GRANULAR: (f64, f64) = (1.0, 2.0);
+
+/// Aspect ratios a = H/W of the cohesionless runs (W = 1 m, H = a W):
+/// the experiments' 1.2 a scaling holds below about 3.
+pub const GRANULAR_ASPECTS: [f64; 3] = [0.5, 1.0, 2.0];
+
+/// Shares of PIC the cohesionless runs take: pure FLIP (the solver's
+/// default) and the case's 1 %.
+pub const GRANULAR_PIC: [f64; 2] = [0.0, 0.01];
+
+/// Cell size of the cohesionless runs (m): twice the case's 0.025 m keeps
+/// the 24 runs to minutes; at a = 2 with 1 % PIC, bspline2 gives a run-out
+/// ratio of 2.70 here and 2.97 at 0.025 m (docs/methods.md, "Granular
+/// collapse").
+pub const GRANULAR_H: f64 = 0.05;
 
 /// Particles per cell per direction in both cases.
 const PPC: f64 = 2.0;
@@ -73,18 +88,31 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
             continue;
         }
         for m in METHODS {
-            let mut j = Job::new(
-                format!("{}-granular-{}", backend_slug(b), m.0),
-                GRANULAR_COLLAPSE,
-                "granular_collapse",
-            )
-            .set("output.vtk_interval=1e9")
-            .on(b)
-            .tag("case", "granular")
-            .method(m)
-            .tag("h", 0.025);
-            j.keep_final = true;
-            out.push(j);
+            for a in GRANULAR_ASPECTS {
+                for pic in GRANULAR_PIC {
+                    let mut j = Job::new(
+                        format!("{}-granular-{}-a{a}-pic{pic}", backend_slug(b), m.0),
+                        GRANULAR_COLLAPSE,
+                        "granular_collapse",
+                    )
+                    .set("output.vtk_interval=1e9")
+                    .set(format!("grid.h={GRANULAR_H}"))
+                    .set(format!(
+                        "bodies.column.rects=[[0.0, 0.0, {}, {}]]",
+                        GRANULAR.0,
+                        a * GRANULAR.0
+                    ))
+                    .set(format!("solver.pic_fraction={pic}"))
+                    .on(b)
+                    .tag("case", "granular")
+                    .method(m)
+                    .tag("a", a)
+                    .tag("pic", pic)
+                    .tag("h", GRANULAR_H);
+                    j.keep_final = true;
+                    out.push(j);
+                }
+            }
         }
     }
     out
@@ -159,17 +187,13 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             .filter(|r| r.job.tag_value("case") == Some(case))
             .collect()
     };
-    let cohesive = mine("cohesive");
-    let granular = mine("granular");
-    let get = |m: &str, h: f64| {
-        cohesive.iter().copied().find(|r| {
-            r.job.tag_value("method") == Some(m)
-                && r.job.tag_value("h") == Some(h.to_string().as_str())
-        })
+    let cohesive = Cohesive {
+        runs: mine("cohesive"),
+        meshes: if quick { &MESHES[..1] } else { &MESHES },
+        times: if quick { &TIMES[..1] } else { &TIMES },
+        main: main.clone(),
     };
-    let meshes: &[f64] = if quick { &MESHES[..1] } else { &MESHES };
-    let times: &[f64] = if quick { &TIMES[..1] } else { &TIMES };
-    let mut charts = Vec::new();
+    let granular = mine("granular");
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -182,116 +206,164 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
          least one cell thick) and final height, and how much they move between meshes.\n",
         COLUMN.0, COLUMN.1
     );
-
-    // --- profiles, one chart per time -----------------------------------------
-    for &t in times {
-        // No dot in the stem: the chart writer sets the extension.
-        let stem = format!("study-column-profile-{:.0}ms", t * 1e3);
-        let mut c = LineChart::new(
-            format!("Column collapse ({main}): free surface at t = {t:.2} s"),
-            "x (m)",
-            "y (m)",
-        );
-        for (k, (m, ..)) in METHODS.iter().enumerate() {
-            for (mi, &h) in meshes.iter().enumerate() {
-                let Some(p) = get(m, h).and_then(|r| at(r, t)) else {
-                    continue;
-                };
-                let s = Series::line(format!("{m}, h = {h}"), profile(p, h), k);
-                c.series.push(if mi == 0 { s.dashed() } else { s });
-            }
-        }
-        c.legend = plotters::prelude::SeriesLabelPosition::UpperRight;
-        c.size = (800, 440);
-        c.save(&dir.join(&stem))?;
-        charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
-        md.push_str(&image(
-            &format!("free surface at {t:.2} s"),
-            &format!("{stem}.png"),
-        ));
+    let mut charts = cohesive.profiles(dir, &mut md)?;
+    charts.extend(cohesive.plastic_strain(dir, &mut md)?);
+    cohesive.run_out_table(&mut md);
+    cohesive.findings(&mut md);
+    if !granular.is_empty() {
+        granular_report(&mut md, &granular);
     }
-    md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+    Ok((md, charts))
+}
 
-    // --- equivalent plastic strain, LME on the finest mesh -------------------
-    let h_fine = meshes[meshes.len() - 1];
-    if let Some(r) = get("lme-g1.8", h_fine) {
-        let panels: Vec<Panel> = times
-            .iter()
-            .filter_map(|&t| {
-                let p = at(r, t)?;
-                Some(Panel {
-                    title: format!("t = {t:.2} s"),
-                    points: (0..p.len())
-                        .map(|i| (p.x[i][0], p.x[i][1], p.plastic.get(i).map_or(0.0, |q| q[1])))
-                        .collect(),
-                    size: h_fine / PPC,
-                })
-            })
-            .collect();
-        if !panels.is_empty() {
-            let stem = "study-column-plastic-strain";
-            ParticleImage {
-                title: format!("Column, LME γ = 1.8, h = {h_fine} m: ε̄p"),
-                value_label: "ε̄p".into(),
-                cols: panels.len().min(2),
-                panels,
-                range: (0.0, 1.0),
-                panel_size: (420, 260),
-            }
-            .save(&dir.join(stem))?;
-            charts.push(dir.join(format!("{stem}.png")));
-            md.push_str(&image("equivalent plastic strain", &format!("{stem}.png")));
-            md.push_str("\nColour scale clamped at ε̄p = 1.\n\n");
-        }
+/// The cohesive column's runs and what its report shows of them.
+struct Cohesive<'a> {
+    runs: Vec<&'a JobResult>,
+    meshes: &'static [f64],
+    times: &'static [f64],
+    /// The backend the report is about.
+    main: String,
+}
+
+impl Cohesive<'_> {
+    /// The run of method `m` at cell size `h`.
+    fn get(&self, m: &str, h: f64) -> Option<&JobResult> {
+        self.runs.iter().copied().find(|r| {
+            r.job.tag_value("method") == Some(m)
+                && r.job.tag_value("h") == Some(h.to_string().as_str())
+        })
     }
 
-    // --- run-out and height table ----------------------------------------------
-    let t_last = times[times.len() - 1];
-    let mut header: Vec<String> = vec!["method".into()];
-    for &h in meshes {
-        header.push(format!("h = {h}: status"));
-        header.push(format!("run-out at {t_last} s (m)"));
-        header.push(format!("height at {t_last} s (m)"));
-    }
-    if meshes.len() == 2 {
-        header.push("run-out change".into());
-        header.push("height change".into());
-    }
-    let mut rows = Vec::new();
-    for (m, ..) in METHODS {
-        let mut row = vec![m.to_string()];
-        let mut figs = Vec::new();
-        for &h in meshes {
-            match get(m, h) {
-                Some(r) if r.completed() => {
-                    let p = at(r, t_last);
-                    let (ro, ht) =
-                        p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
-                    row.extend(["completed".into(), sig(ro), sig(ht)]);
-                    figs.push((ro, ht));
+    /// The free surface at each time, every method on both meshes.
+    fn profiles(&self, dir: &Path, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
+        for &t in self.times {
+            // No dot in the stem: the chart writer sets the extension.
+            let stem = format!("study-column-profile-{:.0}ms", t * 1e3);
+            let mut c = LineChart::new(
+                format!(
+                    "Column collapse ({}): free surface at t = {t:.2} s",
+                    self.main
+                ),
+                "x (m)",
+                "y (m)",
+            );
+            for (k, (m, ..)) in METHODS.iter().enumerate() {
+                for (mi, &h) in self.meshes.iter().enumerate() {
+                    let Some(p) = self.get(m, h).and_then(|r| at(r, t)) else {
+                        continue;
+                    };
+                    let s = Series::line(format!("{m}, h = {h}"), profile(p, h), k);
+                    c.series.push(if mi == 0 { s.dashed() } else { s });
                 }
-                Some(r) => row.extend([super::failure_text(r), "-".into(), "-".into()]),
-                None => row.extend(["-".into(), "-".into(), "-".into()]),
             }
+            c.legend = plotters::prelude::SeriesLabelPosition::UpperRight;
+            c.size = (800, 440);
+            c.save(&dir.join(&stem))?;
+            charts.extend([format!("{stem}.png"), format!("{stem}.svg")].map(|f| dir.join(f)));
+            md.push_str(&image(
+                &format!("free surface at {t:.2} s"),
+                &format!("{stem}.png"),
+            ));
         }
-        if meshes.len() == 2 {
-            if let [(r1, h1), (r2, h2)] = figs[..] {
-                row.push(format!("{:+.1} %", 100.0 * (r2 - r1) / r1));
-                row.push(format!("{:+.1} %", 100.0 * (h2 - h1) / h1));
-            } else {
-                row.extend(["-".into(), "-".into()]);
-            }
-        }
-        rows.push(row);
+        md.push_str("\nDashed: mesh 1 (h = 0.05 m); solid: mesh 2 (h = 0.025 m).\n\n");
+        Ok(charts)
     }
-    md.push_str(&table(&header, &rows));
-    md.push('\n');
-    if meshes.len() == 2 {
+
+    /// ε̄p of LME γ = 1.8 on the finest mesh, one panel per time.
+    fn plastic_strain(&self, dir: &Path, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
+        let h_fine = self.meshes[self.meshes.len() - 1];
+        if let Some(r) = self.get("lme-g1.8", h_fine) {
+            let panels: Vec<Panel> = self
+                .times
+                .iter()
+                .filter_map(|&t| {
+                    let p = at(r, t)?;
+                    Some(Panel {
+                        title: format!("t = {t:.2} s"),
+                        points: (0..p.len())
+                            .map(|i| (p.x[i][0], p.x[i][1], p.plastic.get(i).map_or(0.0, |q| q[1])))
+                            .collect(),
+                        size: h_fine / PPC,
+                    })
+                })
+                .collect();
+            if !panels.is_empty() {
+                let stem = "study-column-plastic-strain";
+                ParticleImage {
+                    title: format!("Column, LME γ = 1.8, h = {h_fine} m: ε̄p"),
+                    value_label: "ε̄p".into(),
+                    cols: panels.len().min(2),
+                    panels,
+                    range: (0.0, 1.0),
+                    panel_size: (420, 260),
+                }
+                .save(&dir.join(stem))?;
+                charts.push(dir.join(format!("{stem}.png")));
+                md.push_str(&image("equivalent plastic strain", &format!("{stem}.png")));
+                md.push_str("\nColour scale clamped at ε̄p = 1.\n\n");
+            }
+        }
+        Ok(charts)
+    }
+
+    /// Run-out and height per method and mesh, and their change between
+    /// meshes.
+    fn run_out_table(&self, md: &mut String) {
+        let t_last = self.times[self.times.len() - 1];
+        let mut header: Vec<String> = vec!["method".into()];
+        for &h in self.meshes {
+            header.push(format!("h = {h}: status"));
+            header.push(format!("run-out at {t_last} s (m)"));
+            header.push(format!("height at {t_last} s (m)"));
+        }
+        if self.meshes.len() == 2 {
+            header.push("run-out change".into());
+            header.push("height change".into());
+        }
+        let mut rows = Vec::new();
+        for (m, ..) in METHODS {
+            let mut row = vec![m.to_string()];
+            let mut figs = Vec::new();
+            for &h in self.meshes {
+                match self.get(m, h) {
+                    Some(r) if r.completed() => {
+                        let p = at(r, t_last);
+                        let (ro, ht) =
+                            p.map_or((f64::NAN, f64::NAN), |p| (run_out(p, h), height(p, h)));
+                        row.extend(["completed".into(), sig(ro), sig(ht)]);
+                        figs.push((ro, ht));
+                    }
+                    Some(r) => row.extend([super::failure_text(r), "-".into(), "-".into()]),
+                    None => row.extend(["-".into(), "-".into(), "-".into()]),
+                }
+            }
+            if self.meshes.len() == 2 {
+                if let [(r1, h1), (r2, h2)] = figs[..] {
+                    row.push(format!("{:+.1} %", 100.0 * (r2 - r1) / r1));
+                    row.push(format!("{:+.1} %", 100.0 * (h2 - h1) / h1));
+                } else {
+                    row.extend(["-".into(), "-".into()]);
+                }
+            }
+            rows.push(row);
+        }
+        md.push_str(&table(&header, &rows));
+        md.push('\n');
+    }
+
+    /// The largest change between meshes and the spread between shapes.
+    fn findings(&self, md: &mut String) {
+        let t_last = self.times[self.times.len() - 1];
+        if self.meshes.len() != 2 {
+            return;
+        }
         let mut changes = (0.0f64, 0.0f64);
         let mut fine = Vec::new();
         for (m, ..) in METHODS {
             let fig = |h: f64| {
-                let r = get(m, h).filter(|r| r.completed())?;
+                let r = self.get(m, h).filter(|r| r.completed())?;
                 let p = at(r, t_last)?;
                 Some((run_out(p, h), height(p, h)))
             };
@@ -323,95 +395,117 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             );
         }
     }
+}
 
-    // --- cohesionless variant ----------------------------------------------------
-    if !granular.is_empty() {
-        let (w, hgt) = GRANULAR;
-        let a = hgt / w;
-        let _ = writeln!(
-            md,
-            "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
-             sits at the apex), φ = 30°, a = H/W = {}, h = 0.025 m, t_end = 2 s. Experiments on 2D \
-             collapses give (L_f − L_0)/L_0 ≈ 1.2 a = {} for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. \
-             2005), with L_0 = W the initial length and L_f the front of the deposit where it is at \
-             least one cell thick (the furthest particle is listed too).\n",
-            sig(a),
-            sig(1.2 * a)
-        );
-        let header: Vec<String> = [
-            "method",
-            "status",
-            "L_f (m)",
-            "furthest particle (m)",
-            "(L_f − L_0)/L_0",
-            "vs 1.2 a",
-            "final height (m)",
-            "kinetic energy at end / m g H",
-        ]
-        .map(String::from)
-        .to_vec();
-        let rows: Vec<Vec<String>> = granular
-            .iter()
-            .map(|r| {
-                let m = r.job.tag_value("method").unwrap_or("").to_string();
-                let p = r.data().and_then(|d| d.final_particles.as_ref());
-                match p {
-                    Some(p) if r.completed() => {
-                        let lf = run_out(p, 0.025);
-                        let ratio = (lf - w) / w;
-                        let mass: f64 = p.mass.iter().sum();
-                        let ke: f64 = (0..p.len())
-                            .map(|i| 0.5 * p.mass[i] * (p.v[i][0].powi(2) + p.v[i][1].powi(2)))
-                            .sum();
-                        vec![
-                            m,
-                            "completed".into(),
-                            sig(lf),
-                            sig(front(p, 0.025)),
-                            sig(ratio),
-                            format!("{:+.0} %", 100.0 * (ratio / (1.2 * a) - 1.0)),
-                            sig(height(p, 0.025)),
-                            sig(ke / (mass * 9.81 * hgt)),
-                        ]
+/// The cohesionless variant's table: per method, aspect ratio and PIC
+/// share, the run-out ratio against the experiments' 1.2 a.
+fn granular_report(md: &mut String, granular: &[&JobResult]) {
+    let w = GRANULAR.0;
+    let h = GRANULAR_H;
+    let _ = writeln!(
+        md,
+        "\n**Cohesionless variant** (`cases/granular_collapse.toml`): c = 10 Pa (the tension cut-off \
+         sits at the apex), φ = 30°, ψ = 0, a column W = {} m wide and H = a W high at geostatic rest \
+         (K0 = 1 − sin φ) between a smooth back wall and a smooth gate, on a rough (`stick`) floor; \
+         the gate is lifted at 0.05 s; h = {} m, t_end = 2 s. Experiments on 2D collapses give \
+         (L_f − L_0)/L_0 ≈ 1.2 a for a ≲ 3 (Lajeunesse et al. 2005; Lube et al. 2005), with \
+         L_0 = W and L_f the front of the deposit where it is at least one cell thick. Each run is \
+         made with pure FLIP (`pic_fraction = 0`, the solver's default) and with the case's 1 % \
+         of PIC; the acceptance is within 25 % of 1.2 a.\n",
+        sig(w),
+        sig(h)
+    );
+    let header: Vec<String> = [
+        "method",
+        "a",
+        "pic_fraction",
+        "status",
+        "L_f (m)",
+        "(L_f − L_0)/L_0",
+        "1.2 a",
+        "off by",
+        "final height (m)",
+        "kinetic energy at end / m g H",
+        "least density (kg/m³)",
+    ]
+    .map(String::from)
+    .to_vec();
+    let mut within = [0usize; 2];
+    let mut counted = [0usize; 2];
+    let mut spread = [(f64::INFINITY, f64::NEG_INFINITY); 2];
+    let rows: Vec<Vec<String>> = granular
+        .iter()
+        .map(|r| {
+            let m = r.job.tag_value("method").unwrap_or("").to_string();
+            let a: f64 = r
+                .job
+                .tag_value("a")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.0);
+            let pic: f64 = r
+                .job
+                .tag_value("pic")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.0);
+            let k = usize::from(pic > 0.0);
+            let p = r.data().and_then(|d| d.final_particles.as_ref());
+            match p {
+                Some(p) if r.completed() => {
+                    let lf = run_out(p, h);
+                    let ratio = (lf - w) / w;
+                    let off = ratio / (1.2 * a) - 1.0;
+                    counted[k] += 1;
+                    if off.abs() <= 0.25 {
+                        within[k] += 1;
                     }
-                    _ => vec![
+                    spread[k] = (spread[k].0.min(off), spread[k].1.max(off));
+                    let mass: f64 = p.mass.iter().sum();
+                    let ke: f64 = (0..p.len())
+                        .map(|i| 0.5 * p.mass[i] * (p.v[i][0].powi(2) + p.v[i][1].powi(2)))
+                        .sum();
+                    let rho_min = p.rho.iter().copied().fold(f64::INFINITY, f64::min);
+                    vec![
                         m,
-                        super::failure_text(r),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                    ],
+                        sig(a),
+                        sig(pic),
+                        "completed".into(),
+                        sig(lf),
+                        sig(ratio),
+                        sig(1.2 * a),
+                        format!("{:+.0} %", 100.0 * off),
+                        sig(height(p, h)),
+                        sig(ke / (mass * 9.81 * a * w)),
+                        sig(rho_min),
+                    ]
                 }
-            })
-            .collect();
-        md.push_str(&table(&header, &rows));
-        md.push('\n');
-        let ratios: Vec<f64> = granular
-            .iter()
-            .filter(|r| r.completed())
-            .filter_map(|r| r.data()?.final_particles.as_ref())
-            .map(|p| (run_out(p, 0.025) - w) / w)
-            .collect();
-        if !ratios.is_empty() {
-            let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let _ = writeln!(
-                md,
-                "**Findings.** The simulated deposits run further than the experiments: \
-                 (L_f − L_0)/L_0 = {}–{} against 1.2 a = {}. We have not found why. A Coulomb floor \
-                 with μ = tan φ instead of the stick floor changes little, and associated flow (ψ = φ) \
-                 runs out further still (both tried on mesh 1 with linear shapes). Candidates not yet \
-                 tested: a rate-independent Mohr–Coulomb law has no collisional dissipation, which the \
-                 μ(I) rheology that fits these experiments adds; the fast thin front's particles dilate \
-                 (their density falls, see methods.md) and stop resisting shear.\n",
-                sig(lo),
-                sig(hi),
-                sig(1.2 * a)
-            );
-        }
-    }
-    Ok((md, charts))
+                _ => {
+                    let mut row = vec![m, sig(a), sig(pic), super::failure_text(r)];
+                    row.extend(std::iter::repeat_n("-".to_string(), 7));
+                    row
+                }
+            }
+        })
+        .collect();
+    md.push_str(&table(&header, &rows));
+    md.push('\n');
+    let pct = |v: f64| format!("{:+.0} %", 100.0 * v);
+    let _ = writeln!(
+        md,
+        "**Findings.** Pure FLIP: {} of {} runs within 25 % of 1.2 a (off by {} to {}); with 1 % \
+         PIC: {} of {} (off by {} to {}). With FLIP the deposit never comes to rest (its kinetic \
+         energy at 2 s is orders of magnitude above the PIC runs') and its particles spread apart \
+         (the least density falls far below the initial 1850 kg/m³): the velocity noise FLIP keeps \
+         (the part of the particles' velocities the grid does not see, which nothing damps) keeps \
+         the frictional material shearing, so it creeps on after it should have stopped. A share \
+         of PIC damps that noise; see docs/methods.md (\"Granular collapse: why FLIP runs out too \
+         far\") for the test that shows it and for what was tried.\n",
+        within[0],
+        counted[0],
+        pct(spread[0].0),
+        pct(spread[0].1),
+        within[1],
+        counted[1],
+        pct(spread[1].0),
+        pct(spread[1].1),
+    );
 }

@@ -403,7 +403,6 @@ impl Report<'_> {
 
     /// The cantilever: table, mesh convergence, error against wall time.
     fn cantilever(&self, md: &mut String) -> Result<Vec<PathBuf>> {
-        let mut charts = Vec::new();
         let _ = writeln!(
             md,
             "### Cantilever\n\nThe static cantilever (`cases/cantilever.toml`, Neo-Hookean, 2 × 2 particles per cell) \
@@ -452,8 +451,15 @@ impl Report<'_> {
         }
         md.push_str(&table(&header, &rows));
         md.push('\n');
+        let mut charts = self.cantilever_mesh(md)?;
+        charts.extend(self.cantilever_cost(md)?);
+        Ok(charts)
+    }
 
-        // --- mesh convergence --------------------------------------------------
+    /// The cantilever's mesh convergence: error and self-convergence
+    /// against h, fitted and pairwise orders, Richardson limits.
+    fn cantilever_mesh(&self, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
         let pct = |r: &JobResult| cantilever_error(r).map(|e| 100.0 * e);
         let mut curves = Vec::new();
         for (scheme, dashed) in [("implicit", false), ("explicit", true)] {
@@ -569,8 +575,13 @@ impl Report<'_> {
                 explicit.join("; ")
             );
         }
+        Ok(charts)
+    }
 
-        // --- error against wall time -------------------------------------------------
+    /// The cantilever's error against wall time, implicit and explicit,
+    /// with the Pareto front and the cost ratio at the finest common h.
+    fn cantilever_cost(&self, md: &mut String) -> Result<Vec<PathBuf>> {
+        let mut charts = Vec::new();
         let mut curves = Vec::new();
         for (scheme, dashed) in [("implicit", false), ("explicit", true)] {
             for (k, (m, _)) in SHAPES.iter().enumerate() {

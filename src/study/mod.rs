@@ -10,8 +10,14 @@ pub mod dyka;
 pub mod implicit;
 pub mod mms;
 pub mod plate;
+pub mod results;
 pub mod runner;
 pub mod stability;
+
+pub use results::{
+    Method, backend_slug, backends_of, failure_text, find_tagged, image, main_backend, on_backend,
+    sig, table, tag_values,
+};
 
 use crate::error::{Error, Result};
 use crate::simulation::BackendChoice;
@@ -121,57 +127,6 @@ pub fn backends(b: StudyBackend) -> Vec<BackendChoice> {
     }
 }
 
-pub use runner::{Method, backend_slug};
-
-/// The backends the study's runs used, in order of first appearance.
-pub fn backends_of(results: &[runner::JobResult]) -> Vec<&str> {
-    tag_values(results, "backend")
-}
-
-/// The values of tag `key` among `results`, in order of first appearance.
-pub fn tag_values<'a>(
-    results: impl IntoIterator<Item = &'a runner::JobResult>,
-    key: &str,
-) -> Vec<&'a str> {
-    let mut v: Vec<&str> = Vec::new();
-    for value in results.into_iter().filter_map(|r| r.job.tag_value(key)) {
-        if !v.contains(&value) {
-            v.push(value);
-        }
-    }
-    v
-}
-
-/// The backend a study's report is about: its first job's ("cpu" if none).
-pub fn main_backend(results: &[runner::JobResult]) -> String {
-    results
-        .first()
-        .and_then(|r| r.job.tag_value("backend"))
-        .unwrap_or("cpu")
-        .to_string()
-}
-
-/// The first result whose job carries every one of these (tag, value) pairs.
-pub fn find_tagged<'a>(
-    results: &'a [runner::JobResult],
-    tags: &[(&str, &str)],
-) -> Option<&'a runner::JobResult> {
-    results
-        .iter()
-        .find(|r| tags.iter().all(|&(k, v)| r.job.tag_value(k) == Some(v)))
-}
-
-/// The results of the jobs run on `backend`, in job order.
-pub fn on_backend<'a>(
-    results: &'a [runner::JobResult],
-    backend: &str,
-) -> Vec<&'a runner::JobResult> {
-    results
-        .iter()
-        .filter(|r| r.job.tag_value("backend") == Some(backend))
-        .collect()
-}
-
 /// Runs one study (or all) and writes its outputs.
 pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
     let names = match name {
@@ -261,12 +216,4 @@ fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Resu
         crate::bench::machine()
     );
     crate::docgen::replace_section(doc, &format!("study-{}", n.slug()), &(stamp + markdown))
-}
-
-pub use crate::sweep::report::{image, sig, table};
-
-/// Short text for how a run ended (`unstable at 1.2e-5 s (left_grid)`),
-/// the same words as a sweep's table.
-pub fn failure_text(r: &runner::JobResult) -> String {
-    Record::from_job(r).status_text()
 }

@@ -135,7 +135,6 @@ pub fn departure(a: &Particles, b: &Particles) -> f64 {
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let main = super::main_backend(results);
     let hh = h(quick);
-    let mut charts = Vec::new();
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -145,12 +144,28 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         sig(hh),
         if quick { " Quick sweep: h = 2 m." } else { "" }
     );
+    let (mut charts, vmax) = fe_against_npc(results, &main, hh, dir, &mut md)?;
+    charts.extend(regular_against_perturbed(
+        results, &main, hh, vmax, dir, &mut md,
+    )?);
+    Ok((md, charts))
+}
 
-    // --- FE against NPC images ----------------------------------------------
+/// FE against NPC (paper Fig. 14): LME's speed images at the snapshot
+/// times and the intra-cell scatter; returns the charts and the largest
+/// speed, which the next image shares as its colour range.
+fn fe_against_npc(
+    results: &[JobResult],
+    main: &str,
+    hh: f64,
+    dir: &Path,
+    md: &mut String,
+) -> Result<(Vec<PathBuf>, f64)> {
+    let mut charts = Vec::new();
     let mut panels = Vec::new();
     let mut scatter_rows = Vec::new();
     for integ in ["npc", "fe"] {
-        let Some(d) = find(results, &main, "lme", integ, "regular").and_then(|r| r.data()) else {
+        let Some(d) = find(results, main, "lme", integ, "regular").and_then(|r| r.data()) else {
             continue;
         };
         let mut row = vec![integ.to_uppercase()];
@@ -194,13 +209,25 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             table(&header, &scatter_rows)
         );
     }
+    Ok((charts, vmax))
+}
 
-    // --- regular against perturbed -----------------------------------------------
+/// Regular against perturbed grids (paper Fig. 15): speed images and the
+/// RMS departure of the same particles, per shape.
+fn regular_against_perturbed(
+    results: &[JobResult],
+    main: &str,
+    hh: f64,
+    vmax: f64,
+    dir: &Path,
+    md: &mut String,
+) -> Result<Vec<PathBuf>> {
+    let mut charts = Vec::new();
     let mut panels = Vec::new();
     let mut rows = Vec::new();
     for (shape, name) in [("lme", "LME γ = 3"), ("ugimp", "uGIMP"), ("linear", "Q4")] {
-        let reg = find(results, &main, shape, "npc", "regular");
-        let per = find(results, &main, shape, "npc", "perturbed");
+        let reg = find(results, main, shape, "npc", "regular");
+        let per = find(results, main, shape, "npc", "perturbed");
         for (r, grid) in [(reg, "regular"), (per, "perturbed")] {
             match r
                 .and_then(|r| r.data())
@@ -283,5 +310,5 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
             sig(u)
         );
     }
-    Ok((md, charts))
+    Ok(charts)
 }

@@ -149,6 +149,8 @@ mod tests {
             nodes: Vec::new(),
             stiffness: 0.0,
             offset: 0.0,
+            appear_at: 0.0,
+            remove_at: f64::INFINITY,
         }
     }
 

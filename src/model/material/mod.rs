@@ -10,10 +10,10 @@
 pub mod increment;
 pub mod plastic;
 pub mod registry;
+pub mod state;
 
-pub use neo_hookean::DefGrad;
-pub use plastic::PlasticState;
 pub use registry::{Constitutive, Entry, Key, Keys, StateKind};
+pub use state::{DefGrad, PlasticState};
 
 use crate::error::SceneError;
 use crate::model::fault::FaultKind;

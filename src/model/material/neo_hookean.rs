@@ -21,8 +21,7 @@ pub struct NeoHookean {
     pub shear: f64,
 }
 
-/// F as [xx, xy, yx, yy].
-pub type DefGrad = [f64; 4];
+pub use super::state::DefGrad;
 
 impl NeoHookean {
     pub fn new(youngs: f64, nu: f64, density: f64) -> Self {

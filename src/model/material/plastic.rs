@@ -4,15 +4,7 @@
 //! WGSL twin: the helpers at the top of `shaders/shared/material.wgsl`
 //! (`jaumann_trial`, `plastic_increment`, `elastic_energy_3d`).
 
-/// Per-particle state of a plastic model:
-/// `[σzz (Pa), ε̄p, εp_v, return]`:
-/// - σzz: out-of-plane stress (plane strain: εzz = 0, but after yielding
-///   σzz ≠ ν(σxx + σyy), so it is carried);
-/// - ε̄p: accumulated equivalent plastic strain, Σ sqrt(2/3 Δεp : Δεp);
-/// - εp_v: accumulated volumetric plastic strain, Σ tr Δεp (dilation > 0);
-/// - return: the surfaces active in the last step's return as a bit mask
-///   (`ACTIVE_*`; 0 = the step was elastic), stored as a float.
-pub type PlasticState = [f64; 4];
+pub use super::state::PlasticState;
 
 /// Index of each entry of `PlasticState`.
 pub const SZZ: usize = 0;
@@ -288,7 +280,7 @@ pub fn yield_keys(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::material::LinearElastic;
+    use crate::model::material::linear_elastic::LinearElastic;
 
     #[test]
     fn energy_matches_plane_strain_linear_elastic() {
