@@ -9,6 +9,9 @@
 #if WALLS
 @group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<f32>;
 @group(0) @binding({{B_WALL_FORCE}}) var<storage, read_write> wall_force: array<f32>;
+#if WALL_PRELOAD
+@group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read_write> wall_pre_force: array<f32>;
+#endif
 #endif
 
 @compute @workgroup_size(256)
@@ -31,5 +34,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     wall_touch[n] = 0.0;
     wall_force[2u * n] = 0.0;
     wall_force[2u * n + 1u] = 0.0;
+#if WALL_PRELOAD
+    wall_pre_force[2u * n] = 0.0;
+    wall_pre_force[2u * n + 1u] = 0.0;
+#endif
 #endif
 }

@@ -131,6 +131,10 @@ fn variants() -> Vec<Variant> {
                                         // Gates, the PIC blend and local damping
                                         // where the walls are.
                                         gates: atomics == AtomicMode::CompareExchange && !mls,
+                                        // The walls' preload (a geostatic body
+                                        // against them) where the walls are.
+                                        wall_preload: atomics == AtomicMode::CompareExchange
+                                            && !mls,
                                         pic: atomics == AtomicMode::CompareExchange && !mls,
                                         local_damping: atomics == AtomicMode::CompareExchange
                                             && !mls,

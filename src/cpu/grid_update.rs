@@ -27,7 +27,8 @@
 
 use super::stage_inputs::ShapeCache;
 use crate::model::walls::{
-    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, wall_penetration,
+    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, preload_force, wall_depth,
+    wall_penetration,
 };
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Walls};
 use rayon::prelude::*;
@@ -66,88 +67,178 @@ pub fn local_damping(f: [f64; 2], v: [f64; 2], alpha: f64) -> [f64; 2] {
     ]
 }
 
+/// The contact's normal spring force (N per unit thickness) of particle
+/// `p` on wall `k` before damping: the penalty k pen 2 l_p (pen from
+/// `wall_penetration`, negative once the domain is clear of the contact
+/// line) plus the particle's preload (`preload_force`, zero unless it
+/// started flush and compressed against the wall), and that preload.
+/// The particle is in contact while the sum is positive.
+#[inline]
+fn contact_spring(p: usize, k: usize, pt: &ContactParticles, walls: &Walls) -> (f64, f64) {
+    let w = &walls.list[k];
+    let lp = half_width(pt.mass[p], pt.rho[p]);
+    let pre = preload_force(
+        walls.preload_of(p, k),
+        pt.stress[p],
+        w.normal,
+        lp,
+        pt.mass[p],
+        pt.gravity,
+        wall_depth(pt.x[p], lp, w),
+    );
+    (
+        w.stiffness * wall_penetration(pt.x[p], lp, w) * 2.0 * lp + pre,
+        pre,
+    )
+}
+
+/// What the contact reads of the particles: positions (m), masses (kg
+/// per unit thickness), densities (kg/m³), stresses (Pa, for the
+/// preload) and the scene's full gravity (m/s², zero without).
+pub struct ContactParticles<'a> {
+    pub x: &'a [[f64; 2]],
+    pub mass: &'a [f64],
+    pub rho: &'a [f64],
+    pub stress: &'a [[f64; 3]],
+    pub v: &'a [[f64; 2]],
+    pub gravity: [f64; 2],
+}
+
 /// Per node, the contact weight S_I = Σ_p N_Ip over the particles in
-/// contact with a wall (`wall_penetration` > 0; a particle in contact
+/// contact with a wall (`contact_spring` > 0; a particle in contact
 /// with two walls counts twice). Only the walls that act in the step
 /// starting at `t` (s) count (`Wall::active_at`), so a removed gate, or
-/// one not there yet, is nowhere in contact. `touch` is zeroed first (its
-/// GPU twin is zeroed by `clear_grid`).
+/// one not there yet, is nowhere in contact. With preloads
+/// (`Walls::preload`; `pre_force` is empty without), each contact's
+/// preload P n onto the nodes at the wall's line (`face_weight`), into
+/// `pre_force`: the load the walls carry whatever the body does, which
+/// `wall_contact` counts in the body's velocity before it decides the
+/// rest (else a stick floor's friction at a corner would also take up
+/// the side wall's preload). `touch` and `pre_force` are zeroed first
+/// (their GPU twins by `clear_grid`).
 pub fn wall_touch(
     cache: &ShapeCache,
-    x: &[[f64; 2]],
-    mass: &[f64],
-    rho: &[f64],
+    pt: &ContactParticles,
     walls: &Walls,
     t: f64,
     touch: &mut [f64],
+    pre_force: &mut [[f64; 2]],
 ) {
     touch.fill(0.0);
-    for p in 0..x.len() {
-        let lp = half_width(mass[p], rho[p]);
-        let count = walls
-            .list
-            .iter()
-            .filter(|w| w.active_at(t) && wall_penetration(x[p], lp, w) > 0.0)
-            .count();
+    pre_force.fill([0.0; 2]);
+    for p in 0..pt.x.len() {
+        let (nodes, w) = cache.particle(p);
+        let mut count = 0;
+        for (k, wl) in walls.list.iter().enumerate() {
+            if !wl.active_at(t) {
+                continue;
+            }
+            let (spring, pre) = contact_spring(p, k, pt, walls);
+            if spring <= 0.0 {
+                continue;
+            }
+            count += 1;
+            if pre > 0.0 {
+                let d = wall_depth(pt.x[p], half_width(pt.mass[p], pt.rho[p]), wl);
+                for (&n, wk) in nodes.iter().zip(w) {
+                    let f = pre * face_weight(wk, wl.normal, d);
+                    pre_force[n as usize][0] += f * wl.normal[0];
+                    pre_force[n as usize][1] += f * wl.normal[1];
+                }
+            }
+        }
         if count == 0 {
             continue;
         }
-        let (nodes, w) = cache.particle(p);
         for (&n, wk) in nodes.iter().zip(w) {
             touch[n as usize] += count as f64 * wk[0];
         }
     }
 }
 
+/// The weight of a node at the wall's line, from the particle's [N, ∇N]
+/// `wk` and the distance `d` (m, `wall_depth`) from its centre to the
+/// line along the normal `n`: N − d n·∇N, first order in d (exact for
+/// linear shapes while the line is in the particle's cell). They sum to
+/// one, as N does.
+#[inline]
+fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
+    wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
+}
+
 /// The walls' forces at their contact points: every particle in contact
-/// with a wall gets a normal force F_n = k pen 2 l_p (penalty) and a
-/// tangential force that stops the slip of the body's velocity at the
-/// particle (stick), capped by μ F_n (friction), or none (slip); the force
-/// goes to the particle's nodes with its weights, into `wall_force`, and
-/// to the wall's reaction. The body's velocity at the particle is the
-/// corrected one without the walls, Σ N (v_I + γΔt f_I / m_I), and the
-/// tangential force that stops it is −v_t / w with
-/// w = γΔt Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
-/// contact pull on the same nodes). Only the walls that act in the step
-/// starting at `t` (s) push (`Wall::active_at`).
+/// with a wall gets a normal force F_n = k pen 2 l_p (penalty) plus its
+/// preload (`contact_spring`), less a damping of its approach, and a
+/// tangential force that stops the particle's slip (stick), capped by
+/// μ F_n (friction), or none (slip); the force goes to the particle's
+/// nodes with its weights, into `wall_force`, and to the wall's reaction.
+/// The damping reads the body's velocity at the particle, corrected
+/// without the walls, Σ N (v_I + γΔt f_I / m_I); the friction the
+/// particle's next velocity without the walls, v_p + `slip_dt` Σ N f_I /
+/// m_I (its slip, v_t, is what must stop: a particle that the nodes' PIC
+/// velocity holds still can still creep by its own), and the tangential
+/// force that stops it is −v_t / w with
+/// w = `slip_dt` Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
+/// contact pull on the same nodes; `slip_dt` the time over which the
+/// particles feel a nodal force, (2 − γ)Δt for NPC, Δt for FE and MUSL),
+/// and the damping's w is the same with γΔt (`gamma_dt`). With preloads,
+/// the body's velocity counts the walls' preloads (`pre_force`, from
+/// `wall_touch`). Only the walls that act in the step
+/// starting at `t` (s) push (`Wall::active_at`). The preload's share of
+/// F_n acts where the wall's traction does, on the wall's line, at
+/// x_p − d n (d from `wall_depth`):
+/// it goes to the nodes with N_I − d n·∇N_I (the weights there, to first
+/// order; exact for linear shapes across the wall's row of cells), so a
+/// geostatic body's boundary nodes get the load their own forces lack,
+/// not a share of it spread a cell into the body.
 #[allow(clippy::too_many_arguments)]
 pub fn wall_contact(
     cache: &ShapeCache,
-    x: &[[f64; 2]],
-    mass: &[f64],
-    rho: &[f64],
+    pt: &ContactParticles,
     mv: &[[f64; 3]],
     force: &[[f64; 2]],
     walls: &Walls,
     t: f64,
     touch: &[f64],
+    pre_force: &[[f64; 2]],
     wall_force: &mut [[f64; 2]],
     wall_r: &mut [[f64; 2]],
     gamma_dt: f64,
+    slip_dt: f64,
     mass_eps: f64,
 ) {
     wall_force.fill([0.0; 2]);
     for r in wall_r.iter_mut() {
         *r = [0.0; 2];
     }
-    for p in 0..x.len() {
-        let lp = half_width(mass[p], rho[p]);
+    for p in 0..pt.x.len() {
+        let lp = half_width(pt.mass[p], pt.rho[p]);
         for (k, wl) in walls.list.iter().enumerate() {
             if !wl.active_at(t) {
                 continue;
             }
-            let pen = wall_penetration(x[p], lp, wl);
-            if pen <= 0.0 {
+            let (spring, pre) = contact_spring(p, k, pt, walls);
+            if spring <= 0.0 {
                 continue;
             }
             let (nodes, wt) = cache.particle(p);
+            // v: the body's corrected velocity at the particle (for the
+            // damping); vp: the particle's own next velocity (for the
+            // friction); both without the walls' contact forces, with
+            // their preloads.
             let (mut v, mut w) = ([0.0; 2], 0.0);
+            let mut vp = pt.v[p];
             for (&n, wk) in nodes.iter().zip(wt) {
                 let node = &mv[n as usize];
                 if node[0] > mass_eps {
-                    let f = force[n as usize];
+                    let mut f = force[n as usize];
+                    if let Some(pf) = pre_force.get(n as usize) {
+                        f = [f[0] + pf[0], f[1] + pf[1]];
+                    }
                     v[0] += wk[0] * (node[1] + gamma_dt * f[0] / node[0]);
                     v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
+                    vp[0] += wk[0] * slip_dt * f[0] / node[0];
+                    vp[1] += wk[0] * slip_dt * f[1] / node[0];
                     w += wk[0] * touch[n as usize] / node[0];
                 }
             }
@@ -157,15 +248,23 @@ pub fn wall_contact(
             w *= gamma_dt;
             let nrm = wl.normal;
             let vn = v[0] * nrm[0] + v[1] * nrm[1];
-            let fnorm = (wl.stiffness * pen * 2.0 * lp - WALL_DAMPING * vn / w).max(0.0);
-            let vt = [v[0] - vn * nrm[0], v[1] - vn * nrm[1]];
+            let fnorm = (spring - WALL_DAMPING * vn / w).max(0.0);
+            let vpn = vp[0] * nrm[0] + vp[1] * nrm[1];
+            let vt = [vp[0] - vpn * nrm[0], vp[1] - vpn * nrm[1]];
             let mu = match wl.contact {
                 CONTACT_STICK => STICK_MU,
                 CONTACT_FRICTION => wl.mu,
                 _ => 0.0,
             };
-            // Coulomb: the force that stops the slip, at most μ F_n.
-            let mut ft = [-vt[0] / w, -vt[1] / w];
+            // Coulomb: the force that stops the particle's slip, at most
+            // μ F_n. The particle feels it over `slip_dt` (NPC: Δt in v_p
+            // and (1 − γ)Δt more in the next predictor), so that is the
+            // step it is sized for. Sized on the corrected nodal velocity
+            // over γΔt instead, the stick loop's gain was (2 − γ)/γ = 3 and
+            // a slip grew (the geostatic column's bottom row: from 1e-16
+            // to 1 m/s in 100 steps).
+            let ws = w / gamma_dt * slip_dt;
+            let mut ft = [-vt[0] / ws, -vt[1] / ws];
             let mag = ft[0].hypot(ft[1]);
             let cap = mu * fnorm;
             if mag > cap {
@@ -174,10 +273,16 @@ pub fn wall_contact(
             let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
             wall_r[k][0] += fw[0];
             wall_r[k][1] += fw[1];
+            // The preload's share at the wall's line, the rest at the
+            // particle.
+            let f_pre = pre.min(fnorm);
+            let f_at = [fw[0] - f_pre * nrm[0], fw[1] - f_pre * nrm[1]];
+            let d = wall_depth(pt.x[p], lp, wl);
             for (&n, wk) in nodes.iter().zip(wt) {
+                let face = f_pre * face_weight(wk, nrm, d);
                 let o = &mut wall_force[n as usize];
-                o[0] += wk[0] * fw[0];
-                o[1] += wk[0] * fw[1];
+                o[0] += wk[0] * f_at[0] + face * nrm[0];
+                o[1] += wk[0] * f_at[1] + face * nrm[1];
             }
         }
     }
@@ -318,27 +423,36 @@ mod tests {
         let walls = Walls {
             list: vec![wall],
             mask: vec![1],
+            preload: Vec::new(),
         };
         let mut cache = ShapeCache::new(1, 1);
         cache.count[0] = 1;
         cache.w[0] = [1.0, 0.0, 0.0];
         let (xs, mass, rho) = ([x], [10.0], [1000.0]);
+        let pt = ContactParticles {
+            x: &xs,
+            mass: &mass,
+            rho: &rho,
+            stress: &[[0.0; 3]],
+            v: &[v],
+            gravity: [0.0; 2],
+        };
         let mut touch = [0.0];
-        wall_touch(&cache, &xs, &mass, &rho, &walls, t, &mut touch);
+        wall_touch(&cache, &pt, &walls, t, &mut touch, &mut []);
         let mv = [[2.0, v[0], v[1]]];
         let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
         wall_contact(
             &cache,
-            &xs,
-            &mass,
-            &rho,
+            &pt,
             &mv,
             &[[0.0; 2]],
             &walls,
             t,
             &touch,
+            &[],
             &mut wf,
             &mut r,
+            0.01,
             0.01,
             1e-9,
         );

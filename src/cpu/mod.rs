@@ -45,6 +45,9 @@ pub struct CpuBackend {
     /// Per node: the walls' forces this step (`grid_update::wall_contact`);
     /// empty without walls.
     pub wall_force: Vec<[f64; 2]>,
+    /// Per node: the walls' preloads this step (`grid_update::wall_touch`);
+    /// empty unless some particle starts with one (`Walls::preload`).
+    pub wall_pre_force: Vec<[f64; 2]>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -56,6 +59,22 @@ pub struct CpuBackend {
     dt: f64,
     /// The step in progress lands on t_end.
     final_step: bool,
+}
+
+/// The particles' fields the walls' contact reads, and the scene's full
+/// gravity (zero without).
+fn contact_particles<'a>(
+    p: &'a Particles,
+    gravity: Option<&crate::model::Gravity>,
+) -> grid_update::ContactParticles<'a> {
+    grid_update::ContactParticles {
+        x: &p.x,
+        mass: &p.mass,
+        rho: &p.rho,
+        stress: &p.stress,
+        v: &p.v,
+        gravity: gravity.map_or([0.0; 2], |g| g.g),
+    }
 }
 
 impl CpuBackend {
@@ -74,6 +93,11 @@ impl CpuBackend {
                 vec![0.0; nodes]
             },
             wall_force: if model.walls.is_empty() {
+                Vec::new()
+            } else {
+                vec![[0.0; 2]; nodes]
+            },
+            wall_pre_force: if model.walls.preload.is_empty() {
                 Vec::new()
             } else {
                 vec![[0.0; 2]; nodes]
@@ -296,12 +320,11 @@ impl CpuBackend {
                 if !m.walls.is_empty() {
                     grid_update::wall_touch(
                         &self.cache,
-                        &p.x,
-                        &p.mass,
-                        &p.rho,
+                        &contact_particles(p, m.gravity.as_ref()),
                         &m.walls,
                         self.t,
                         &mut self.wall_touch,
+                        &mut self.wall_pre_force,
                     );
                 }
                 grid_update::predict(
@@ -352,17 +375,17 @@ impl CpuBackend {
                 if !m.walls.is_empty() {
                     grid_update::wall_contact(
                         &self.cache,
-                        &p.x,
-                        &p.mass,
-                        &p.rho,
+                        &contact_particles(p, m.gravity.as_ref()),
                         &self.mv,
                         &self.force,
                         &m.walls,
                         self.t,
                         &self.wall_touch,
+                        &self.wall_pre_force,
                         &mut self.wall_force,
                         wall_r,
                         gamma * self.dt,
+                        (2.0 - gamma) * self.dt,
                         self.mass_eps,
                     );
                 }

@@ -58,6 +58,13 @@ pub enum Buf {
     /// Per node: the weight of the particles in contact with a wall this
     /// step (wall_touch.wgsl).
     WallTouch,
+    /// Per particle and wall: the preload traction of the particles that
+    /// start flush with a wall and compressed (`Walls::preload`); only
+    /// when some particle has one.
+    WallPreload,
+    /// Per node: the walls' preloads this step (wall_touch.wgsl), which
+    /// wall_contact.wgsl counts in the body's velocity; with `WallPreload`.
+    WallPreForce,
     ExtForce,
     /// MUSL: each particle's position at the step's start (grid-relative),
     /// for the remap and the stress, which run after g2p has moved it.
@@ -65,7 +72,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 36] = [
+    pub const ALL: [Buf; 38] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -100,6 +107,8 @@ impl Buf {
         Buf::Walls,
         Buf::WallForce,
         Buf::WallTouch,
+        Buf::WallPreload,
+        Buf::WallPreForce,
         Buf::ExtForce,
         Buf::XStart,
     ];
@@ -352,6 +361,11 @@ fn grid_and_output_data(
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
         data.push((Buf::WallForce, vec![0u8; 8 * g.n_nodes()]));
         data.push((Buf::WallTouch, vec![0u8; 4 * g.n_nodes()]));
+        if !model.walls.preload.is_empty() {
+            let pre: Vec<f32> = model.walls.preload.iter().map(|&t| t as f32).collect();
+            data.push((Buf::WallPreload, bytemuck::cast_slice(&pre).to_vec()));
+            data.push((Buf::WallPreForce, vec![0u8; 8 * g.n_nodes()]));
+        }
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
     let probe_idx = if probe_idx.is_empty() {

@@ -79,6 +79,10 @@ pub struct Variant {
     /// Some wall appears or goes during the run (GATES: `wall_touch`
     /// compares the step's time with the wall's `appear_at`/`remove_at`).
     pub gates: bool,
+    /// Some particle starts flush with a wall and compressed across it
+    /// (WALL_PRELOAD: the `WallPreload` buffer, read with the stress by
+    /// `shared/wall_spring.wgsl`).
+    pub wall_preload: bool,
     /// `solver.pic_fraction` > 0 (PIC: `g2p` blends Σ N v_I in).
     pub pic: bool,
     /// `solver.local_damping` > 0 (LOCAL_DAMPING: `grid_update` built
@@ -121,6 +125,7 @@ impl Variant {
             mls: model.mls,
             walls: !model.walls.is_empty(),
             gates: model.walls.timed(),
+            wall_preload: !model.walls.preload.is_empty(),
             pic: model.pic_fraction > 0.0,
             local_damping: model.local_damping > 0.0,
             ext_force: model.external.is_some(),
@@ -172,6 +177,7 @@ impl Variant {
             .flag("MLS", self.mls)
             .flag("WALLS", self.walls)
             .flag("GATES", self.gates)
+            .flag("WALL_PRELOAD", self.wall_preload)
             .flag("PIC", self.pic)
             .flag("LOCAL_DAMPING", self.local_damping)
             .flag("EXT_FORCE", self.ext_force)
@@ -537,6 +543,7 @@ mod tests {
                                 mls: false,
                                 walls: mms,
                                 gates: mms,
+                                wall_preload: mms,
                                 pic: mms,
                                 local_damping: mms,
                                 ext_force: mms,
