@@ -1,12 +1,17 @@
 // Stage `clear_grid`: zero the nodal accumulators and the reactions (and,
-// with walls, the nodes' touch bits, which the CPU's `wall_touch` zeroes).
+// with walls, the nodes' contact weights and walls' forces, which the
+// CPU's `wall_touch` and `wall_contact` zero).
 // CPU twin: src/cpu/clear_grid.rs.
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
 @group(0) @binding({{B_REACTIONS}}) var<storage, read_write> reactions: array<f32>;
 #if WALLS
-@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<u32>;
+@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<f32>;
+@group(0) @binding({{B_WALL_FORCE}}) var<storage, read_write> wall_force: array<f32>;
+#if WALL_PRELOAD
+@group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read_write> wall_pre_force: array<f32>;
+#endif
 #endif
 
 @compute @workgroup_size(256)
@@ -26,6 +31,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         node_acc[n * NODE_STRIDE + k] = 0.0;
     }
 #if WALLS
-    wall_touch[n] = 0u;
+    wall_touch[n] = 0.0;
+    wall_force[2u * n] = 0.0;
+    wall_force[2u * n + 1u] = 0.0;
+#if WALL_PRELOAD
+    wall_pre_force[2u * n] = 0.0;
+    wall_pre_force[2u * n + 1u] = 0.0;
+#endif
 #endif
 }

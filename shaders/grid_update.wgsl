@@ -1,24 +1,21 @@
 // Stage `grid_update`, two entry points around the force computation.
-// `predict`: v_I = q_I / m_I, then each wall's contact rule (the walls the
-// node is behind and touches, `wall_touch.wgsl`, in scene order), then the fixed components set to their
-// constraint's prescribed velocity at the step's end (zero by default): a
-// constraint wins over a wall.
-// `correct`: reactions (−f on fixed components, summed per constraint),
-// those components zeroed, then v_I += γ Δt f_I / m_I (FE: γ = 1); then the
-// walls' rules on the corrected velocity, whose change Δv is the wall's
-// force m Δv / (γ Δt), added to f_I and to the wall's reaction. With
-// LOCAL_DAMPING, before the update each force component of a node with mass
-// loses α |f_i| sign(v_i), v the predicted nodal velocity (Cundall).
+// `predict`: v_I = q_I / m_I, then the fixed components set to their
+// constraint's prescribed velocity at the step's end (zero by default).
+// `correct`: the walls' forces (`wall_contact.wgsl`) added to f_I, then
+// reactions (−f on fixed components, summed per constraint), those
+// components zeroed (a constraint wins over a wall), then
+// v_I += γ Δt f_I / m_I (FE: γ = 1).
+// With LOCAL_DAMPING, before the update each force component of a node
+// with mass (the walls' forces included) loses α |f_i| sign(v_i), v the
+// predicted nodal velocity (Cundall).
 // CPU twin: src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
-#if WALLS
-@group(0) @binding({{B_WALLS}}) var<storage, read> walls: array<Wall>;
-@group(0) @binding({{B_WALL_MASK}}) var<storage, read> wall_mask: array<u32>;
-@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read> wall_touch: array<u32>;
-#endif
 #if CORRECT
+#if WALLS
+@group(0) @binding({{B_WALL_FORCE}}) var<storage, read> wall_force: array<f32>;
+#endif
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
 @group(0) @binding({{B_REACTIONS}}) var<storage, read_write> reactions: array<{{ATOMIC_T}}>;
 #include "shared/atomics.wgsl" ARR=reactions FN=reaction_add
@@ -37,33 +34,6 @@ fn fix_bits(i: u32, j: u32) -> u32 {
     }
     return f;
 }
-
-#if WALLS
-// A wall's contact rule on the velocity v of a node in contact (CPU twin:
-// `wall_velocity`): separating or resting (v·n ≥ 0) is free; approaching,
-// stick stops it, slip removes the normal component, friction also takes
-// μ Δv_n (Δv_n = −v·n) off the tangential speed, or stops it when that
-// speed is at most μ Δv_n.
-fn wall_velocity(v: vec2<f32>, w: Wall) -> vec2<f32> {
-    let vn = dot(v, w.normal);
-    if vn >= 0.0 {
-        return v;
-    }
-    if w.contact == CONTACT_STICK {
-        return vec2<f32>(0.0);
-    }
-    let vt = v - vn * w.normal;
-    if w.contact != CONTACT_FRICTION {
-        return vt;
-    }
-    let dvn = -vn;
-    let speed = length(vt);
-    if speed <= w.mu * dvn {
-        return vec2<f32>(0.0);
-    }
-    return (1.0 - w.mu * dvn / speed) * vt;
-}
-#endif
 
 #if !CORRECT
 // Prescribed velocities at time t (s) on the fixed components of node
@@ -101,6 +71,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let m = node_acc[b];
 #if CORRECT
     var f = vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]);
+#if WALLS
+    f += vec2<f32>(wall_force[2u * n], wall_force[2u * n + 1u]);
+#endif
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
         if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
@@ -125,31 +98,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         f -= params.local_damping * abs(f) * sign(vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]));
 #endif
         var v = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f;
-#if WALLS
-        let mask = wall_mask[n] & wall_touch[n];
-        for (var k = 0u; mask != 0u && k < arrayLength(&walls); k++) {
-            if (mask & (1u << k)) == 0u {
-                continue;
-            }
-            var nv = wall_velocity(v, walls[k]);
-            // A constraint wins: its components keep their value.
-            if (fix & 1u) != 0u {
-                nv.x = v.x;
-            }
-            if (fix & 2u) != 0u {
-                nv.y = v.y;
-            }
-            let fw = m * (nv - v) / gdt;
-            if fw.x != 0.0 {
-                reaction_add(2u * (params.n_groups + k), fw.x);
-            }
-            if fw.y != 0.0 {
-                reaction_add(2u * (params.n_groups + k) + 1u, fw.y);
-            }
-            f += fw;
-            v = nv;
-        }
-#endif
         node_acc[b + 1u] = v.x;
         node_acc[b + 2u] = v.y;
     }
@@ -159,14 +107,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var vel = vec2<f32>(0.0);
     if m > params.mass_eps {
         vel = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) / m;
-#if WALLS
-        let mask = wall_mask[n] & wall_touch[n];
-        for (var k = 0u; mask != 0u && k < arrayLength(&walls); k++) {
-            if (mask & (1u << k)) != 0u {
-                vel = wall_velocity(vel, walls[k]);
-            }
-        }
-#endif
         let fix = fix_bits(i, j);
         if (fix & 1u) != 0u {
             vel.x = 0.0;

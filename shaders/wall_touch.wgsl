@@ -1,12 +1,13 @@
-// Stage `grid_update`, walls only, before `predict`: which walls each node
-// touches this step. A particle whose (square) domain of half-width
-// l_p = ½ sqrt(m_p / ρ_p) reaches a wall's line, (x_p − point)·n −
-// l_p (|n_x| + |n_y|) ≤ WALL_TOUCH_SLACK l_p, sets the wall's bit on every node of its
-// stencil (weight > 0); `predict` and `correct` apply a wall only on the
-// nodes behind it that touch it. `clear_grid` zeroes the bits. With GATES
-// only the walls that act at the step's start time t (appear_at <= t <
-// remove_at) are touched.
-// CPU twin: `wall_touch` and `touching_walls` in src/cpu/grid_update.rs.
+// Stage `grid_update`, walls only, before `predict`: per node, the weight
+// S_I = Σ_p N_Ip of the particles in contact with a wall, those whose
+// contact spring is positive (`shared/wall_spring.wgsl`: the domain of
+// half-width l_p = ½ sqrt(m_p / ρ_p) reaches past the wall's contact
+// line, or a preloaded particle has not left it) (a particle in contact
+// with two walls counts twice). With WALL_PRELOAD, each contact's preload
+// onto the nodes at the wall's line, into `wall_pre_force`. `wall_contact`
+// reads it; `clear_grid` zeroes it. With GATES only the walls that act at
+// the step's start time t (appear_at <= t < remove_at) are in contact.
+// CPU twin: `wall_touch` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -16,10 +17,13 @@
 @group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
 @group(0) @binding({{B_RHO}}) var<storage, read> rho: array<f32>;
 @group(0) @binding({{B_WALLS}}) var<storage, read> walls: array<Wall>;
-@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<atomic<u32>>;
-
-// Keep in sync with `cpu::grid_update::WALL_TOUCH_SLACK`.
-const WALL_TOUCH_SLACK: f32 = 1e-3;
+@group(0) @binding({{B_WALL_TOUCH}}) var<storage, read_write> wall_touch: array<{{ATOMIC_T}}>;
+#include "shared/wall_spring.wgsl"
+#include "shared/atomics.wgsl" ARR=wall_touch FN=touch_add
+#if WALL_PRELOAD
+@group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read_write> wall_pre_force: array<{{ATOMIC_T}}>;
+#include "shared/atomics.wgsl" ARR=wall_pre_force FN=pre_force_add
+#endif
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -29,7 +33,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let x = x0[p] + u[p];
     let lp = 0.5 * sqrt(mass[p] / rho[p]);
-    var bits = 0u;
+    var count = 0u;
 #if GATES
     let t = sim.t + sim.t_lo;
 #endif
@@ -40,12 +44,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             continue;
         }
 #endif
-        let d = dot(x - w.point, w.normal);
-        if d - lp * (abs(w.normal.x) + abs(w.normal.y)) <= WALL_TOUCH_SLACK * lp {
-            bits |= 1u << k;
+        if contact_spring(p, k, w, x, lp).x > 0.0 {
+            count += 1u;
         }
     }
-    if bits == 0u {
+    if count == 0u {
         return;
     }
     let c = shape_ctx(p, x);
@@ -53,9 +56,38 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let span = shape_span(c, r);
         for (var k = span.x; k < span.y; k++) {
             let w = shape_node(c, k);
-            if w.ok && w.n > 0.0 {
-                atomicOr(&wall_touch[w.node], bits);
+            if w.ok && w.n != 0.0 {
+                touch_add(w.node, f32(count) * w.n);
             }
         }
     }
+#if WALL_PRELOAD
+    // Each contact's preload P n onto the nodes at the wall's line
+    // (weights N − d n·∇N), which `wall_contact` counts in the body's
+    // velocity before it decides the rest.
+    for (var k = 0u; k < arrayLength(&walls); k++) {
+        let wl = walls[k];
+#if GATES
+        if t < wl.appear_at || t >= wl.remove_at {
+            continue;
+        }
+#endif
+        let sp = contact_spring(p, k, wl, x, lp);
+        if sp.x <= 0.0 || sp.y <= 0.0 {
+            continue;
+        }
+        let d = wall_depth(x, lp, wl);
+        for (var r = 0u; r < SHAPE_ROWS; r++) {
+            let span = shape_span(c, r);
+            for (var s = span.x; s < span.y; s++) {
+                let nw = shape_node(c, s);
+                if nw.ok {
+                    let f = sp.y * (nw.n - d * dot(wl.normal, nw.dn)) * wl.normal;
+                    pre_force_add(2u * nw.node, f.x);
+                    pre_force_add(2u * nw.node + 1u, f.y);
+                }
+            }
+        }
+    }
+#endif
 }

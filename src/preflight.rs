@@ -380,8 +380,16 @@ fn memory(
     }
     if !f.walls.is_empty() {
         // model::Walls: the node mask, and at most every node in each
-        // wall's node list; the CPU's touch bits (cpu::grid_update::wall_touch).
-        per_node += 8.0 + 4.0 * f.walls.len() as f64;
+        // wall's node list; the CPU's contact weights and walls' forces
+        // (cpu::grid_update::wall_touch, wall_contact).
+        per_node += 4.0 + 8.0 + 16.0 + 4.0 * f.walls.len() as f64;
+        if f.bodies
+            .values()
+            .any(|b| b.initial_stress == crate::scene::InitialStress::Geostatic)
+        {
+            // model::Walls::preload: a traction per particle and wall.
+            particle += 8.0 * f.walls.len() as f64;
+        }
     }
     let mut mls = 0.0;
     if f.solver.mls {

@@ -119,8 +119,8 @@ pub enum Pass {
     /// component of the stencil.
     P2gPatch,
     MlsP2g,
-    /// Walls only: the walls each node touches (wall_touch.wgsl), before
-    /// `GridPredict`.
+    /// Walls only: the weight of the particles in contact per node
+    /// (wall_touch.wgsl), before `GridPredict`.
     WallTouch,
     GridPredict,
     Stress,
@@ -152,6 +152,9 @@ pub enum Pass {
     MlsGradGauss,
     MlsGradParticles,
     MlsStrain,
+    /// Walls only: the walls' forces at the contact points
+    /// (wall_contact.wgsl), before `GridCorrect`.
+    WallContact,
     GridCorrect,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
@@ -167,7 +170,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 33] = [
+    pub const ALL: [Pass; 34] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -193,6 +196,7 @@ impl Pass {
         Pass::MlsGradGauss,
         Pass::MlsGradParticles,
         Pass::MlsStrain,
+        Pass::WallContact,
         Pass::GridCorrect,
         Pass::G2p,
         Pass::RemapClear,
@@ -212,6 +216,7 @@ impl Pass {
             Pass::LmeNewton => "lme_newton.wgsl",
             Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
             Pass::WallTouch => "wall_touch.wgsl",
+            Pass::WallContact => "wall_contact.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
@@ -404,6 +409,7 @@ impl StepPlan {
             ],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
+            Stage::GridCorrect if walls => &[Pass::WallContact, Pass::GridCorrect],
             Stage::GridCorrect => &[Pass::GridCorrect],
             Stage::G2p => &[Pass::G2p],
             Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],

@@ -135,6 +135,10 @@ fn variants() -> Vec<Variant> {
                                         // Gates, the PIC blend and local damping
                                         // where the walls are.
                                         gates: atomics == AtomicMode::CompareExchange && !mls,
+                                        // The walls' preload (a geostatic body
+                                        // against them) where the walls are.
+                                        wall_preload: atomics == AtomicMode::CompareExchange
+                                            && !mls,
                                         pic: atomics == AtomicMode::CompareExchange && !mls,
                                         local_damping: atomics == AtomicMode::CompareExchange
                                             && !mls,
@@ -231,16 +235,21 @@ fn every_pass_validates_in_every_variant() {
                 "{pass:?} {v:?}: cell bins without MLS, gather or patch"
             );
             assert!(
-                !(has(Buf::Walls) || has(Buf::WallMask) || has(Buf::WallTouch)) || v.walls,
+                !(has(Buf::Walls) || has(Buf::WallForce) || has(Buf::WallTouch)) || v.walls,
                 "{pass:?} {v:?}: wall buffers without walls"
             );
             assert!(
                 !has(Buf::ExtForce) || v.ext_force,
                 "{pass:?} {v:?}: external forces without loads"
             );
-            if v.walls && matches!(pass, Pass::GridPredict | Pass::GridCorrect) {
-                assert!(has(Buf::WallMask), "{pass:?} {v:?}: walls unread");
-                assert!(has(Buf::WallTouch), "{pass:?} {v:?}: touch bits unread");
+            if v.walls && matches!(pass, Pass::GridCorrect) {
+                assert!(has(Buf::WallForce), "{pass:?} {v:?}: walls' forces unread");
+            }
+            if v.walls && matches!(pass, Pass::WallContact) {
+                assert!(
+                    has(Buf::WallTouch),
+                    "{pass:?} {v:?}: contact weights unread"
+                );
             }
             if v.ext_force && matches!(pass, Pass::Forces | Pass::ForcesGather) {
                 assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");
@@ -270,6 +279,7 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::MlsRemap
             | Pass::MlsForceGauss
             | Pass::WallTouch
+            | Pass::WallContact
     )
 }
 
@@ -315,7 +325,8 @@ fn shared_structs_match_rust_layouts() {
     assert_eq!(wgsl_struct(&module, "Material"), mat);
     let con = rust_fields!(GpuConstraint; i0, i1, j0, j1, fix, vx, vy, ramp_time);
     assert_eq!(wgsl_struct(&module, "Constraint"), con);
-    let wall = rust_fields!(GpuWall; point, normal, mu, contact, appear_at, remove_at);
+    let wall =
+        rust_fields!(GpuWall; point, normal, mu, contact, stiffness, offset, appear_at, remove_at);
     assert_eq!(wgsl_struct(&module, "Wall"), wall);
 }
 
@@ -342,9 +353,10 @@ fn wgsl_constants(module: &naga::Module) -> Vec<(String, Value)> {
         .collect()
 }
 
-/// The constants of every pass in two variants that together include every
+/// The constants of every pass in variants that together include every
 /// shared file (MLS B-splines with two materials; stored-weight LME with the
-/// manufactured load), with the passes' entry-point workgroup sizes.
+/// manufactured load; MUSL; walls), with the passes' entry-point workgroup
+/// sizes.
 fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     let all = variants();
     let mls = all
@@ -361,8 +373,9 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
             .find(|v| v.integrator == Integrator::Musl && v.mls == mls)
             .unwrap()
     };
+    let walls = all.iter().find(|v| v.walls).unwrap();
     let mut out = Vec::new();
-    for v in [mls, lme, musl(true), musl(false)] {
+    for v in [mls, lme, musl(true), musl(false), walls] {
         let d = v.defines();
         for pass in Pass::ALL {
             if v.plan().gpu_uses(pass) {
@@ -418,6 +431,8 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("WG", u(l::WG)),
         ("LAST_STEP_REL", f(lme_mpm::model::time_step::LAST_STEP_REL)),
         ("MLS_SUPPORT", f(lme_mpm::cpu::mls::SUPPORT_CELLS)),
+        ("WALL_DAMPING", f(lme_mpm::model::walls::WALL_DAMPING)),
+        ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
     ];
     let modules = every_pass_module();
     // Every model's code, generated from the registry.

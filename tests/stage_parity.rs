@@ -1088,8 +1088,9 @@ fn stages_match_two_materials() {
 /// overlaps a wall, a ramped prescribed velocity, a ramped traction and a
 /// point load (tests/scenes/boundaries.toml), at t = 0.7 s (mid-ramp), on
 /// three shape families, both integrators, a perturbed grid and CAS
-/// atomics. Random particle velocities put wall nodes in every branch of
-/// the contact rules (approach and separation, stick and slide).
+/// atomics. Random particle positions and velocities put particles in
+/// contact with every wall, approaching and separating, sticking and
+/// sliding (the contact forces' every branch).
 #[test]
 fn stages_match_boundaries() {
     let text = include_str!("scenes/boundaries.toml");
@@ -1250,4 +1251,41 @@ fn stages_match_modified_cam_clay() {
         GpuOptions::default(),
         0.0,
     );
+}
+
+/// The walls' preloads (a geostatic body flush against its walls,
+/// tests/scenes/gate_release.toml with the gate kept): the seeded column
+/// with random velocities and its stresses scaled by 0.5–1.5, so the
+/// preload is capped by the stress now on some particles and by the
+/// initial traction on others, and friction, damping and the preload's
+/// weights at the wall's line all act; linear NPC (exact face weights),
+/// LME FE and bspline2 MUSL (first order).
+#[test]
+fn stages_match_wall_preload() {
+    let text = include_str!("scenes/gate_release.toml");
+    for (label, sets) in [
+        ("preload, linear npc", &["solver.shape=linear"][..]),
+        (
+            "preload, lme fe",
+            &["solver.shape=lme", "solver.integrator=fe"][..],
+        ),
+        (
+            "preload, bspline2 musl",
+            &["solver.shape=bspline2", "solver.integrator=musl"][..],
+        ),
+    ] {
+        let mut all = vec!["walls.gate.remove_at=1e9"];
+        all.extend_from_slice(sets);
+        let o: Vec<Override> = all.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let scene = Scene::from_str(text, "parity scene", "parity", &o).unwrap();
+        let mut m = Model::new(&scene).unwrap();
+        assert!(!m.walls.preload.is_empty(), "{label}: no preload");
+        let mut rng = SplitMix64::new(17);
+        for i in 0..m.particles.len() {
+            m.particles.v[i] = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+            let s = rng.range(0.5, 1.5);
+            m.particles.stress[i] = m.particles.stress[i].map(|c| s * c);
+        }
+        parity_of(label, m, false, GpuOptions::default(), 0.0);
+    }
 }

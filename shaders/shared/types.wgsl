@@ -147,12 +147,15 @@ const CONTACT_FRICTION: u32 = 2u;
 
 // A rigid wall: the line through `point` (m, grid-relative) with unit
 // normal `normal` into the material; `contact` is CONTACT_*, `mu` Coulomb's
-// coefficient (friction only). Its nodes are marked in `wall_mask`.
+// coefficient (friction only); `stiffness` the penalty k (Pa/m) and
+// `offset` (m) how far past the line contact starts (src/model/walls.rs).
 struct Wall {
     point: vec2<f32>,
     normal: vec2<f32>,
     mu: f32,
     contact: u32,
+    stiffness: f32,
+    offset: f32,
     // The wall acts for appear_at <= t < remove_at (s), t the step's start
     // (flag GATES).
     appear_at: f32,

@@ -1,29 +1,36 @@
 //! Stage `grid_update`, in two passes around the force computation.
-//! `wall_touch` (walls only, before `predict`): the walls each node is in
-//! contact with, from where the body is: a node touches wall k when a
-//! particle whose domain reaches the wall line holds it in its stencil.
+//! `wall_touch` (walls only, before `predict`): per node, the weight S_I of
+//! the particles in contact with a wall (their domain reaches past its
+//! contact line).
 //! `predict`: nodal velocity from the scattered momentum, v_I = q_I / m_I,
-//! then the walls' contact rules (each wall the node is behind and
-//! touches, in scene order), then the Dirichlet conditions (fixed components set to the
-//! constraint's prescribed velocity at the step's end, zero by default):
-//! a constraint wins over a wall.
-//! `correct`: reactions on fixed nodes, their force components zeroed, then
-//! v_I += γ Δt f_I / m_I (NPC corrector; FE is γ = 1: the nodal momentum
-//! update p_I += Δt f_I of Zhang et al.); then the walls' rules on the
-//! corrected velocity, whose change Δv becomes the wall's force
-//! m Δv / (γ Δt), added to f_I (so the particles feel it) and to the wall's
-//! reaction. Fixed components keep their prescribed value.
+//! then the Dirichlet conditions (fixed components set to the
+//! constraint's prescribed velocity at the step's end, zero by default).
+//! `wall_contact` (walls only, before `correct`): the walls' forces at the
+//! contact points, the particles in contact: a penalty normal force with
+//! some damping, and Coulomb friction capped by it that stops the slip of
+//! the body at the point (docs/methods.md, "Walls"); onto the nodes with
+//! the particle's weights, and into the walls' reactions.
+//! `correct`: the walls' forces added to f_I, reactions on fixed nodes,
+//! their force components zeroed, then v_I += γ Δt f_I / m_I (NPC
+//! corrector; FE is γ = 1: the nodal momentum update p_I += Δt f_I of
+//! Zhang et al.). Fixed components keep their prescribed value: a
+//! constraint wins over a wall.
 //! With `solver.local_damping` α > 0 (Cundall), `correct` first takes
 //! α |f_i| sign(v_i) off each component of the unbalanced force of a node
-//! with mass, v_I the nodal velocity it is about to correct (the
-//! predicted one), before the velocity update, so the nodes and the
-//! particles' FLIP update (`g2p`) feel the damped force.
-//! GPU twin: `shaders/grid_update.wgsl` (built without and with `CORRECT`)
-//! and `shaders/wall_touch.wgsl`.
+//! with mass (the walls' forces included), v_I the nodal velocity it is
+//! about to correct (the predicted one), before the velocity update, so
+//! the nodes and the particles' FLIP update (`g2p`) feel the damped force.
+//! Only the walls that act in the step (`Wall::active_at`: a gate's
+//! `appear_at` ≤ t < `remove_at`) are in contact.
+//! GPU twins: `shaders/grid_update.wgsl` (built without and with
+//! `CORRECT`), `shaders/wall_touch.wgsl` and `shaders/wall_contact.wgsl`.
 
 use super::stage_inputs::ShapeCache;
-use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
-use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Wall, Walls};
+use crate::model::walls::{
+    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, preload_force, wall_depth,
+    wall_penetration,
+};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Walls};
 use rayon::prelude::*;
 
 pub use crate::model::MASS_EPS_REL;
@@ -36,36 +43,6 @@ fn zero_fixed(v: &mut [f64], fix: u8) {
     if fix & FIX_Y != 0 {
         v[1] = 0.0;
     }
-}
-
-/// A wall's contact rule on a node velocity `v` (m/s), for a node in
-/// contact: a separating or resting velocity (v·n ≥ 0) is free under every
-/// law; an approaching one loses its normal component, and then stick
-/// stops it (no slip where in contact, so a disk can roll: the nodes that
-/// lift off behind the contact are released), slip keeps the tangential
-/// part, and friction applies Coulomb's law with the normal velocity
-/// change Δv_n = −v·n as the impulse per unit mass: a tangential velocity
-/// |v_t| ≤ μ Δv_n stops, a larger one loses μ Δv_n along −v_t/|v_t|.
-#[inline]
-pub fn wall_velocity(v: [f64; 2], normal: [f64; 2], contact: u32, mu: f64) -> [f64; 2] {
-    let vn = v[0] * normal[0] + v[1] * normal[1];
-    if vn >= 0.0 {
-        return v;
-    }
-    if contact == CONTACT_STICK {
-        return [0.0, 0.0];
-    }
-    let vt = [v[0] - vn * normal[0], v[1] - vn * normal[1]];
-    if contact != CONTACT_FRICTION {
-        return vt;
-    }
-    let dvn = -vn;
-    let speed = vt[0].hypot(vt[1]);
-    if speed <= mu * dvn {
-        return [0.0, 0.0];
-    }
-    let k = 1.0 - mu * dvn / speed;
-    [k * vt[0], k * vt[1]]
 }
 
 /// Cundall's non-viscous local damping of a nodal force `f` (N) at nodal
@@ -90,81 +67,225 @@ pub fn local_damping(f: [f64; 2], v: [f64; 2], alpha: f64) -> [f64; 2] {
     ]
 }
 
-/// The rules of every wall in `mask` (bit k = wall k), in order.
+/// The contact's normal spring force (N per unit thickness) of particle
+/// `p` on wall `k` before damping: the penalty k pen 2 l_p (pen from
+/// `wall_penetration`, negative once the domain is clear of the contact
+/// line) plus the particle's preload (`preload_force`, zero unless it
+/// started flush and compressed against the wall), and that preload.
+/// The particle is in contact while the sum is positive.
 #[inline]
-fn walls_velocity(mut v: [f64; 2], mask: u32, walls: &[Wall]) -> [f64; 2] {
-    for (k, w) in walls.iter().enumerate() {
-        if mask & (1 << k) != 0 {
-            v = wall_velocity(v, w.normal, w.contact, w.mu);
-        }
-    }
-    v
+fn contact_spring(p: usize, k: usize, pt: &ContactParticles, walls: &Walls) -> (f64, f64) {
+    let w = &walls.list[k];
+    let lp = half_width(pt.mass[p], pt.rho[p]);
+    let pre = preload_force(
+        walls.preload_of(p, k),
+        pt.stress[p],
+        w.normal,
+        lp,
+        pt.mass[p],
+        pt.gravity,
+        wall_depth(pt.x[p], lp, w),
+    );
+    (
+        w.stiffness * wall_penetration(pt.x[p], lp, w) * 2.0 * lp + pre,
+        pre,
+    )
 }
 
-/// Per node, the bit set of the walls it touches (bit k = wall k): the
-/// nodes of the stencil (weight > 0) of every particle p whose domain
-/// reaches the wall line, (x_p − point)·n − l_p (|n_x| + |n_y|) ≤ s l_p
-/// (s = `WALL_TOUCH_SLACK`), with
-/// l_p = ½ sqrt(m_p / ρ_p) the half-width of its (square) domain. A node
-/// behind a wall that no touching particle reaches is free: the body is
-/// not at the wall there, whatever its velocity (before, every node
-/// behind the wall that held mass got the rule, so the patch of about
-/// sqrt(2 R h) under a disk dragged on it; docs/methods.md, "Walls").
-/// `touch` is zeroed first (its GPU twin is zeroed by `clear_grid`).
-/// Only the walls that act in the step starting at `t` (s) are touched
-/// (`Wall::active_at`: a gate's `appear_at` ≤ t < `remove_at`), so a
-/// removed gate is nowhere in contact.
+/// What the contact reads of the particles: positions (m), masses (kg
+/// per unit thickness), densities (kg/m³), stresses (Pa, for the
+/// preload) and the scene's full gravity (m/s², zero without).
+pub struct ContactParticles<'a> {
+    pub x: &'a [[f64; 2]],
+    pub mass: &'a [f64],
+    pub rho: &'a [f64],
+    pub stress: &'a [[f64; 3]],
+    pub v: &'a [[f64; 2]],
+    pub gravity: [f64; 2],
+}
+
+/// Per node, the contact weight S_I = Σ_p N_Ip over the particles in
+/// contact with a wall (`contact_spring` > 0; a particle in contact
+/// with two walls counts twice). Only the walls that act in the step
+/// starting at `t` (s) count (`Wall::active_at`), so a removed gate, or
+/// one not there yet, is nowhere in contact. With preloads
+/// (`Walls::preload`; `pre_force` is empty without), each contact's
+/// preload P n onto the nodes at the wall's line (`face_weight`), into
+/// `pre_force`: the load the walls carry whatever the body does, which
+/// `wall_contact` counts in the body's velocity before it decides the
+/// rest (else a stick floor's friction at a corner would also take up
+/// the side wall's preload). `touch` and `pre_force` are zeroed first
+/// (their GPU twins by `clear_grid`).
 pub fn wall_touch(
     cache: &ShapeCache,
-    x: &[[f64; 2]],
-    mass: &[f64],
-    rho: &[f64],
+    pt: &ContactParticles,
     walls: &Walls,
     t: f64,
-    touch: &mut [u32],
+    touch: &mut [f64],
+    pre_force: &mut [[f64; 2]],
 ) {
-    touch.fill(0);
-    let active = walls
-        .list
-        .iter()
-        .enumerate()
-        .fold(0u32, |bits, (k, w)| bits | (u32::from(w.active_at(t)) << k));
-    if active == 0 {
-        return;
-    }
-    for p in 0..x.len() {
-        let bits = touching_walls(x[p], mass[p], rho[p], &walls.list) & active;
-        if bits == 0 {
+    touch.fill(0.0);
+    pre_force.fill([0.0; 2]);
+    for p in 0..pt.x.len() {
+        let (nodes, w) = cache.particle(p);
+        let mut count = 0;
+        for (k, wl) in walls.list.iter().enumerate() {
+            if !wl.active_at(t) {
+                continue;
+            }
+            let (spring, pre) = contact_spring(p, k, pt, walls);
+            if spring <= 0.0 {
+                continue;
+            }
+            count += 1;
+            if pre > 0.0 {
+                let d = wall_depth(pt.x[p], half_width(pt.mass[p], pt.rho[p]), wl);
+                for (&n, wk) in nodes.iter().zip(w) {
+                    let f = pre * face_weight(wk, wl.normal, d);
+                    pre_force[n as usize][0] += f * wl.normal[0];
+                    pre_force[n as usize][1] += f * wl.normal[1];
+                }
+            }
+        }
+        if count == 0 {
             continue;
         }
-        let (nodes, w) = cache.particle(p);
         for (&n, wk) in nodes.iter().zip(w) {
-            if wk[0] > 0.0 {
-                touch[n as usize] |= bits;
+            touch[n as usize] += count as f64 * wk[0];
+        }
+    }
+}
+
+/// The weight of a node at the wall's line, from the particle's [N, ∇N]
+/// `wk` and the distance `d` (m, `wall_depth`) from its centre to the
+/// line along the normal `n`: N − d n·∇N, first order in d (exact for
+/// linear shapes while the line is in the particle's cell). They sum to
+/// one, as N does.
+#[inline]
+fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
+    wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
+}
+
+/// The walls' forces at their contact points: every particle in contact
+/// with a wall gets a normal force F_n = k pen 2 l_p (penalty) plus its
+/// preload (`contact_spring`), less a damping of its approach, and a
+/// tangential force that stops the particle's slip (stick), capped by
+/// μ F_n (friction), or none (slip); the force goes to the particle's
+/// nodes with its weights, into `wall_force`, and to the wall's reaction.
+/// The damping reads the body's velocity at the particle, corrected
+/// without the walls, Σ N (v_I + γΔt f_I / m_I); the friction the
+/// particle's next velocity without the walls, v_p + `slip_dt` Σ N f_I /
+/// m_I (its slip, v_t, is what must stop: a particle that the nodes' PIC
+/// velocity holds still can still creep by its own), and the tangential
+/// force that stops it is −v_t / w with
+/// w = `slip_dt` Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
+/// contact pull on the same nodes; `slip_dt` the time over which the
+/// particles feel a nodal force, (2 − γ)Δt for NPC, Δt for FE and MUSL),
+/// and the damping's w is the same with γΔt (`gamma_dt`). With preloads,
+/// the body's velocity counts the walls' preloads (`pre_force`, from
+/// `wall_touch`). Only the walls that act in the step
+/// starting at `t` (s) push (`Wall::active_at`). The preload's share of
+/// F_n acts where the wall's traction does, on the wall's line, at
+/// x_p − d n (d from `wall_depth`):
+/// it goes to the nodes with N_I − d n·∇N_I (the weights there, to first
+/// order; exact for linear shapes across the wall's row of cells), so a
+/// geostatic body's boundary nodes get the load their own forces lack,
+/// not a share of it spread a cell into the body.
+#[allow(clippy::too_many_arguments)]
+pub fn wall_contact(
+    cache: &ShapeCache,
+    pt: &ContactParticles,
+    mv: &[[f64; 3]],
+    force: &[[f64; 2]],
+    walls: &Walls,
+    t: f64,
+    touch: &[f64],
+    pre_force: &[[f64; 2]],
+    wall_force: &mut [[f64; 2]],
+    wall_r: &mut [[f64; 2]],
+    gamma_dt: f64,
+    slip_dt: f64,
+    mass_eps: f64,
+) {
+    wall_force.fill([0.0; 2]);
+    for r in wall_r.iter_mut() {
+        *r = [0.0; 2];
+    }
+    for p in 0..pt.x.len() {
+        let lp = half_width(pt.mass[p], pt.rho[p]);
+        for (k, wl) in walls.list.iter().enumerate() {
+            if !wl.active_at(t) {
+                continue;
+            }
+            let (spring, pre) = contact_spring(p, k, pt, walls);
+            if spring <= 0.0 {
+                continue;
+            }
+            let (nodes, wt) = cache.particle(p);
+            // v: the body's corrected velocity at the particle (for the
+            // damping); vp: the particle's own next velocity (for the
+            // friction); both without the walls' contact forces, with
+            // their preloads.
+            let (mut v, mut w) = ([0.0; 2], 0.0);
+            let mut vp = pt.v[p];
+            for (&n, wk) in nodes.iter().zip(wt) {
+                let node = &mv[n as usize];
+                if node[0] > mass_eps {
+                    let mut f = force[n as usize];
+                    if let Some(pf) = pre_force.get(n as usize) {
+                        f = [f[0] + pf[0], f[1] + pf[1]];
+                    }
+                    v[0] += wk[0] * (node[1] + gamma_dt * f[0] / node[0]);
+                    v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
+                    vp[0] += wk[0] * slip_dt * f[0] / node[0];
+                    vp[1] += wk[0] * slip_dt * f[1] / node[0];
+                    w += wk[0] * touch[n as usize] / node[0];
+                }
+            }
+            if w <= 0.0 {
+                continue;
+            }
+            w *= gamma_dt;
+            let nrm = wl.normal;
+            let vn = v[0] * nrm[0] + v[1] * nrm[1];
+            let fnorm = (spring - WALL_DAMPING * vn / w).max(0.0);
+            let vpn = vp[0] * nrm[0] + vp[1] * nrm[1];
+            let vt = [vp[0] - vpn * nrm[0], vp[1] - vpn * nrm[1]];
+            let mu = match wl.contact {
+                CONTACT_STICK => STICK_MU,
+                CONTACT_FRICTION => wl.mu,
+                _ => 0.0,
+            };
+            // Coulomb: the force that stops the particle's slip, at most
+            // μ F_n. The particle feels it over `slip_dt` (NPC: Δt in v_p
+            // and (1 − γ)Δt more in the next predictor), so that is the
+            // step it is sized for. Sized on the corrected nodal velocity
+            // over γΔt instead, the stick loop's gain was (2 − γ)/γ = 3 and
+            // a slip grew (the geostatic column's bottom row: from 1e-16
+            // to 1 m/s in 100 steps).
+            let ws = w / gamma_dt * slip_dt;
+            let mut ft = [-vt[0] / ws, -vt[1] / ws];
+            let mag = ft[0].hypot(ft[1]);
+            let cap = mu * fnorm;
+            if mag > cap {
+                ft = [ft[0] * cap / mag, ft[1] * cap / mag];
+            }
+            let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
+            wall_r[k][0] += fw[0];
+            wall_r[k][1] += fw[1];
+            // The preload's share at the wall's line, the rest at the
+            // particle.
+            let f_pre = pre.min(fnorm);
+            let f_at = [fw[0] - f_pre * nrm[0], fw[1] - f_pre * nrm[1]];
+            let d = wall_depth(pt.x[p], lp, wl);
+            for (&n, wk) in nodes.iter().zip(wt) {
+                let face = f_pre * face_weight(wk, nrm, d);
+                let o = &mut wall_force[n as usize];
+                o[0] += wk[0] * f_at[0] + face * nrm[0];
+                o[1] += wk[0] * f_at[1] + face * nrm[1];
             }
         }
     }
-}
-
-/// Slack of the touch test, relative to the particle's half-width: a
-/// domain whose edge lies on the line (a body seeded against a wall with
-/// the uniform layout) touches it on both backends, whatever the f32
-/// round-off of the GPU's positions (about 1e-7 of the grid's size).
-pub const WALL_TOUCH_SLACK: f64 = 1e-3;
-
-/// The walls (bit k = wall k) that the domain of a particle at `x` (m)
-/// with mass `m` and density `rho` reaches.
-#[inline]
-pub fn touching_walls(x: [f64; 2], m: f64, rho: f64, walls: &[Wall]) -> u32 {
-    let lp = 0.5 * (m / rho).sqrt();
-    let mut bits = 0;
-    for (k, w) in walls.iter().enumerate() {
-        let d = (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1];
-        if d - lp * (w.normal[0].abs() + w.normal[1].abs()) <= WALL_TOUCH_SLACK * lp {
-            bits |= 1 << k;
-        }
-    }
-    bits
 }
 
 /// Prescribed velocities at time `t` (s) on the fixed components of the
@@ -188,35 +309,16 @@ fn prescribe(mv: &mut [[f64; 3]], groups: &[ConstraintGroup], t: f64, mass_eps: 
 }
 
 /// `mv[n] = [m, qx, qy]` in, `[m, vx, vy]` out; `t` is the step's end
-/// time (s); `touch` is `wall_touch`'s (empty without walls). With
-/// contact pairs `mv` holds one copy of the nodes per field, stacked
-/// (`model::contact`); `fix` and the walls' mask are per grid node.
-pub fn predict(
-    mv: &mut [[f64; 3]],
-    fix: &[u8],
-    groups: &[ConstraintGroup],
-    walls: &Walls,
-    touch: &[u32],
-    t: f64,
-    mass_eps: f64,
-) {
-    let wl = &walls.list;
-    let n_nodes = fix.len();
-    for (field, mv) in mv.chunks_mut(n_nodes).enumerate() {
-        let base = field * n_nodes;
+/// time (s). With contact pairs `mv` holds one copy of the nodes per
+/// field, stacked (`model::contact`); `fix` is per grid node.
+pub fn predict(mv: &mut [[f64; 3]], fix: &[u8], groups: &[ConstraintGroup], t: f64, mass_eps: f64) {
+    for mv in mv.chunks_mut(fix.len()) {
         mv.par_iter_mut()
             .zip(fix)
-            .enumerate()
             .with_min_len(4096)
-            .for_each(|(i, (n, &f))| {
+            .for_each(|(n, &f)| {
                 if n[0] > mass_eps {
                     let mut v = [n[1] / n[0], n[2] / n[0]];
-                    if let Some(&mask) = walls.mask.get(i) {
-                        let mask = mask & touch[base + i];
-                        if mask != 0 {
-                            v = walls_velocity(v, mask, wl);
-                        }
-                    }
                     zero_fixed(&mut v, f);
                     *n = [n[0], v[0], v[1]];
                 } else {
@@ -227,28 +329,37 @@ pub fn predict(
     }
 }
 
-/// Records reactions per constraint group (the force the support exerts,
-/// −f_I on each fixed component), zeroes those components, corrects the
-/// velocities by `gamma_dt` · f/m, then applies the walls on the nodes
-/// that touch them (`touch`, as in `predict`). `reactions` holds the
-/// constraint groups' then the walls'. `damping` is Cundall's α
-/// (`local_damping`; 0 leaves the force as it is).
+/// Adds the walls' forces (`wall_contact`'s `wall_force`; empty without
+/// walls) to the nodal forces, records reactions per constraint group
+/// (the force the support exerts, −f_I on each fixed component), zeroes
+/// those components, then corrects the velocities by `gamma_dt` · f/m.
+/// `reactions` holds the constraint groups' (the walls' are
+/// `wall_contact`'s). `damping` is Cundall's α (`local_damping`; 0 leaves
+/// the force as it is).
 #[allow(clippy::too_many_arguments)]
 pub fn correct(
     mv: &mut [[f64; 3]],
     force: &mut [[f64; 2]],
     fix: &[u8],
     groups: &[ConstraintGroup],
-    walls: &Walls,
-    touch: &[u32],
+    wall_force: &[[f64; 2]],
     reactions: &mut [[f64; 2]],
     gamma_dt: f64,
     damping: f64,
     mass_eps: f64,
 ) {
     let n_nodes = fix.len();
-    let (group_r, wall_r) = reactions.split_at_mut(groups.len());
-    for (g, r) in groups.iter().zip(group_r.iter_mut()) {
+    if !wall_force.is_empty() {
+        force
+            .par_iter_mut()
+            .zip(wall_force)
+            .with_min_len(4096)
+            .for_each(|(f, w)| {
+                f[0] += w[0];
+                f[1] += w[1];
+            });
+    }
+    for (g, r) in groups.iter().zip(reactions.iter_mut()) {
         *r = [0.0; 2];
         for field in force.chunks(n_nodes) {
             for &n in &g.nodes {
@@ -278,90 +389,122 @@ pub fn correct(
                 }
             });
     }
-    for r in wall_r.iter_mut() {
-        *r = [0.0; 2];
-    }
-    if walls.is_empty() {
-        return;
-    }
-    // Each wall's velocity change on its nodes, one wall after another in
-    // scene order (a node behind two walls gets both), as on the GPU.
-    for (node, &t) in touch.iter().enumerate() {
-        let i = node % n_nodes;
-        let mask = walls.mask[i] & t;
-        let n = &mut mv[node];
-        if mask == 0 || n[0] <= mass_eps {
-            continue;
-        }
-        let m = n[0];
-        let mut v = [n[1], n[2]];
-        for (k, w) in walls.list.iter().enumerate() {
-            if mask & (1 << k) == 0 {
-                continue;
-            }
-            let mut new = wall_velocity(v, w.normal, w.contact, w.mu);
-            // A constraint wins: its components keep their value.
-            if fix[i] & FIX_X != 0 {
-                new[0] = v[0];
-            }
-            if fix[i] & FIX_Y != 0 {
-                new[1] = v[1];
-            }
-            let fw = [
-                m * (new[0] - v[0]) / gamma_dt,
-                m * (new[1] - v[1]) / gamma_dt,
-            ];
-            wall_r[k][0] += fw[0];
-            wall_r[k][1] += fw[1];
-            force[node][0] += fw[0];
-            force[node][1] += fw[1];
-            v = new;
-        }
-        n[1] = v[0];
-        n[2] = v[1];
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Wall;
     use crate::model::walls::CONTACT_SLIP;
 
-    const N: [f64; 2] = [0.0, 1.0];
-
-    #[test]
-    fn stick_stops_approach_and_frees_separation() {
-        assert_eq!(
-            wall_velocity([1.0, -2.0], N, CONTACT_STICK, 0.0),
-            [0.0, 0.0]
-        );
-        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_STICK, 0.0), [1.0, 2.0]);
+    /// One particle at `x` on one node (weight 1) of mass 2 kg moving at
+    /// `v` (m/s), against a level wall at y = 0 with k = 1e6 Pa/m; the
+    /// particle's domain is 0.1 m wide (m / ρ = 0.01). Returns the wall's
+    /// force on the material (N per unit thickness).
+    fn contact(x: [f64; 2], v: [f64; 2], law: u32, mu: f64) -> [f64; 2] {
+        contact_at(x, v, law, mu, 0.0, f64::INFINITY, 0.0)
     }
 
-    #[test]
-    fn touch_from_the_particle_domain() {
+    /// `contact` against a gate there for `appear_at` ≤ t < `remove_at`,
+    /// at time `t` (s).
+    fn contact_at(
+        x: [f64; 2],
+        v: [f64; 2],
+        law: u32,
+        mu: f64,
+        appear_at: f64,
+        remove_at: f64,
+        t: f64,
+    ) -> [f64; 2] {
         let wall = Wall {
             name: "w".into(),
             point: [0.0, 0.0],
-            normal: N,
-            contact: CONTACT_STICK,
-            mu: 0.0,
+            normal: [0.0, 1.0],
+            contact: law,
+            mu,
             nodes: Vec::new(),
-            appear_at: 0.0,
-            remove_at: f64::INFINITY,
+            stiffness: 1e6,
+            offset: 0.0,
+            appear_at,
+            remove_at,
         };
-        // Domain 0.1 m wide (m / ρ = 0.01): it reaches the line from 0.05 m.
-        let walls = [
-            wall.clone(),
-            Wall {
-                point: [0.0, -1.0],
-                ..wall
-            },
-        ];
-        assert_eq!(touching_walls([0.3, 0.05], 10.0, 1000.0, &walls), 1);
-        assert_eq!(touching_walls([0.3, 0.05004], 10.0, 1000.0, &walls), 1);
-        assert_eq!(touching_walls([0.3, 0.0501], 10.0, 1000.0, &walls), 0);
-        assert_eq!(touching_walls([0.3, -0.96], 10.0, 1000.0, &walls), 3);
+        let walls = Walls {
+            list: vec![wall],
+            mask: vec![1],
+            preload: Vec::new(),
+        };
+        let mut cache = ShapeCache::new(1, 1);
+        cache.count[0] = 1;
+        cache.w[0] = [1.0, 0.0, 0.0];
+        let (xs, mass, rho) = ([x], [10.0], [1000.0]);
+        let pt = ContactParticles {
+            x: &xs,
+            mass: &mass,
+            rho: &rho,
+            stress: &[[0.0; 3]],
+            v: &[v],
+            gravity: [0.0; 2],
+        };
+        let mut touch = [0.0];
+        wall_touch(&cache, &pt, &walls, t, &mut touch, &mut []);
+        let mv = [[2.0, v[0], v[1]]];
+        let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
+        wall_contact(
+            &cache,
+            &pt,
+            &mv,
+            &[[0.0; 2]],
+            &walls,
+            t,
+            &touch,
+            &[],
+            &mut wf,
+            &mut r,
+            0.01,
+            0.01,
+            1e-9,
+        );
+        assert_eq!(wf[0], r[0]);
+        r[0]
+    }
+
+    #[test]
+    fn penalty_pushes_only_where_the_domain_reaches_past_the_line() {
+        // Reaches 0.05 m: 0.01 m past the line at y = 0.04 m.
+        assert_eq!(
+            contact([0.3, 0.06], [0.0, 0.0], CONTACT_SLIP, 0.0),
+            [0.0, 0.0]
+        );
+        let f = contact([0.3, 0.04], [0.0, 0.0], CONTACT_SLIP, 0.0);
+        // k pen 2 l_p = 1e6 · 0.01 · 0.1.
+        assert!((f[1] - 1e3).abs() < 1e-9 && f[0] == 0.0, "{f:?}");
+        // Approaching at 1 m/s adds the damping: WALL_DAMPING · 1 / w,
+        // w = γΔt S/m = 0.01 / 2.
+        let f = contact([0.3, 0.04], [0.0, -1.0], CONTACT_SLIP, 0.0);
+        assert!((f[1] - 1e3 - WALL_DAMPING * 200.0).abs() < 1e-9, "{f:?}");
+    }
+
+    #[test]
+    fn friction_is_coulomb_at_the_contact_point_and_stick_stops_the_slip() {
+        // Stopping 1 m/s of slip takes 1 / w = 200 N; μ F_n = 0.1 · 1e3.
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_FRICTION, 0.1);
+        assert!((f[0] + 100.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_FRICTION, 0.5);
+        assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_STICK, 0.0);
+        assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
+        let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_SLIP, 0.0);
+        assert_eq!(f[0], 0.0);
+    }
+
+    #[test]
+    fn gates_push_only_between_their_times() {
+        // Pressed 0.01 m into a gate there for 0.1 <= t < 0.5 s.
+        let at = |t| contact_at([0.3, 0.04], [0.0, 0.0], CONTACT_SLIP, 0.0, 0.1, 0.5, t);
+        assert_eq!(at(0.0), [0.0, 0.0]);
+        assert!((at(0.1)[1] - 1e3).abs() < 1e-9);
+        assert!((at(0.4999)[1] - 1e3).abs() < 1e-9);
+        assert_eq!(at(0.5), [0.0, 0.0]);
     }
 
     #[test]
@@ -371,47 +514,5 @@ mod tests {
         assert_eq!(local_damping([2.0, -2.0], [1.0, 1.0], 0.5), [1.0, -3.0]);
         assert_eq!(local_damping([2.0, -2.0], [0.0, 0.0], 0.5), [2.0, -2.0]);
         assert_eq!(local_damping([2.0, 0.0], [-1.0, 3.0], 0.5), [3.0, 0.0]);
-    }
-
-    #[test]
-    fn gates_act_between_their_times() {
-        let w = Wall {
-            name: "gate".into(),
-            point: [0.0, 0.0],
-            normal: N,
-            contact: CONTACT_SLIP,
-            mu: 0.0,
-            nodes: Vec::new(),
-            appear_at: 0.1,
-            remove_at: 0.5,
-        };
-        assert!(!w.active_at(0.0));
-        assert!(w.active_at(0.1));
-        assert!(w.active_at(0.4999));
-        assert!(!w.active_at(0.5));
-    }
-
-    #[test]
-    fn slip_removes_approach_only() {
-        assert_eq!(wall_velocity([1.0, -2.0], N, CONTACT_SLIP, 0.0), [1.0, 0.0]);
-        assert_eq!(wall_velocity([1.0, 2.0], N, CONTACT_SLIP, 0.0), [1.0, 2.0]);
-    }
-
-    #[test]
-    fn friction_is_coulomb() {
-        // Δv_n = 2, μ Δv_n = 1: a tangential speed of 3 loses 1, 0.5 stops.
-        assert_eq!(
-            wall_velocity([3.0, -2.0], N, CONTACT_FRICTION, 0.5),
-            [2.0, 0.0]
-        );
-        assert_eq!(
-            wall_velocity([-0.5, -2.0], N, CONTACT_FRICTION, 0.5),
-            [0.0, 0.0]
-        );
-        // Separating: untouched.
-        assert_eq!(
-            wall_velocity([3.0, 2.0], N, CONTACT_FRICTION, 0.5),
-            [3.0, 2.0]
-        );
     }
 }

@@ -40,9 +40,15 @@ pub struct CpuBackend {
     pub force: Vec<[f64; 2]>,
     /// Per constraint group: reaction (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
-    /// Per node: the walls it touches this step (`grid_update::wall_touch`);
+    /// Per node: the weight of the particles in contact with a wall this
+    /// step (`grid_update::wall_touch`); empty without walls.
+    pub wall_touch: Vec<f64>,
+    /// Per node: the walls' forces this step (`grid_update::wall_contact`);
     /// empty without walls.
-    pub wall_touch: Vec<u32>,
+    pub wall_force: Vec<[f64; 2]>,
+    /// Per node: the walls' preloads this step (`grid_update::wall_touch`);
+    /// empty unless some particle starts with one (`Walls::preload`).
+    pub wall_pre_force: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
     pub contact: Option<contact::ContactState>,
     p2g_scatter: Scatter<3>,
@@ -61,6 +67,22 @@ pub struct CpuBackend {
     final_step: bool,
 }
 
+/// The particles' fields the walls' contact reads, and the scene's full
+/// gravity (zero without).
+fn contact_particles<'a>(
+    p: &'a Particles,
+    gravity: Option<&crate::model::Gravity>,
+) -> grid_update::ContactParticles<'a> {
+    grid_update::ContactParticles {
+        x: &p.x,
+        mass: &p.mass,
+        rho: &p.rho,
+        stress: &p.stress,
+        v: &p.v,
+        gravity: gravity.map_or([0.0; 2], |g| g.g),
+    }
+}
+
 impl CpuBackend {
     pub fn new(model: Model) -> Self {
         let n = model.particles.len();
@@ -76,7 +98,17 @@ impl CpuBackend {
             wall_touch: if model.walls.is_empty() {
                 Vec::new()
             } else {
-                vec![0; nodes]
+                vec![0.0; nodes]
+            },
+            wall_force: if model.walls.is_empty() {
+                Vec::new()
+            } else {
+                vec![[0.0; 2]; nodes]
+            },
+            wall_pre_force: if model.walls.preload.is_empty() {
+                Vec::new()
+            } else {
+                vec![[0.0; 2]; nodes]
             },
             contact: model
                 .contact
@@ -151,11 +183,11 @@ impl CpuBackend {
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
         // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask,
-        // touch bits and node lists.
+        // contact weights, forces and node lists.
         let walls = if model.walls.is_empty() {
             0.0
         } else {
-            8.0 * model.grid.n_nodes() as f64
+            (4.0 + 8.0 + 16.0) * model.grid.n_nodes() as f64
                 + 4.0
                     * model
                         .walls
@@ -320,12 +352,11 @@ impl CpuBackend {
                 if !m.walls.is_empty() {
                     grid_update::wall_touch(
                         &self.cache,
-                        &p.x,
-                        &p.mass,
-                        &p.rho,
+                        &contact_particles(p, m.gravity.as_ref()),
                         &m.walls,
                         self.t,
                         &mut self.wall_touch,
+                        &mut self.wall_pre_force,
                     );
                 }
                 if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
@@ -346,8 +377,6 @@ impl CpuBackend {
                     &mut self.mv,
                     &m.constraints.fix,
                     &m.constraints.groups,
-                    &m.walls,
-                    &self.wall_touch,
                     self.t + self.dt,
                     self.mass_eps,
                 );
@@ -425,14 +454,31 @@ impl CpuBackend {
                 let (fixed, pairs) = self
                     .reactions
                     .split_at_mut(m.constraints.groups.len() + m.walls.list.len());
+                let (group_r, wall_r) = fixed.split_at_mut(m.constraints.groups.len());
+                if !m.walls.is_empty() {
+                    grid_update::wall_contact(
+                        &self.cache,
+                        &contact_particles(p, m.gravity.as_ref()),
+                        &self.mv,
+                        &self.force,
+                        &m.walls,
+                        self.t,
+                        &self.wall_touch,
+                        &self.wall_pre_force,
+                        &mut self.wall_force,
+                        wall_r,
+                        gamma * self.dt,
+                        (2.0 - gamma) * self.dt,
+                        self.mass_eps,
+                    );
+                }
                 grid_update::correct(
                     &mut self.mv,
                     &mut self.force,
                     &m.constraints.fix,
                     &m.constraints.groups,
-                    &m.walls,
-                    &self.wall_touch,
-                    fixed,
+                    &self.wall_force,
+                    group_r,
                     gamma * self.dt,
                     m.local_damping,
                     self.mass_eps,
@@ -483,14 +529,12 @@ impl CpuBackend {
                         &mut self.p2g_scatter,
                     );
                 }
-                // The walls' touch bits and the contacts stay those of the
-                // step's start (`GridPredict`), as on the GPU.
+                // The contacts stay those of the step's start
+                // (`GridPredict`).
                 grid_update::predict(
                     &mut self.mv,
                     &m.constraints.fix,
                     &m.constraints.groups,
-                    &m.walls,
-                    &self.wall_touch,
                     self.t + self.dt,
                     self.mass_eps,
                 );

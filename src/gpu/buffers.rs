@@ -63,9 +63,18 @@ pub enum Buf {
     /// (xx, xy, yx, yy; mls_strain.wgsl).
     MlsDl,
     Walls,
-    WallMask,
-    /// Per node: the walls it touches this step (wall_touch.wgsl).
+    /// Per node: the walls' forces this step (wall_contact.wgsl).
+    WallForce,
+    /// Per node: the weight of the particles in contact with a wall this
+    /// step (wall_touch.wgsl).
     WallTouch,
+    /// Per particle and wall: the preload traction of the particles that
+    /// start flush with a wall and compressed (`Walls::preload`); only
+    /// when some particle has one.
+    WallPreload,
+    /// Per node: the walls' preloads this step (wall_touch.wgsl), which
+    /// wall_contact.wgsl counts in the body's velocity; with `WallPreload`.
+    WallPreForce,
     ExtForce,
     /// MUSL: each particle's position at the step's start (grid-relative),
     /// for the remap and the stress, which run after g2p has moved it.
@@ -73,7 +82,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 39] = [
+    pub const ALL: [Buf; 41] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -109,8 +118,10 @@ impl Buf {
         Buf::MlsGrad,
         Buf::MlsDl,
         Buf::Walls,
-        Buf::WallMask,
+        Buf::WallForce,
         Buf::WallTouch,
+        Buf::WallPreload,
+        Buf::WallPreForce,
         Buf::ExtForce,
         Buf::XStart,
     ];
@@ -349,6 +360,8 @@ fn grid_and_output_data(
                 normal: f32x2(w.normal),
                 mu: w.mu as f32,
                 contact: w.contact,
+                stiffness: w.stiffness as f32,
+                offset: w.offset as f32,
                 appear_at: w.appear_at as f32,
                 // A finite "never" (WGSL may assume no infinities).
                 remove_at: if w.remove_at.is_finite() {
@@ -359,11 +372,13 @@ fn grid_and_output_data(
             })
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
-        data.push((
-            Buf::WallMask,
-            bytemuck::cast_slice(&model.walls.mask).to_vec(),
-        ));
+        data.push((Buf::WallForce, vec![0u8; 8 * g.n_nodes()]));
         data.push((Buf::WallTouch, vec![0u8; 4 * g.n_nodes()]));
+        if !model.walls.preload.is_empty() {
+            let pre: Vec<f32> = model.walls.preload.iter().map(|&t| t as f32).collect();
+            data.push((Buf::WallPreload, bytemuck::cast_slice(&pre).to_vec()));
+            data.push((Buf::WallPreForce, vec![0u8; 8 * g.n_nodes()]));
+        }
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
     let probe_idx = if probe_idx.is_empty() {

@@ -120,10 +120,14 @@ pub struct GpuWall {
     pub normal: [f32; 2],
     pub mu: f32,
     pub contact: u32,
+    /// Penalty stiffness k (Pa/m, `Wall::stiffness`).
+    pub stiffness: f32,
+    /// Contact line's offset (m, `Wall::offset`).
+    pub offset: f32,
     pub appear_at: f32,
     pub remove_at: f32,
 }
-const _: () = assert!(std::mem::size_of::<GpuWall>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuWall>() == 40);
 
 /// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
 pub const NODE_STRIDE: usize = 5;

@@ -83,11 +83,15 @@ pub struct Variant {
     /// `solver.mls_scope = "force"`: the fit corrects the internal force
     /// only (forces.wgsl built with MLS_FORCE, mls_fit, mls_force_gauss).
     pub mls_force: bool,
-    /// Rigid walls (the `Walls` and `WallMask` buffers).
+    /// Rigid walls (the `Walls`, `WallTouch` and `WallForce` buffers).
     pub walls: bool,
     /// Some wall appears or goes during the run (GATES: `wall_touch`
     /// compares the step's time with the wall's `appear_at`/`remove_at`).
     pub gates: bool,
+    /// Some particle starts flush with a wall and compressed across it
+    /// (WALL_PRELOAD: the `WallPreload` buffer, read with the stress by
+    /// `shared/wall_spring.wgsl`).
+    pub wall_preload: bool,
     /// `solver.pic_fraction` > 0 (PIC: `g2p` blends Σ N v_I in).
     pub pic: bool,
     /// `solver.local_damping` > 0 (LOCAL_DAMPING: `grid_update` built
@@ -131,6 +135,7 @@ impl Variant {
             mls_force: model.mls && model.mls_scope == crate::scene::MlsScope::Force,
             walls: !model.walls.is_empty(),
             gates: model.walls.timed(),
+            wall_preload: !model.walls.preload.is_empty(),
             pic: model.pic_fraction > 0.0,
             local_damping: model.local_damping > 0.0,
             ext_force: model.external.is_some(),
@@ -185,6 +190,7 @@ impl Variant {
             .flag("MLS_FORCE", self.mls_force)
             .flag("WALLS", self.walls)
             .flag("GATES", self.gates)
+            .flag("WALL_PRELOAD", self.wall_preload)
             .flag("PIC", self.pic)
             .flag("LOCAL_DAMPING", self.local_damping)
             .flag("EXT_FORCE", self.ext_force)
@@ -555,6 +561,7 @@ mod tests {
                                 mls_force: false,
                                 walls: mms,
                                 gates: mms,
+                                wall_preload: mms,
                                 pic: mms,
                                 local_damping: mms,
                                 ext_force: mms,

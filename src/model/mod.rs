@@ -238,7 +238,15 @@ impl Model {
         geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
         let constraints = build_constraints(scene, &grid)?;
-        let walls = Walls::new(scene, &grid)?;
+        let mut walls = Walls::new(scene, &grid)?;
+        let p_wave = materials
+            .iter()
+            .map(|m| {
+                let (l, mu) = m.lame_shear();
+                l + 2.0 * mu
+            })
+            .fold(0.0, f64::max);
+        walls.set_contact(p_wave, grid.h, &particles);
         check_not_behind_walls(&walls, &seeds, &body_names)?;
         let gravity = f.gravity.as_ref().map(|g| Gravity {
             g: g.g,

@@ -378,12 +378,10 @@ impl Disk<'_> {
         format!(
             "**Findings.** From Δt1 to Δt{}: {}. The explicit step is bounded by the Courant limit, far \
              below what the time integration's accuracy needs, so the error left is spatial, and most of it is \
-             the wall's grid contact. The wall acts only on the nodes that a particle touching the plane \
-             reaches (docs/methods.md, \"Walls\"), but at those nodes the rule is decided per node from its \
-             velocity: ahead of the contact the nodes approach and are held, behind it they lift off and are \
-             released, so the wall's normal force sits about a cell ahead of the contact point and acts as a \
-             rolling resistance of the order of h/R (first order in h on a grid-aligned floor, \
-             docs/methods.md; on this inclined plane see the finer run).{finer}\n\n",
+             the wall's contact. The wall acts at the contact points, the particles whose domain reaches past \
+             the plane, with a penalty normal force and Coulomb friction capped by it (docs/methods.md, \
+             \"Walls\"): the penalty's damping and the partial slip at the contact's edges, where the normal \
+             force is small, slow the disk a little, and the particles' lattice makes its rim a staircase.{finer}\n\n",
             last + 1,
             spread.join("; "),
         )
@@ -399,8 +397,8 @@ impl Disk<'_> {
             .map_or(0.0, |&(t, u)| u / self.exact.displacement(t)[0]);
         format!(
             "\nWith a `stick` wall instead (linear, Δt1) the disk {}: its centre covers {} % of the exact \
-             distance. A stick wall stops the nodes in contact that approach it and frees those that \
-             lift off, so the disk rolls on it as on the frictional wall.\n\n",
+             distance. A stick wall stops the slip at the contact points that press on it (Coulomb with \
+             μ = 20), so the disk rolls on it as on the frictional wall.\n\n",
             if r.completed() {
                 "completes"
             } else {

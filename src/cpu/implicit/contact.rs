@@ -147,6 +147,8 @@ mod tests {
             contact,
             mu: 0.5,
             nodes: Vec::new(),
+            stiffness: 0.0,
+            offset: 0.0,
             appear_at: 0.0,
             remove_at: f64::INFINITY,
         }

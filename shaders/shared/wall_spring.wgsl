@@ -1,0 +1,39 @@
+// The walls' contact spring, shared by `wall_touch.wgsl` and
+// `wall_contact.wgsl` (which declare `walls` and `mass`): the normal force
+// of particle p on wall k before damping, the penalty k pen 2 l_p (pen:
+// how far its domain reaches past the contact line, negative once clear)
+// plus, with WALL_PRELOAD, the preload of a particle that started flush
+// with the wall and compressed across it: 2 l_p (min(τ0, −σ_nn) +
+// ρ max(0, −g·n) d), its normal stress now (capped by the initial τ0) and the
+// weight of its material between its centre and the line (d:
+// `wall_depth`), times 2 l_p. In contact while positive.
+// CPU twins: `contact_spring` in src/cpu/grid_update.rs and
+// `preload_force` in src/model/walls.rs.
+#if WALL_PRELOAD
+@group(0) @binding({{B_STRESS}}) var<storage, read> stress: array<f32>;
+@group(0) @binding({{B_WALL_PRELOAD}}) var<storage, read> wall_preload: array<f32>;
+#endif
+
+// How far (m) the particle's centre is in front of the wall's line,
+// clamped to [0, l_p (|n_x| + |n_y|)]: where the wall's traction acts.
+fn wall_depth(x: vec2<f32>, lp: f32, w: Wall) -> f32 {
+    return clamp(dot(x - w.point, w.normal), 0.0, lp * (abs(w.normal.x) + abs(w.normal.y)));
+}
+
+// (spring force, preload) in N per unit thickness.
+fn contact_spring(p: u32, k: u32, w: Wall, x: vec2<f32>, lp: f32) -> vec2<f32> {
+    let pen = lp * (abs(w.normal.x) + abs(w.normal.y)) - dot(x - w.point, w.normal) - w.offset;
+    var pre = 0.0;
+#if WALL_PRELOAD
+    let tau0 = wall_preload[p * arrayLength(&walls) + k];
+    if tau0 > 0.0 {
+        let n = w.normal;
+        let snn = stress[3u * p] * n.x * n.x + 2.0 * stress[3u * p + 2u] * n.x * n.y
+            + stress[3u * p + 1u] * n.y * n.y;
+        let traction = min(tau0, max(-snn, 0.0));
+        let weight = max(-dot(params.gravity, n), 0.0);
+        pre = 2.0 * lp * traction + mass[p] * weight * wall_depth(x, lp, w) / (2.0 * lp);
+    }
+#endif
+    return vec2<f32>(w.stiffness * pen * 2.0 * lp + pre, pre);
+}
