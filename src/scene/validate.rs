@@ -570,33 +570,43 @@ fn check_walls(file: &SceneFile) -> Result<(), SceneError> {
                 format!("must have a non-zero length, got {:?}", w.normal),
             ));
         }
-        match (w.contact, w.friction) {
-            (Contact::Friction, None) => {
-                return Err(SceneError::invalid(
-                    format!("{key}.friction"),
-                    "is required with contact = \"friction\" (Coulomb's μ >= 0)",
-                ));
-            }
-            (Contact::Friction, Some(mu)) => {
-                finite(&format!("{key}.friction"), mu)?;
-                if mu < 0.0 {
-                    return Err(SceneError::invalid(
-                        format!("{key}.friction"),
-                        format!("must be >= 0, got {mu}"),
-                    ));
-                }
-            }
-            (_, Some(_)) => {
-                return Err(SceneError::invalid(
-                    format!("{key}.friction"),
-                    "is only read with contact = \"friction\"; drop it or set contact = \"friction\"",
-                ));
-            }
-            (_, None) => {}
-        }
+        check_friction(&key, "contact", w.contact, w.friction)?;
         check_gate(file, &key, w)?;
     }
     Ok(())
+}
+
+/// `KEY.friction` against `KEY.LAW_KEY` (a wall's `contact`, a pair's
+/// `law`): required and ≥ 0 with friction, refused otherwise.
+fn check_friction(
+    key: &str,
+    law_key: &str,
+    law: Contact,
+    friction: Option<f64>,
+) -> Result<(), SceneError> {
+    match (law, friction) {
+        (Contact::Friction, None) => Err(SceneError::invalid(
+            format!("{key}.friction"),
+            format!("is required with {law_key} = \"friction\" (Coulomb's μ >= 0)"),
+        )),
+        (Contact::Friction, Some(mu)) => {
+            finite(&format!("{key}.friction"), mu)?;
+            if mu < 0.0 {
+                return Err(SceneError::invalid(
+                    format!("{key}.friction"),
+                    format!("must be >= 0, got {mu}"),
+                ));
+            }
+            Ok(())
+        }
+        (_, Some(_)) => Err(SceneError::invalid(
+            format!("{key}.friction"),
+            format!(
+                "is only read with {law_key} = \"friction\"; drop it or set {law_key} = \"friction\""
+            ),
+        )),
+        (_, None) => Ok(()),
+    }
 }
 
 /// `[contact.NAME]`: two different bodies of the scene, each pair once,
@@ -632,30 +642,7 @@ fn check_contact(file: &SceneFile) -> Result<(), SceneError> {
             ));
         }
         seen.push(pair);
-        match (c.law, c.friction) {
-            (Contact::Friction, None) => {
-                return Err(SceneError::invalid(
-                    format!("{key}.friction"),
-                    "is required with law = \"friction\" (Coulomb's μ >= 0)",
-                ));
-            }
-            (Contact::Friction, Some(mu)) => {
-                finite(&format!("{key}.friction"), mu)?;
-                if mu < 0.0 {
-                    return Err(SceneError::invalid(
-                        format!("{key}.friction"),
-                        format!("must be >= 0, got {mu}"),
-                    ));
-                }
-            }
-            (_, Some(_)) => {
-                return Err(SceneError::invalid(
-                    format!("{key}.friction"),
-                    "is only read with law = \"friction\"; drop it or set law = \"friction\"",
-                ));
-            }
-            (_, None) => {}
-        }
+        check_friction(&key, "law", c.law, c.friction)?;
         if file.solver.integrator == IntegratorKind::Implicit {
             return Err(SceneError::invalid(
                 key,
