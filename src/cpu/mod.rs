@@ -196,7 +196,16 @@ impl CpuBackend {
                         .map(|w| w.nodes.len())
                         .sum::<usize>() as f64
         };
-        per + (model.grid.n_nodes() as f64 * 40.0 + walls) / n
+        // Contact pairs: one copy of the nodes per field, and per field node
+        // the mass gradient and volume (24), per pair node normal and gap (24).
+        let fields = model.n_fields() as f64;
+        let pairs = model.contact.as_ref().map_or(0, |c| c.pairs.len()) as f64;
+        let contact = if model.contact.is_some() {
+            model.grid.n_nodes() as f64 * (24.0 * fields + 24.0 * pairs)
+        } else {
+            0.0
+        };
+        per + (model.grid.n_nodes() as f64 * 40.0 * fields + walls + contact) / n
     }
 
     /// Time step the next `step` would take (s).
