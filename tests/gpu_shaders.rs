@@ -410,10 +410,7 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("FAULT_LME_NOT_CONVERGED", u(l::FAULT_LME_NOT_CONVERGED)),
         ("FAULT_LME_SINGULAR", u(l::FAULT_LME_SINGULAR)),
         ("FAULT_MLS_SINGULAR", u(l::FAULT_MLS_SINGULAR)),
-        (
-            "FAULT_RETURN_NOT_CONVERGED",
-            u(l::FAULT_RETURN_NOT_CONVERGED),
-        ),
+        ("FAULT_MATERIAL", u(l::FAULT_MATERIAL)),
         ("CONTACT_STICK", u(lme_mpm::model::walls::CONTACT_STICK)),
         ("CONTACT_SLIP", u(lme_mpm::model::walls::CONTACT_SLIP)),
         (

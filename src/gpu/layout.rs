@@ -150,8 +150,9 @@ pub const FAULT_LME_NOT_CONVERGED: u32 = 7;
 pub const FAULT_LME_SINGULAR: u32 = 8;
 /// The index field holds the Gauss point, not a particle.
 pub const FAULT_MLS_SINGULAR: u32 = 9;
-/// A material's implicit stress return did not converge.
-pub const FAULT_RETURN_NOT_CONVERGED: u32 = 10;
+/// The first code of the material models' own faults (codes
+/// `FAULT_MATERIAL..16`, `Constitutive::FAULTS` in order).
+pub const FAULT_MATERIAL: u32 = crate::model::material::registry::GPU_FAULT_BASE;
 
 /// Splits an f64 into a two-float sum hi + lo (for times in f32).
 pub fn split_f64(v: f64) -> (f32, f32) {

@@ -303,49 +303,10 @@ impl GpuBackend {
         self.fresh = false;
     }
 
-    fn fault_of(&self, word: u32) -> Fault {
-        let particle = (word >> 4) as usize;
-        if word & 0xf == FAULT_MLS_SINGULAR {
-            let at = crate::model::gauss::gauss_point_position(
-                &self.model.shape,
-                &self.model.grid,
-                particle,
-            );
-            return Fault {
-                particle: None,
-                kind: FaultKind::MlsSingular { at },
-            };
-        }
-        let kind = match word & 0xf {
-            FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
-            FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
-            FAULT_NON_FINITE_STRESS => FaultKind::NonFinite { field: "stress" },
-            FAULT_NON_FINITE_MOTION => FaultKind::NonFinite {
-                field: "position or velocity",
-            },
-            FAULT_DENSITY => FaultKind::NonPositiveDensity,
-            FAULT_LME_FEW_NODES => FaultKind::Shape(ShapeFault::LmeTooFewNodes { nodes: None }),
-            FAULT_LME_NOT_CONVERGED => FaultKind::Shape(ShapeFault::LmeNotConverged {
-                iterations: self.params.lme_max_iter,
-                residual: None,
-            }),
-            FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
-            // The shader does not report its residual.
-            FAULT_RETURN_NOT_CONVERGED => FaultKind::ReturnNotConverged { residual: f64::NAN },
-            code => FaultKind::NonFinite {
-                field: if code == 0 {
-                    "unknown (fault code 0)"
-                } else {
-                    "unknown fault code"
-                },
-            },
-        };
-        Fault::at(particle, kind)
-    }
-
     /// The fault the device recorded, if any.
     pub fn fault(&self) -> Option<Fault> {
-        (self.sim.fault != FAULT_NONE).then(|| self.fault_of(self.sim.fault))
+        (self.sim.fault != FAULT_NONE)
+            .then(|| decode_fault(&self.model, self.params.lme_max_iter, self.sim.fault))
     }
 
     fn t(&self) -> f64 {
@@ -662,4 +623,55 @@ impl ReadBack {
     pub fn sim(&self) -> Sim {
         bytemuck::pod_read_unaligned(&self.bytes(Buf::Sim)[..std::mem::size_of::<Sim>()])
     }
+}
+
+/// The fault of `Sim::fault`'s `word` ((index << 4) | code) for `model`:
+/// the solver's codes of `layout`, and from `FAULT_MATERIAL` on the faults
+/// the faulting particle's material declares (`Constitutive::FAULTS`).
+/// `lme_max_iter` is the scene's LME Newton limit (its fault's message).
+pub fn decode_fault(model: &Model, lme_max_iter: u32, word: u32) -> Fault {
+    let particle = (word >> 4) as usize;
+    if word & 0xf == FAULT_MLS_SINGULAR {
+        let at = crate::model::gauss::gauss_point_position(&model.shape, &model.grid, particle);
+        return Fault {
+            particle: None,
+            kind: FaultKind::MlsSingular { at },
+        };
+    }
+    let kind = match word & 0xf {
+        FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
+        FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
+        FAULT_NON_FINITE_STRESS => FaultKind::NonFinite { field: "stress" },
+        FAULT_NON_FINITE_MOTION => FaultKind::NonFinite {
+            field: "position or velocity",
+        },
+        FAULT_DENSITY => FaultKind::NonPositiveDensity,
+        FAULT_LME_FEW_NODES => FaultKind::Shape(ShapeFault::LmeTooFewNodes { nodes: None }),
+        FAULT_LME_NOT_CONVERGED => FaultKind::Shape(ShapeFault::LmeNotConverged {
+            iterations: lme_max_iter,
+            residual: None,
+        }),
+        FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+        // The material's own fault, through the particle's material;
+        // the shader does not report its figure.
+        code if code >= FAULT_MATERIAL && particle < model.particles.len() => {
+            match model.material_of(particle).entry().fault_of_gpu_code(code) {
+                Some(fault) => FaultKind::Material {
+                    fault,
+                    value: f64::NAN,
+                },
+                None => FaultKind::NonFinite {
+                    field: "unknown material fault code",
+                },
+            }
+        }
+        code => FaultKind::NonFinite {
+            field: if code == 0 {
+                "unknown (fault code 0)"
+            } else {
+                "unknown fault code"
+            },
+        },
+    };
+    Fault::at(particle, kind)
 }
