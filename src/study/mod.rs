@@ -5,6 +5,7 @@
 
 pub mod block;
 pub mod column;
+pub mod contact;
 pub mod disk;
 pub mod dyka;
 pub mod implicit;
@@ -49,6 +50,10 @@ pub enum StudyName {
     /// bar and the rolling disk, error against wall time per case, and the
     /// Newton iteration's cost split (CPU only).
     Implicit,
+    /// Contact between bodies: block on a slab (μ = 0–0.7), two disks
+    /// colliding head-on and off-centre, a disk rolling on an elastic slab
+    /// (R/h = 10–40), each beside the single shared field (CPU; about 20 minutes, --quick about 1).
+    Contact,
     /// All of them, in that order.
     All,
 }
@@ -64,6 +69,7 @@ impl StudyName {
             StudyName::Disk => "disk",
             StudyName::Column => "column",
             StudyName::Implicit => "implicit",
+            StudyName::Contact => "contact",
             StudyName::All => "all",
         }
     }
@@ -139,6 +145,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk,
             StudyName::Column,
             StudyName::Implicit,
+            StudyName::Contact,
         ],
         n => vec![n],
     };
@@ -156,6 +163,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::jobs(opts.quick, &backends),
             StudyName::Column => column::jobs(opts.quick, &backends),
             StudyName::Implicit => implicit::jobs(opts.quick),
+            StudyName::Contact => contact::jobs(opts.quick, &backends),
             StudyName::All => unreachable!(),
         };
         if opts.progress || opts.progress_lines {
@@ -182,6 +190,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
+            StudyName::Contact => contact::report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
         // The charts sit beside report.md; the markdown links them in
