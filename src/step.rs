@@ -577,4 +577,59 @@ mod tests {
             assert_eq!(p.gpu_uses(Pass::WallTouch), p.inputs.walls, "{bits:05b}");
         }
     }
+
+    /// Contact pairs add their passes where the CPU does its work (detect
+    /// before `predict`, the exchange after it, after `correct` and after
+    /// MUSL's remap) and the binning in `shape_eval`; without pairs the
+    /// step is the same, pass for pass.
+    #[test]
+    fn contact_pairs_add_their_passes_only_with_pairs() {
+        let contact_passes = [
+            Pass::ContactGrad,
+            Pass::ContactDetect,
+            Pass::ContactExchange,
+            Pass::ContactExchangeForce,
+        ];
+        for musl in [false, true] {
+            for walls in [false, true] {
+                let base = PlanInputs {
+                    lme: false,
+                    mls: false,
+                    mls_force: false,
+                    musl,
+                    gather: false,
+                    patch: false,
+                    walls,
+                    contact: false,
+                };
+                let without = StepPlan::new(base);
+                let with = StepPlan::new(PlanInputs {
+                    contact: true,
+                    ..base
+                });
+                for pass in contact_passes {
+                    assert!(!without.gpu_uses(pass), "{pass:?}");
+                    assert!(with.gpu_step.contains(&pass), "{pass:?}");
+                }
+                let at = |p: Pass| with.gpu_step.iter().position(|x| *x == p).unwrap();
+                assert!(at(Pass::BinFill) < at(Pass::P2g));
+                assert!(at(Pass::P2g) < at(Pass::ContactGrad));
+                assert!(at(Pass::ContactDetect) < at(Pass::GridPredict));
+                assert!(at(Pass::GridPredict) < at(Pass::ContactExchange));
+                assert!(at(Pass::GridCorrect) < at(Pass::ContactExchangeForce));
+                assert!(at(Pass::ContactExchangeForce) < at(Pass::G2p));
+                if musl {
+                    let remap = with.passes_for(Stage::Remap);
+                    assert_eq!(remap.last(), Some(&Pass::ContactExchange));
+                }
+                let stripped: Vec<Pass> = with
+                    .gpu_step
+                    .iter()
+                    .copied()
+                    .filter(|p| !contact_passes.contains(p) && !BINS.contains(p))
+                    .collect();
+                assert_eq!(stripped, without.gpu_step);
+            }
+        }
+    }
 }
