@@ -129,6 +129,21 @@ pub struct GpuWall {
 }
 const _: () = assert!(std::mem::size_of::<GpuWall>() == 40);
 
+/// A contact pair (shaders/shared/contact.wgsl `ContactPair`): the fields
+/// of its first and second body, its law (`model::walls::CONTACT_*`),
+/// Coulomb μ (friction only) and the index of its reaction in
+/// `Buf::Reactions` (after the constraint groups' and the walls').
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuContactPair {
+    pub fields: [u32; 2],
+    pub law: u32,
+    pub mu: f32,
+    pub reaction: u32,
+    pub _pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<GpuContactPair>() == 24);
+
 /// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
 pub const NODE_STRIDE: usize = 5;
 /// Floats per probe in the probe buffer.

@@ -70,13 +70,6 @@ impl GpuBackend {
             )
             .into());
         }
-        if model.contact.is_some() {
-            return Err(crate::error::SceneError::invalid(
-                "contact",
-                "pairs run on the CPU path only for now (--backend cpu or auto)",
-            )
-            .into());
-        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
@@ -186,21 +179,46 @@ impl GpuBackend {
         Ok(self.read(&[Buf::Sim])?.sim())
     }
 
-    /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32).
+    /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32), every
+    /// field's nodes in turn with contact pairs (as the CPU's `mv`).
     pub fn read_nodes(&self) -> Result<Vec<[f32; NODE_STRIDE]>> {
         let b = self.read(&[Buf::NodeAcc])?;
         Ok(b.f32s(Buf::NodeAcc)
             .chunks_exact(NODE_STRIDE)
-            .take(self.buffers.n_nodes)
+            .take(self.buffers.n_nodes * self.buffers.n_fields)
             .map(|c| c.try_into().expect("chunk of NODE_STRIDE"))
             .collect())
     }
 
-    /// Reactions per constraint group then per wall, as last computed on the device.
+    /// Reactions per constraint group, then per wall, then per contact
+    /// pair, as last computed on the device.
     pub fn read_reactions(&self) -> Result<Vec<[f64; 2]>> {
         Ok(self
             .read(&[Buf::Reactions])?
-            .pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls))
+            .pairs(Buf::Reactions, self.n_reactions()))
+    }
+
+    fn n_reactions(&self) -> usize {
+        self.buffers.n_groups + self.buffers.n_walls + self.buffers.n_pairs
+    }
+
+    /// Contact pairs' detection as last computed on the device: per pair
+    /// and grid node (`pair · n_nodes + node`), the normal (zero where the
+    /// pair is not in contact) and the gap (m; `None` where none was
+    /// measured), as the CPU's `contact::ContactState`. Empty without pairs.
+    pub fn read_contact(&self) -> Result<Vec<([f64; 2], Option<f64>)>> {
+        if self.buffers.n_pairs == 0 {
+            return Ok(Vec::new());
+        }
+        let b = self.read(&[Buf::ContactNormal])?;
+        Ok(b.f32s(Buf::ContactNormal)
+            .chunks_exact(3)
+            .take(self.buffers.n_pairs * self.buffers.n_nodes)
+            .map(|c| {
+                let gap = (c[2] < f32::MAX).then_some(c[2] as f64);
+                ([c[0] as f64, c[1] as f64], gap)
+            })
+            .collect())
     }
 
     /// Sets the device's stop time (`Sim::t_stop_hi`, `t_stop_lo`: adjacent
@@ -508,7 +526,7 @@ impl Backend for GpuBackend {
                 strain: e[1] as f64,
                 gravity_work_bound: e[2] as f64,
             },
-            reactions: b.pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls),
+            reactions: b.pairs(Buf::Reactions, self.n_reactions()),
             newton: None,
         })
     }
