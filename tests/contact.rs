@@ -57,9 +57,10 @@ fn ramp_integral(t: f64, period: f64) -> f64 {
 }
 
 /// Relative velocity while sliding against g (sin θ − μ cos θ) R(t): the
-/// issue's 3 %. Measured (h = 0.05, linear, NPC): μ = 0.2 −0.11 % at
-/// 0.5 s, μ = 0 −0.03 %, μ = 0.4 −1.7 % (the block's elastic bounce
-/// modulates the normal force and so the friction, as on a wall).
+/// issue's 3 %. Measured (h = 0.05, linear, NPC, `lme-mpm study contact`
+/// 2026-11-25): μ = 0.2 −0.21 % at 0.5 s, μ = 0 −0.12 %, μ = 0.4 +0.56 %
+/// (the block's elastic bounce modulates the normal force and so the
+/// friction, as on a wall).
 const SLIDING_TOL: f64 = 0.03;
 /// At rest (μ > tan θ): the relative speed over the frictionless g sin θ
 /// R(t). Measured 2e-4.
