@@ -11,19 +11,13 @@ use lme_mpm::cpu::CpuBackend;
 use lme_mpm::gpu::GpuBackend;
 use lme_mpm::model::Model;
 use lme_mpm::scene::Scene;
+use lme_mpm::study::contact::{BodyMotion, body_motion, one_field, overlap};
 
 /// Mass-weighted mean velocity of each body (scene order).
 fn body_velocities(b: &mut dyn Backend) -> Vec<[f64; 2]> {
     let n = b.model().body_names.len();
-    let mut acc = vec![[0.0; 3]; n];
     let p = b.particles().unwrap();
-    for i in 0..p.len() {
-        let a = &mut acc[p.body[i] as usize];
-        a[0] += p.mass[i];
-        a[1] += p.mass[i] * p.v[i][0];
-        a[2] += p.mass[i] * p.v[i][1];
-    }
-    acc.iter().map(|a| [a[1] / a[0], a[2] / a[0]]).collect()
+    body_motion(p, n).iter().map(|m| m.v).collect()
 }
 
 /// (t, velocity of each body) every `every` s up to t_end, on the CPU.
@@ -143,17 +137,7 @@ fn block_on_a_slab_on_gpu() {
 #[test]
 fn one_shared_field_glues_the_block_to_the_slab() {
     // The same scene without the pair: one velocity field, no slip.
-    let text = std::fs::read_to_string(common::case("contact_block.toml")).unwrap();
-    let start = text.find("[contact.interface]").unwrap();
-    let end = start + text[start..].find("\n\n").unwrap();
-    let glued = format!("{}{}", &text[..start], &text[end..]);
-    let scene = Scene::from_str(
-        &glued,
-        "glued",
-        "glued",
-        &[lme_mpm::scene::Override::parse("solver.t_end=0.2").unwrap()],
-    )
-    .unwrap();
+    let scene = without_contact("contact_block.toml", "interface", &["solver.t_end=0.2"]);
     let (t, v) = history(&scene, 0.2).pop().unwrap();
     let rel = v[0][0] - v[1][0];
     println!(
@@ -163,80 +147,10 @@ fn one_shared_field_glues_the_block_to_the_slab() {
     assert!(rel.abs() < 0.05 * exact_rel(0.2, t), "{rel}");
 }
 
-/// Per body (scene order): mass, centre of mass, its velocity, and the
-/// angular velocity about it, Σ m (r × v) / Σ m |r|² (rad/s).
-#[derive(Debug, Clone, Copy)]
-struct Rigid {
-    mass: f64,
-    centre: [f64; 2],
-    v: [f64; 2],
-    omega: f64,
-}
-
-fn rigid(b: &mut CpuBackend) -> Vec<Rigid> {
-    let m = b.model();
-    let p = &m.particles;
-    let n = m.body_names.len();
-    let mut out = vec![
-        Rigid {
-            mass: 0.0,
-            centre: [0.0; 2],
-            v: [0.0; 2],
-            omega: 0.0
-        };
-        n
-    ];
-    for i in 0..p.len() {
-        let r = &mut out[p.body[i] as usize];
-        let mi = p.mass[i];
-        r.mass += mi;
-        for d in 0..2 {
-            r.centre[d] += mi * p.x[i][d];
-            r.v[d] += mi * p.v[i][d];
-        }
-    }
-    for r in &mut out {
-        for d in 0..2 {
-            r.centre[d] /= r.mass;
-            r.v[d] /= r.mass;
-        }
-    }
-    let mut ang = vec![[0.0; 2]; n];
-    for i in 0..p.len() {
-        let b = p.body[i] as usize;
-        let r = [p.x[i][0] - out[b].centre[0], p.x[i][1] - out[b].centre[1]];
-        let v = [p.v[i][0] - out[b].v[0], p.v[i][1] - out[b].v[1]];
-        ang[b][0] += p.mass[i] * (r[0] * v[1] - r[1] * v[0]);
-        ang[b][1] += p.mass[i] * (r[0] * r[0] + r[1] * r[1]);
-    }
-    for (r, a) in out.iter_mut().zip(ang) {
-        r.omega = a[0] / a[1];
-    }
-    out
-}
-
-/// Overlap of the two bodies' particle domains along the line of their
-/// centres (m; negative: apart).
-fn overlap(b: &mut CpuBackend, r: &[Rigid]) -> f64 {
-    let m = b.model();
-    let p = &m.particles;
-    let d = [
-        r[1].centre[0] - r[0].centre[0],
-        r[1].centre[1] - r[0].centre[1],
-    ];
-    let len = d[0].hypot(d[1]);
-    let u = [d[0] / len, d[1] / len];
-    let (mut reach0, mut reach1) = (f64::NEG_INFINITY, f64::INFINITY);
-    for i in 0..p.len() {
-        let l = 0.5 * (p.mass[i] / p.rho[i]).sqrt();
-        let s = p.x[i][0] * u[0] + p.x[i][1] * u[1];
-        if p.body[i] == 0 {
-            reach0 = reach0.max(s + l);
-        } else {
-            reach1 = reach1.min(s - l);
-        }
-    }
-    reach0 - reach1
+/// Each body's motion (scene order), from the library's study helper.
+fn rigid(b: &mut CpuBackend) -> Vec<BodyMotion> {
+    let n = b.model().body_names.len();
+    body_motion(&b.model().particles, n)
 }
 
 /// The collision's figures: first time the pair's reaction is non-zero,
@@ -244,7 +158,7 @@ fn overlap(b: &mut CpuBackend, r: &[Rigid]) -> f64 {
 struct Collision {
     onset: Option<f64>,
     max_overlap: f64,
-    end: Vec<Rigid>,
+    end: Vec<BodyMotion>,
     momentum_drift: f64,
 }
 
@@ -266,7 +180,7 @@ fn collide(scene: &Scene) -> Collision {
             onset = Some(t0);
         }
         let r = rigid(&mut b);
-        max_overlap = max_overlap.max(overlap(&mut b, &r));
+        max_overlap = max_overlap.max(overlap(&b.model().particles, &r));
         let p = [
             r[0].mass * r[0].v[0] + r[1].mass * r[1].v[0],
             r[0].mass * r[0].v[1] + r[1].mass * r[1].v[1],
@@ -281,17 +195,14 @@ fn collide(scene: &Scene) -> Collision {
     }
 }
 
-/// The scene `name` without its `[contact.*]` table: one shared field.
+/// The scene `name` without its `[contact.<table>]` table: one shared field.
 fn without_contact(name: &str, table: &str, sets: &[&str]) -> Scene {
     let text = std::fs::read_to_string(common::case(name)).unwrap();
-    let start = text.find(table).unwrap();
-    let end = start + text[start..].find("\n\n").unwrap();
-    let one = format!("{}{}", &text[..start], &text[end..]);
     let o: Vec<_> = sets
         .iter()
         .map(|s| lme_mpm::scene::Override::parse(s).unwrap())
         .collect();
-    Scene::from_str(&one, "one field", "one_field", &o).unwrap()
+    Scene::from_str(&one_field(&text, table), "one field", "one_field", &o).unwrap()
 }
 
 /// Line of centres at impact in `contact_disks.toml` (30° off x) and its
@@ -333,11 +244,7 @@ fn frictionless_disks_bounce_apart_head_on() {
 #[test]
 fn frictionless_disks_off_centre_against_one_shared_field() {
     let c = collide(&common::scene("contact_disks.toml", &[]));
-    let one = collide(&without_contact(
-        "contact_disks.toml",
-        "[contact.impact]",
-        &[],
-    ));
+    let one = collide(&without_contact("contact_disks.toml", "impact", &[]));
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     for (name, c) in [("contact pair", &c), ("one field", &one)] {
         let [l, r] = [c.end[0], c.end[1]];

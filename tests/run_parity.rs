@@ -743,14 +743,10 @@ const CONTACT_DISKS_TOL: f64 = 5e-2;
 /// Mass-weighted mean velocity of each body.
 fn body_means(p: &Particles) -> Vec<[f64; 2]> {
     let n = p.body.iter().max().map_or(0, |b| *b as usize + 1);
-    let mut acc = vec![[0.0; 3]; n];
-    for i in 0..p.len() {
-        let a = &mut acc[p.body[i] as usize];
-        a[0] += p.mass[i];
-        a[1] += p.mass[i] * p.v[i][0];
-        a[2] += p.mass[i] * p.v[i][1];
-    }
-    acc.iter().map(|a| [a[1] / a[0], a[2] / a[0]]).collect()
+    lme_mpm::study::contact::body_motion(p, n)
+        .iter()
+        .map(|m| m.v)
+        .collect()
 }
 
 #[test]
