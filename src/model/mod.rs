@@ -2,6 +2,7 @@
 //! constraints, loads and solver settings, built from a checked `Scene`.
 //! Everything here is backend-neutral; `cpu::` and `gpu::` step it.
 
+pub mod constraint_points;
 pub mod contact;
 pub mod energy;
 pub mod fault;
@@ -15,6 +16,7 @@ pub mod shape;
 pub mod time_step;
 pub mod walls;
 
+pub use constraint_points::ConstraintPoint;
 pub use contact::Contacts;
 pub use grid::Grid;
 pub use loads::{AlignedVibration, ExternalForces, Gravity};
@@ -63,12 +65,16 @@ impl ConstraintGroup {
     }
 }
 
-/// Dirichlet nodes (zero or prescribed velocity).
+/// Dirichlet nodes (zero or prescribed velocity), and the points where a
+/// region's edge inside the grid holds the body (`constraint_points`).
 #[derive(Debug, Clone, Default)]
 pub struct Constraints {
     /// Per node: `FIX_X | FIX_Y` bits (0 = free).
     pub fix: Vec<u8>,
     pub groups: Vec<ConstraintGroup>,
+    /// Empty unless some group's edge lies inside the grid where nodes
+    /// outside its region reach it.
+    pub points: Vec<ConstraintPoint>,
 }
 
 /// Time integrator with its parameters.
@@ -237,7 +243,8 @@ impl Model {
         }
         geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
-        let constraints = build_constraints(scene, &grid)?;
+        let mut constraints = build_constraints(scene, &grid)?;
+        constraint_points::place(scene, &grid, &shape, &particles, &mut constraints)?;
         let mut walls = Walls::new(scene, &grid)?;
         let p_wave = materials
             .iter()
@@ -571,6 +578,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
     let mut c = Constraints {
         fix: vec![0; grid.n_nodes()],
         groups: Vec::new(),
+        points: Vec::new(),
     };
     // Membership is tested on the unperturbed lattice position, so a
     // perturbed grid fixes the same nodes as the regular one.
