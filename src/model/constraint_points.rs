@@ -1,21 +1,23 @@
 //! Constraint points: a constraint holds the body where its region's edge
 //! is, not only at the grid nodes inside the region. Where an edge of a
-//! `[constraints.NAME]` region lies inside the grid and inside the body,
-//! points are placed along it (two per cell, at the Gauss points of the
-//! edge's stretch in each cell), each with the shape functions' weights
-//! N_a(x_b) on the unperturbed grid's nodes. When some node outside the
-//! region weighs on a point (B-splines and LME, whose supports reach
-//! across the edge; linear and uGIMP only on an edge between node lines),
-//! the group holds its points instead of the region's nodes that weigh on
-//! them (LME excepted: see `place`): those nodes are freed, and the backends impose Σ_a N_a(x_b) v_a =
-//! v̄ at every point (`cpu::constraint_points` by a mass-weighted
-//! projection, the implicit step by a penalty; docs/methods.md,
-//! "Constraints at their place"). A group whose points no outside node
-//! reaches (an edge on a node line with linear shapes, or on the grid's
-//! edge) gets no points and runs as before.
+//! `[constraints.NAME]` region (of some width, with no particle in it at
+//! t = 0: a support beside the body, as a clamp) lies inside the grid and
+//! on the body, points are placed along it (two per cell, at the Gauss
+//! points of the edge's stretch in each cell), each with the shape
+//! functions' weights N_a(x_b) on the unperturbed grid's nodes. When some
+//! node outside the region weighs on a point (B-splines, whose supports
+//! reach across the edge; linear and uGIMP only on an edge between node
+//! lines), the group holds its points instead of the region's nodes that
+//! weigh on them: those nodes are freed, and the backends impose
+//! Σ_a N_a(x_b) v_a = v̄ at every point (`cpu::constraint_points` by a
+//! mass-weighted projection, the implicit step by a penalty;
+//! docs/methods.md, "Constraints at their place"). A group whose points no
+//! outside node reaches (an edge on a node line with linear shapes, or on
+//! the grid's edge), a pin line, a region holding particles and LME (see
+//! `place`) keep their nodes and run as before.
 
 use super::shape::{Shape, linear};
-use super::{Constraints, Grid, Particles};
+use super::{Grid, Particles};
 use crate::error::SceneError;
 use crate::scene::Scene;
 use std::collections::HashMap;
@@ -43,35 +45,56 @@ pub struct ConstraintPoint {
     pub n: Vec<f64>,
 }
 
-/// Places the points of every group that needs them and frees the
-/// region's nodes they replace (`Constraints::fix` and each group's
-/// `nodes` are rebuilt). `particles` at t = 0 say where the body is.
+/// The points of every group that needs them, and per group the region's
+/// nodes they free (sorted; the caller drops them from the group and its
+/// fixed bits: `Constraints::hold_at`).
+#[derive(Debug, Clone, Default)]
+pub struct Placement {
+    pub points: Vec<ConstraintPoint>,
+    pub freed: Vec<Vec<u32>>,
+}
+
+/// Places the points of every group that needs them; `groups` holds each
+/// group's region nodes and fixed bits, in scene order. `particles` at
+/// t = 0 say where the body is.
 pub fn place(
     scene: &Scene,
     grid: &Grid,
     shape: &Shape,
     particles: &Particles,
-    c: &mut Constraints,
-) -> Result<(), SceneError> {
+    groups: &[(&[u32], u8)],
+) -> Result<Placement, SceneError> {
+    let mut out = Placement {
+        points: Vec::new(),
+        freed: vec![Vec::new(); groups.len()],
+    };
     if matches!(shape, Shape::Lme(_)) {
         // LME keeps the region's nodes: freed, they let the field bend in
         // the strip between the edge and the first particles, which no
-        // particle samples (the stiff cantilever came out 3.1 times too
+        // particle samples (the stiff cantilever came out 3.2 times too
         // soft), while held they already hold the edge (0.09 % from the
         // grid-edge run; docs/methods.md).
-        return Ok(());
+        return Ok(out);
     }
     let mut body: Option<BodyCells> = None;
-    let mut freed: Vec<Vec<u32>> = vec![Vec::new(); c.groups.len()];
     for (g, (name, spec)) in scene.file.constraints.iter().enumerate() {
         let key = || format!("constraints.{name}");
+        // A region that is a line (a pin inside a body) or that holds
+        // particles keeps its nodes: they hold what lies in it.
+        let eps = 1e-9 * grid.h;
+        let inside =
+            |x: &[f64; 2]| (0..2).all(|a| x[a] > spec.min[a] + eps && x[a] < spec.max[a] - eps);
+        if (0..2).any(|a| spec.max[a] - spec.min[a] <= eps) || particles.x.iter().any(inside) {
+            continue;
+        }
         let xs = edge_points(spec.min, spec.max, grid);
         if xs.is_empty() {
             continue;
         }
+        let (region, fix) = groups[g];
         let body = body.get_or_insert_with(|| BodyCells::new(grid, particles));
         let mut in_region = vec![false; grid.n_nodes()];
-        for &n in &c.groups[g].nodes {
+        for &n in region {
             in_region[n as usize] = true;
         }
         let mut pts = Vec::new();
@@ -90,7 +113,7 @@ pub fn place(
             pts.push(ConstraintPoint {
                 group: g as u32,
                 x,
-                fix: c.groups[g].fix,
+                fix,
                 nodes,
                 n,
             });
@@ -101,27 +124,15 @@ pub fn place(
         for p in &pts {
             for (&a, &w) in p.nodes.iter().zip(&p.n) {
                 if in_region[a as usize] && w != 0.0 {
-                    freed[g].push(a);
+                    out.freed[g].push(a);
                 }
             }
         }
-        c.points.extend(pts);
+        out.freed[g].sort_unstable();
+        out.freed[g].dedup();
+        out.points.extend(pts);
     }
-    if c.points.is_empty() {
-        return Ok(());
-    }
-    for (group, mut f) in c.groups.iter_mut().zip(freed) {
-        f.sort_unstable();
-        f.dedup();
-        group.nodes.retain(|n| f.binary_search(n).is_err());
-    }
-    c.fix.fill(0);
-    for group in &c.groups {
-        for &n in &group.nodes {
-            c.fix[n as usize] |= group.fix;
-        }
-    }
-    Ok(())
+    Ok(out)
 }
 
 /// Points along the edges of the region [`min`, `max`] (m) that lie

@@ -77,6 +77,27 @@ pub struct Constraints {
     pub points: Vec<ConstraintPoint>,
 }
 
+impl Constraints {
+    /// Takes `placed`'s points: each group drops the region nodes they
+    /// free, and the fixed bits are rebuilt from the groups (no points:
+    /// nothing changes).
+    pub fn hold_at(&mut self, placed: constraint_points::Placement) {
+        if placed.points.is_empty() {
+            return;
+        }
+        for (group, freed) in self.groups.iter_mut().zip(&placed.freed) {
+            group.nodes.retain(|n| freed.binary_search(n).is_err());
+        }
+        self.fix.fill(0);
+        for group in &self.groups {
+            for &n in &group.nodes {
+                self.fix[n as usize] |= group.fix;
+            }
+        }
+        self.points = placed.points;
+    }
+}
+
 /// Time integrator with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Integrator {
@@ -244,7 +265,13 @@ impl Model {
         geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
         let mut constraints = build_constraints(scene, &grid)?;
-        constraint_points::place(scene, &grid, &shape, &particles, &mut constraints)?;
+        let regions: Vec<(&[u32], u8)> = constraints
+            .groups
+            .iter()
+            .map(|g| (&g.nodes[..], g.fix))
+            .collect();
+        let placed = constraint_points::place(scene, &grid, &shape, &particles, &regions)?;
+        constraints.hold_at(placed);
         let mut walls = Walls::new(scene, &grid)?;
         let p_wave = materials
             .iter()
