@@ -6,7 +6,8 @@
 //! nodes with mass whose component is free,
 //!   Δv = M⁻¹ Cᵀ λ,   (C M⁻¹ Cᵀ) λ = v̄ − C v,
 //! a Lagrange multiplier per point with the lumped mass (the points of one
-//! edge overlap in their nodes, so λ comes from one small dense solve,
+//! edge overlap in their nodes, so λ comes from one solve, a Cholesky in
+//! the band of the points that share nodes,
 //! regularised by `HOLD_REG` because two points per cell can be more than
 //! the nodes they hold). In `correct` the change is a force, m Δv / (γΔt),
 //! added to f_I (so the particles' FLIP update feels it) and to the
@@ -109,26 +110,41 @@ fn solve(
         }
     }
     by_node.sort_unstable_by_key(|&(a, i, _)| (a, i));
-    let mut s = vec![0.0; k * k];
+    // S in its envelope: row i from the first point that shares a node
+    // with it (points along an edge share nodes with their neighbours
+    // only, so the envelope is a band and its factor stays in it).
+    let mut groups = Vec::new();
     let mut start = 0;
     while start < by_node.len() {
-        let a = by_node[start].0;
         let mut end = start;
-        while end < by_node.len() && by_node[end].0 == a {
+        while end < by_node.len() && by_node[end].0 == by_node[start].0 {
             end += 1;
         }
-        let inv_m = 1.0 / mv[a][0];
-        for &(_, i, wi) in &by_node[start..end] {
-            for &(_, j, wj) in &by_node[start..end] {
-                s[i * k + j] += wi * wj * inv_m;
-            }
-        }
+        groups.push(start..end);
         start = end;
     }
-    for i in 0..k {
-        s[i * k + i] *= 1.0 + HOLD_REG;
+    let mut first: Vec<usize> = (0..k).collect();
+    for g in &groups {
+        let lo = by_node[g.start].1;
+        for &(_, i, _) in &by_node[g.clone()] {
+            first[i] = first[i].min(lo);
+        }
     }
-    let l = cholesky(&mut s, k);
+    let mut s = Envelope::new(first);
+    for g in &groups {
+        let inv_m = 1.0 / mv[by_node[g.start].0][0];
+        for &(_, i, wi) in &by_node[g.clone()] {
+            for &(_, j, wj) in &by_node[g.clone()] {
+                if j <= i {
+                    *s.at(i, j) += wi * wj * inv_m;
+                }
+            }
+        }
+    }
+    for i in 0..k {
+        *s.at(i, i) *= 1.0 + HOLD_REG;
+    }
+    let l = s.cholesky();
     // v at each point now, then λ and its refinements.
     let mut v: Vec<f64> = held
         .iter()
@@ -146,7 +162,7 @@ fn solve(
         if !l {
             break;
         }
-        cholesky_solve(&s, k, &mut r);
+        s.solve(&mut r);
         for (li, ri) in lambda.iter_mut().zip(&r) {
             *li += ri;
         }
@@ -195,44 +211,77 @@ fn change(
     }
 }
 
-/// In-place Cholesky S = L Lᵀ (lower triangle of `s`, row-major k × k);
-/// false when a pivot is not positive.
-fn cholesky(s: &mut [f64], k: usize) -> bool {
-    for j in 0..k {
-        let mut d = s[j * k + j];
-        for m in 0..j {
-            d -= s[j * k + m] * s[j * k + m];
-        }
-        if d <= 0.0 || !d.is_finite() {
-            return false;
-        }
-        let d = d.sqrt();
-        s[j * k + j] = d;
-        for i in j + 1..k {
-            let mut x = s[i * k + j];
-            for m in 0..j {
-                x -= s[i * k + m] * s[j * k + m];
-            }
-            s[i * k + j] = x / d;
-        }
-    }
-    true
+/// A symmetric matrix by rows of its lower envelope: row i holds columns
+/// `first[i]..=i`.
+struct Envelope {
+    first: Vec<usize>,
+    start: Vec<usize>,
+    val: Vec<f64>,
 }
 
-/// Solves L Lᵀ x = r in place (`s` from `cholesky`).
-fn cholesky_solve(s: &[f64], k: usize, r: &mut [f64]) {
-    for i in 0..k {
-        let mut x = r[i];
-        for m in 0..i {
-            x -= s[i * k + m] * r[m];
+impl Envelope {
+    fn new(first: Vec<usize>) -> Envelope {
+        let mut start = Vec::with_capacity(first.len() + 1);
+        let mut n = 0;
+        for (i, &f) in first.iter().enumerate() {
+            start.push(n);
+            n += i + 1 - f;
         }
-        r[i] = x / s[i * k + i];
+        start.push(n);
+        Envelope {
+            first,
+            start,
+            val: vec![0.0; n],
+        }
     }
-    for i in (0..k).rev() {
-        let mut x = r[i];
-        for m in i + 1..k {
-            x -= s[m * k + i] * r[m];
+
+    /// Entry (i, j), j in `first[i]..=i`.
+    #[inline]
+    fn at(&mut self, i: usize, j: usize) -> &mut f64 {
+        &mut self.val[self.start[i] + j - self.first[i]]
+    }
+
+    #[inline]
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.val[self.start[i] + j - self.first[i]]
+    }
+
+    /// In-place Cholesky S = L Lᵀ (the factor fills no entry outside the
+    /// envelope); false when a pivot is not positive.
+    fn cholesky(&mut self) -> bool {
+        for i in 0..self.first.len() {
+            for j in self.first[i]..=i {
+                let mut x = self.get(i, j);
+                for m in self.first[i].max(self.first[j])..j {
+                    x -= self.get(i, m) * self.get(j, m);
+                }
+                if j < i {
+                    *self.at(i, j) = x / self.get(j, j);
+                } else if x > 0.0 && x.is_finite() {
+                    *self.at(i, i) = x.sqrt();
+                } else {
+                    return false;
+                }
+            }
         }
-        r[i] = x / s[i * k + i];
+        true
+    }
+
+    /// Solves L Lᵀ x = r in place (after `cholesky`).
+    fn solve(&self, r: &mut [f64]) {
+        for i in 0..r.len() {
+            let mut x = r[i];
+            for m in self.first[i]..i {
+                x -= self.get(i, m) * r[m];
+            }
+            r[i] = x / self.get(i, i);
+        }
+        for i in (0..r.len()).rev() {
+            r[i] /= self.get(i, i);
+            let xi = r[i];
+            for m in self.first[i]..i {
+                r[m] -= self.get(i, m) * xi;
+            }
+        }
     }
 }
