@@ -270,17 +270,23 @@ impl Envelope {
     /// Solves L Lᵀ x = r in place (after `cholesky`).
     fn solve(&self, r: &mut [f64]) {
         for i in 0..r.len() {
-            let mut x = r[i];
-            for m in self.first[i]..i {
-                x -= self.get(i, m) * r[m];
-            }
-            r[i] = x / self.get(i, i);
+            let f = self.first[i];
+            let row = &self.val[self.start[i]..self.start[i + 1]];
+            let x = r[i]
+                - row[..i - f]
+                    .iter()
+                    .zip(&r[f..i])
+                    .map(|(l, y)| l * y)
+                    .sum::<f64>();
+            r[i] = x / row[i - f];
         }
         for i in (0..r.len()).rev() {
-            r[i] /= self.get(i, i);
+            let f = self.first[i];
+            let row = &self.val[self.start[i]..self.start[i + 1]];
+            r[i] /= row[i - f];
             let xi = r[i];
-            for m in self.first[i]..i {
-                r[m] -= self.get(i, m) * xi;
+            for (y, l) in r[f..i].iter_mut().zip(&row[..i - f]) {
+                *y -= l * xi;
             }
         }
     }

@@ -799,7 +799,7 @@ impl ImplicitBackend {
         }
         // The points' penalty forces are the support's force on the body.
         for (p, target) in m.constraints.points.iter().zip(&self.point_target) {
-            for c in 0..2 {
+            for (c, &t) in target.iter().enumerate() {
                 if p.fix & (1 << c) != 0 {
                     let u: f64 = p
                         .nodes
@@ -807,7 +807,7 @@ impl ImplicitBackend {
                         .zip(&p.n)
                         .map(|(&a, &w)| w * self.du[a as usize][c])
                         .sum();
-                    self.reactions[p.group as usize][c] -= self.point_penalty * (u - target[c]);
+                    self.reactions[p.group as usize][c] -= self.point_penalty * (u - t);
                 }
             }
         }
