@@ -106,9 +106,24 @@ pub fn place(
                     format!("its edge point ({:.6}, {:.6}) m: {why}", x[0], x[1]),
                 )
             })?;
-            outside |= nodes
+            // Whether nodes beyond the edge reach it is decided on the
+            // unperturbed lattice, as membership is: a perturbed grid's
+            // wavy node line holds the body as the regular one does.
+            let reach = if grid.is_perturbed() {
+                let lattice = Grid::regular(grid.h, grid.min, grid.nx, grid.ny);
+                weights(shape, &lattice, x).map_err(|why| {
+                    SceneError::invalid(
+                        key(),
+                        format!("its edge point ({:.6}, {:.6}) m: {why}", x[0], x[1]),
+                    )
+                })?
+            } else {
+                (nodes.clone(), n.clone())
+            };
+            outside |= reach
+                .0
                 .iter()
-                .zip(&n)
+                .zip(&reach.1)
                 .any(|(&a, &w)| !in_region[a as usize] && w.abs() > OUTSIDE_WEIGHT_TOL);
             pts.push(ConstraintPoint {
                 group: g as u32,
