@@ -4,6 +4,7 @@
 
 pub mod cfl;
 pub mod clear_grid;
+pub mod constraint_points;
 pub mod contact;
 pub mod energy;
 pub mod forces;
@@ -389,6 +390,15 @@ impl CpuBackend {
                     self.t + self.dt,
                     self.mass_eps,
                 );
+                constraint_points::hold(
+                    &mut self.mv,
+                    &m.constraints.fix,
+                    &m.constraints.points,
+                    &m.constraints.groups,
+                    self.t + self.dt,
+                    self.mass_eps,
+                    None,
+                );
                 if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
                     contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);
                 }
@@ -492,6 +502,19 @@ impl CpuBackend {
                     m.local_damping,
                     self.mass_eps,
                 );
+                constraint_points::hold(
+                    &mut self.mv,
+                    &m.constraints.fix,
+                    &m.constraints.points,
+                    &m.constraints.groups,
+                    self.t + self.dt,
+                    self.mass_eps,
+                    Some(constraint_points::AsForce {
+                        force: &mut self.force,
+                        reactions: group_r,
+                        gamma_dt: gamma * self.dt,
+                    }),
+                );
                 if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
                     contact::exchange(
                         c,
@@ -546,6 +569,15 @@ impl CpuBackend {
                     &m.constraints.groups,
                     self.t + self.dt,
                     self.mass_eps,
+                );
+                constraint_points::hold(
+                    &mut self.mv,
+                    &m.constraints.fix,
+                    &m.constraints.points,
+                    &m.constraints.groups,
+                    self.t + self.dt,
+                    self.mass_eps,
+                    None,
                 );
                 if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
                     contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);

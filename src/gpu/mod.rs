@@ -70,6 +70,17 @@ impl GpuBackend {
             )
             .into());
         }
+        if let Some(p) = model.constraints.points.first() {
+            return Err(crate::error::SceneError::invalid(
+                format!(
+                    "constraints.{}",
+                    model.constraints.groups[p.group as usize].name
+                ),
+                "holds constraint points, which run on the CPU path only for now (--backend cpu \
+                 or auto)",
+            )
+            .into());
+        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;

@@ -2,6 +2,7 @@
 //! constraints, loads and solver settings, built from a checked `Scene`.
 //! Everything here is backend-neutral; `cpu::` and `gpu::` step it.
 
+pub mod constraint_points;
 pub mod contact;
 pub mod energy;
 pub mod fault;
@@ -15,6 +16,7 @@ pub mod shape;
 pub mod time_step;
 pub mod walls;
 
+pub use constraint_points::ConstraintPoint;
 pub use contact::Contacts;
 pub use grid::Grid;
 pub use loads::{AlignedVibration, ExternalForces, Gravity};
@@ -63,12 +65,37 @@ impl ConstraintGroup {
     }
 }
 
-/// Dirichlet nodes (zero or prescribed velocity).
+/// Dirichlet nodes (zero or prescribed velocity), and the points where a
+/// region's edge inside the grid holds the body (`constraint_points`).
 #[derive(Debug, Clone, Default)]
 pub struct Constraints {
     /// Per node: `FIX_X | FIX_Y` bits (0 = free).
     pub fix: Vec<u8>,
     pub groups: Vec<ConstraintGroup>,
+    /// Empty unless some group's edge lies inside the grid where nodes
+    /// outside its region reach it.
+    pub points: Vec<ConstraintPoint>,
+}
+
+impl Constraints {
+    /// Takes `placed`'s points: each group drops the region nodes they
+    /// free, and the fixed bits are rebuilt from the groups (no points:
+    /// nothing changes).
+    pub fn hold_at(&mut self, placed: constraint_points::Placement) {
+        if placed.points.is_empty() {
+            return;
+        }
+        for (group, freed) in self.groups.iter_mut().zip(&placed.freed) {
+            group.nodes.retain(|n| freed.binary_search(n).is_err());
+        }
+        self.fix.fill(0);
+        for group in &self.groups {
+            for &n in &group.nodes {
+                self.fix[n as usize] |= group.fix;
+            }
+        }
+        self.points = placed.points;
+    }
 }
 
 /// Time integrator with its parameters.
@@ -237,7 +264,14 @@ impl Model {
         }
         geostatic_start(scene, &materials, &body_material, &mut particles)?;
 
-        let constraints = build_constraints(scene, &grid)?;
+        let mut constraints = build_constraints(scene, &grid)?;
+        let regions: Vec<(&[u32], u8)> = constraints
+            .groups
+            .iter()
+            .map(|g| (&g.nodes[..], g.fix))
+            .collect();
+        let placed = constraint_points::place(scene, &grid, &shape, &particles, &regions)?;
+        constraints.hold_at(placed);
         let mut walls = Walls::new(scene, &grid)?;
         let p_wave = materials
             .iter()
@@ -571,6 +605,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
     let mut c = Constraints {
         fix: vec![0; grid.n_nodes()],
         groups: Vec::new(),
+        points: Vec::new(),
     };
     // Membership is tested on the unperturbed lattice position, so a
     // perturbed grid fixes the same nodes as the regular one.

@@ -21,10 +21,10 @@
 
 use super::contact::{self, ContactPair, ContactState};
 use crate::cpu::ShapeCache;
-use crate::model::Model;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::Material;
 use crate::model::material::increment::{StepState, mul};
+use crate::model::{ConstraintPoint, Model};
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::solvers::SymbolicLu;
 use rayon::prelude::*;
@@ -36,6 +36,15 @@ pub const NO_DOF: u32 = u32::MAX;
 /// modulus (N/m per metre of thickness): a wall node then gives way by
 /// about 1e-4 of the strain the contact force would cause in the material.
 pub const PENALTY_REL: f64 = 1e4;
+
+/// Constraint-point penalty relative to the stiffest material's P-wave
+/// modulus (N/m per metre of thickness, per point), as the walls'
+/// (`PENALTY_REL`): with two points per cell along the edge, the edge
+/// gives way by about 1 / (2 · 1e4) of the strain its force would cause in
+/// a cell of the material (the stiff cantilever's points move by ~1e-8 m
+/// against a tip deflection of 6.8e-3 m). 1e6 stalls Newton at a residual
+/// of 3e-8 of the step's reference (the penalty forces' round-off).
+pub const POINT_PENALTY_REL: f64 = 1e4;
 
 /// The unknowns of one step: two per node with mass (equations 2·id and
 /// 2·id + 1). Held components (constraints, stick walls) stay in the
@@ -216,6 +225,10 @@ pub struct StepInputs<'a> {
     pub pairs: &'a [ContactPair],
     /// Lumped mass, M_II = Σ_p m_p N_I, instead of the consistent one.
     pub lumped_mass: bool,
+    /// Per constraint point (`model.constraints.points`): its prescribed
+    /// Δu over the step (m), and the points' penalty α (N/m per metre).
+    pub point_target: &'a [[f64; 2]],
+    pub point_penalty: f64,
 }
 
 /// Nodal residual of the particles at the iterate `du` (N per metre of
@@ -329,6 +342,38 @@ pub fn add_contact(
     }
 }
 
+/// Adds the constraint points' penalty forces at `du` to `r`: at each
+/// point b, on each held component c, f = −α (Σ_a N_a(x_b) Δu_a,c − ū_b,c)
+/// spread to the nodes by N_a(x_b); `reactions`, when given, receives each
+/// group's sum (the support's force on the body).
+pub fn add_points(
+    inp: &StepInputs,
+    du: &[[f64; 2]],
+    r: &mut [[f64; 2]],
+    mut reactions: Option<&mut [[f64; 2]]>,
+) {
+    for (p, target) in inp.model.constraints.points.iter().zip(inp.point_target) {
+        for c in 0..2 {
+            if p.fix & (1 << c) == 0 {
+                continue;
+            }
+            let u: f64 = p
+                .nodes
+                .iter()
+                .zip(&p.n)
+                .map(|(&a, &w)| w * du[a as usize][c])
+                .sum();
+            let f = -inp.point_penalty * (u - target[c]);
+            for (&a, &w) in p.nodes.iter().zip(&p.n) {
+                r[a as usize][c] += w * f;
+            }
+            if let Some(re) = reactions.as_deref_mut() {
+                re[p.group as usize][c] += f;
+            }
+        }
+    }
+}
+
 /// Each pair's state under Coulomb's law at `du`.
 pub fn natural_states(inp: &StepInputs, du: &[[f64; 2]], states: &mut Vec<ContactState>) {
     let walls = &inp.model.walls.list;
@@ -362,6 +407,7 @@ impl Pattern {
         cache: &ShapeCache,
         dofs: &Dofs,
         particles: usize,
+        points: &[ConstraintPoint],
         previous: Option<Pattern>,
     ) -> Result<Pattern, Fault> {
         let fail = |_| Fault {
@@ -371,8 +417,10 @@ impl Pattern {
             },
         };
         let mut pairs: Vec<u64> = Vec::new();
-        for p in 0..particles {
-            let (nodes, _) = cache.particle(p);
+        let stencils = (0..particles)
+            .map(|p| cache.particle(p).0)
+            .chain(points.iter().map(|p| &p.nodes[..]));
+        for nodes in stencils {
             for &b in nodes {
                 let ib = dofs.id[b as usize];
                 for &a in nodes {
@@ -576,6 +624,26 @@ pub fn jacobian(
         for i in 0..2 {
             for c in 0..2 {
                 values[pattern.slot(id, id, i, c)] += dk[2 * i + c];
+            }
+        }
+    }
+    // Constraint points: α N_a N_b on each held component.
+    for p in &inp.model.constraints.points {
+        for (&a, &wa) in p.nodes.iter().zip(&p.n) {
+            let ia = dofs.id[a as usize];
+            if ia == NO_DOF {
+                continue;
+            }
+            for (&b, &wb) in p.nodes.iter().zip(&p.n) {
+                let ib = dofs.id[b as usize];
+                if ib == NO_DOF {
+                    continue;
+                }
+                for c in 0..2 {
+                    if p.fix & (1 << c) != 0 {
+                        values[pattern.slot(ia, ib, c, c)] += inp.point_penalty * wa * wb;
+                    }
+                }
             }
         }
     }

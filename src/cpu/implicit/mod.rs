@@ -105,6 +105,9 @@ pub struct ImplicitBackend {
     wall_force: Vec<[f64; 2]>,
     mass_eps: f64,
     penalty: f64,
+    /// Per constraint point: its prescribed Δu over the step (m).
+    point_target: Vec<[f64; 2]>,
+    point_penalty: f64,
     pub stats: NewtonStats,
     t: f64,
     steps: u64,
@@ -167,6 +170,8 @@ impl ImplicitBackend {
             wall_force: vec![[0.0; 2]; model.walls.list.len()],
             mass_eps: crate::model::MASS_EPS_REL * min_mass,
             penalty: assemble::PENALTY_REL * stiffest,
+            point_target: vec![[0.0; 2]; model.constraints.points.len()],
+            point_penalty: assemble::POINT_PENALTY_REL * stiffest,
             stats: NewtonStats::default(),
             t: 0.0,
             steps: 0,
@@ -305,6 +310,7 @@ impl ImplicitBackend {
             &self.cache,
             &self.dofs,
             n,
+            &self.model.constraints.points,
             self.pattern.take(),
         )?);
         self.stats.seconds.symbolic += mapped.elapsed().as_secs_f64();
@@ -372,6 +378,18 @@ impl ImplicitBackend {
     /// time; zero otherwise), the free ones zero: Newton's start.
     fn predict(&mut self, dt: f64) {
         self.du.fill([0.0; 2]);
+        let groups = &self.model.constraints.groups;
+        for (p, target) in self
+            .model
+            .constraints
+            .points
+            .iter()
+            .zip(&mut self.point_target)
+        {
+            let g = &groups[p.group as usize];
+            let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
+            *target = std::array::from_fn(|d| 0.5 * dt * (v0[d] + v1[d]));
+        }
         for g in self.model.constraints.groups.iter().filter(|g| g.moves()) {
             let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
             for &n in &g.nodes {
@@ -436,6 +454,8 @@ impl ImplicitBackend {
             penalty: self.penalty,
             pairs: &self.pairs,
             lumped_mass: self.settings.lumped_mass,
+            point_target: &self.point_target,
+            point_penalty: self.point_penalty,
         };
         // The load's own size, |Σ_p N m_p b_p| over the free components.
         let mut fext = vec![[0.0f64; 2]; self.du.len()];
@@ -473,6 +493,7 @@ impl ImplicitBackend {
             let res = assemble::residual(&inp, &self.du, &mut self.iterates, &mut self.r_body);
             self.stats.seconds.residual += clock.elapsed().as_secs_f64();
             res.map_err(AttemptFail::Particle)?;
+            assemble::add_points(&inp, &self.du, &mut self.r_body, None);
             let clock = Instant::now();
             self.r.copy_from_slice(&self.r_body);
             assemble::add_contact(
@@ -643,6 +664,8 @@ impl ImplicitBackend {
             penalty: self.penalty,
             pairs: &self.pairs,
             lumped_mass: self.settings.lumped_mass,
+            point_target: &self.point_target,
+            point_penalty: self.point_penalty,
         };
         let mut its = self.iterates.clone();
         let mut wf = self.wall_force.clone();
@@ -651,6 +674,7 @@ impl ImplicitBackend {
                         r: &mut [[f64; 2]],
                         wf: &mut [[f64; 2]]| {
             assemble::residual(&inp, du, its, r).map(|()| {
+                assemble::add_points(&inp, du, r, None);
                 assemble::add_contact(&inp, du, None, r, Some(wf));
             })
         };
@@ -770,6 +794,20 @@ impl ImplicitBackend {
                 }
                 if g.fix & FIX_Y != 0 {
                     r[1] -= self.r[n][1];
+                }
+            }
+        }
+        // The points' penalty forces are the support's force on the body.
+        for (p, target) in m.constraints.points.iter().zip(&self.point_target) {
+            for (c, &t) in target.iter().enumerate() {
+                if p.fix & (1 << c) != 0 {
+                    let u: f64 = p
+                        .nodes
+                        .iter()
+                        .zip(&p.n)
+                        .map(|(&a, &w)| w * self.du[a as usize][c])
+                        .sum();
+                    self.reactions[p.group as usize][c] -= self.point_penalty * (u - t);
                 }
             }
         }
