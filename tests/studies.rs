@@ -413,7 +413,9 @@ fn implicit_quick_compares_schemes_per_case() {
     let rows = md
         .lines()
         .filter(|l| {
-            l.starts_with("| implicit | linear |") || l.starts_with("| implicit | bspline2 |")
+            l.starts_with("| implicit | linear |")
+                || l.starts_with("| implicit | bspline2 |")
+                || l.starts_with("| implicit | gmm-")
         })
         .count()
         + md.lines()
@@ -452,4 +454,22 @@ fn implicit_quick_compares_schemes_per_case() {
             _ => {}
         }
     }
+}
+
+/// `study gmm --quick`: GMM-LME and GMM-MLS on the cantilever at h = 0.5,
+/// 0.25, 0.125 (milliseconds each), with the orders, Richardson limits and
+/// the paper's ordering of the two bases in the section.
+#[test]
+fn gmm_quick_reports_orders_and_the_paper_ordering() {
+    let (results, md, dir) = run(StudyName::Gmm);
+    let chart = "study-gmm-cantilever-mesh.png";
+    assert!(md.contains(chart) && dir.join(chart).exists(), "{md}");
+    assert_eq!(results.len(), 6);
+    for r in &results {
+        assert!(r.data().is_some_and(|d| d.completed()), "{}", r.job.label);
+    }
+    for m in ["gmm-lme", "gmm-mls"] {
+        assert!(md.contains(&format!("- {m}: order")), "{md}");
+    }
+    assert!(md.contains("GMM-MLS is below at every h"), "{md}");
 }

@@ -101,7 +101,7 @@ fn cantilever_h(quick: bool) -> &'static [f64] {
 
 fn gmm_h(quick: bool) -> &'static [f64] {
     if quick {
-        &CANTILEVER_H_QUICK
+        &CANTILEVER_H_GMM[..3]
     } else {
         &CANTILEVER_H_GMM
     }
@@ -253,11 +253,7 @@ pub fn jobs(quick: bool) -> Vec<Job> {
             out.push(cantilever_job("implicit", m, h));
         }
     }
-    for &h in gmm_h(quick).iter().rev() {
-        for m in GMM_METHODS {
-            out.push(gmm_cantilever_job(m, h));
-        }
-    }
+    out.extend(gmm_jobs(quick));
     out
 }
 
@@ -395,6 +391,34 @@ struct Report<'a> {
     results: &'a [JobResult],
     quick: bool,
     dir: &'a Path,
+}
+
+/// `lme-mpm study gmm`: GMM's cantilever runs alone (the implicit
+/// study's GMM rows, in seconds).
+pub fn gmm_jobs(quick: bool) -> Vec<Job> {
+    let mut out = Vec::new();
+    for &h in gmm_h(quick).iter().rev() {
+        for m in GMM_METHODS {
+            out.push(gmm_cantilever_job(m, h));
+        }
+    }
+    out
+}
+
+/// `lme-mpm study gmm`'s section.
+pub fn gmm_report(
+    results: &[JobResult],
+    dir: &Path,
+    quick: bool,
+) -> Result<(String, Vec<PathBuf>)> {
+    let r = Report {
+        results,
+        quick,
+        dir,
+    };
+    let mut md = String::new();
+    let charts = r.gmm_section(&mut md)?;
+    Ok((md, charts))
 }
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
@@ -604,11 +628,7 @@ impl Report<'_> {
                 _ => None,
             };
             if is_gmm(m) {
-                if let (Some(l), Some(&p), Some(&(h, d))) =
-                    (limit, pair_orders(&diffs).last(), defl.last())
-                {
-                    gmm.push((m, p, l, h, d));
-                }
+                gmm.extend(self.richardson(m).map(|(p, l, h, d)| (m, p, l, h, d)));
             }
             order_text.push(format!(
                 "implicit {m}: against 0.67433 between successive h {}; self-convergence (successive \
@@ -667,6 +687,107 @@ impl Report<'_> {
                 explicit.join("; ")
             );
         }
+        Ok(charts)
+    }
+
+    /// Self-convergence of `method`'s implicit cantilever from its three
+    /// finest runs: (order of the finest pair of differences, Richardson
+    /// limit (m), finest h (m), its deflection (m)).
+    fn richardson(&self, method: &str) -> Option<(f64, f64, f64, f64)> {
+        let defl = self.over_h("implicit", method, deflection);
+        let n = defl.len();
+        if n < 3 {
+            return None;
+        }
+        let (a, b, c) = (defl[n - 3].1, defl[n - 2].1, defl[n - 1].1);
+        let p = ((b - a) / (c - b)).abs().log2();
+        Some((p, c + (c - b) / (2f64.powf(p) - 1.0), defl[n - 1].0, c))
+    }
+
+    /// `lme-mpm study gmm`: GMM's cantilever runs alone, their table, mesh
+    /// chart and acceptance.
+    fn gmm_section(&self, md: &mut String) -> Result<Vec<PathBuf>> {
+        let _ = writeln!(
+            md,
+            "### GMM on the static cantilever\n\nThe static cantilever (`cases/cantilever.toml`, one load step) on \
+             GMM's node cloud instead of the grid, the paper's §5.1 settings; the same runs are rows of \
+             `lme-mpm study implicit`'s cantilever beside implicit MPM.\n"
+        );
+        let header: Vec<String> = [
+            "method",
+            "h (m)",
+            "particles",
+            "Newton iterations",
+            "deflection (m)",
+            "error vs 0.67433 (%)",
+            "wall (s)",
+        ]
+        .map(String::from)
+        .to_vec();
+        let mut rows = Vec::new();
+        for (m, _) in GMM_METHODS {
+            for (h, r) in self.runs("implicit", m) {
+                let d = r.data();
+                rows.push(vec![
+                    m.to_string(),
+                    sig(h),
+                    d.map_or("-".into(), |d| d.particles.to_string()),
+                    d.and_then(|d| d.newton.as_ref())
+                        .map_or("-".into(), |n| n.iterations.to_string()),
+                    deflection(r).map_or_else(|| super::failure_text(r), |v| format!("{v:.5}")),
+                    cantilever_error(r).map_or("-".into(), |e| sig(100.0 * e)),
+                    wall(r),
+                ]);
+            }
+        }
+        md.push_str(&table(&header, &rows));
+        md.push('\n');
+        let pct = |r: &JobResult| cantilever_error(r).map(|e| 100.0 * e);
+        let mut curves = Vec::new();
+        for (k, (m, _)) in GMM_METHODS.iter().enumerate() {
+            let defl = self.over_h("implicit", m, deflection);
+            curves.push(Curve {
+                label: format!("{m} vs 0.67433"),
+                points: self.over_h("implicit", m, pct),
+                color: k,
+                dashed: false,
+            });
+            curves.push(Curve {
+                label: format!("{m} |δ(h) − δ(h/2)|"),
+                points: defl
+                    .windows(2)
+                    .map(|w| (w[0].0, 100.0 * (w[0].1 - w[1].1).abs() / PAPER_NONLINEAR))
+                    .collect(),
+                color: k,
+                dashed: true,
+            });
+        }
+        let (charts, orders) = report::convergence_chart(
+            "Cantilever on GMM's node cloud: free-end deflection error against cell size",
+            "cell size h (m)",
+            "error relative to 0.67433 m (%)",
+            &curves,
+            &self.dir.join("study-gmm-cantilever-mesh"),
+        )?;
+        md.push_str(&image(
+            "GMM cantilever error against cell size",
+            "study-gmm-cantilever-mesh.png",
+        ));
+        let fitted: Vec<String> = curves
+            .iter()
+            .zip(&orders)
+            .filter_map(|(c, p)| Some(format!("{}: {:.2}", c.label, (*p)?)))
+            .collect();
+        let _ = writeln!(
+            md,
+            "\n**Orders.** Least-squares slopes over all cell sizes: {}.\n",
+            fitted.join("; ")
+        );
+        let gmm: Vec<_> = GMM_METHODS
+            .iter()
+            .filter_map(|(m, _)| self.richardson(m).map(|(p, l, h, d)| (*m, p, l, h, d)))
+            .collect();
+        self.gmm_acceptance(md, &gmm);
         Ok(charts)
     }
 

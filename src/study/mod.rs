@@ -49,6 +49,10 @@ pub enum StudyName {
     /// bar and the rolling disk, error against wall time per case, and the
     /// Newton iteration's cost split (CPU only).
     Implicit,
+    /// The Galerkin meshfree method on the static cantilever: GMM-LME and
+    /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson (the
+    /// implicit study's GMM rows alone, seconds).
+    Gmm,
     /// All of them, in that order.
     All,
 }
@@ -64,6 +68,7 @@ impl StudyName {
             StudyName::Disk => "disk",
             StudyName::Column => "column",
             StudyName::Implicit => "implicit",
+            StudyName::Gmm => "gmm",
             StudyName::All => "all",
         }
     }
@@ -139,6 +144,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk,
             StudyName::Column,
             StudyName::Implicit,
+            StudyName::Gmm,
         ],
         n => vec![n],
     };
@@ -156,6 +162,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::jobs(opts.quick, &backends),
             StudyName::Column => column::jobs(opts.quick, &backends),
             StudyName::Implicit => implicit::jobs(opts.quick),
+            StudyName::Gmm => implicit::gmm_jobs(opts.quick),
             StudyName::All => unreachable!(),
         };
         if opts.progress || opts.progress_lines {
@@ -182,6 +189,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
+            StudyName::Gmm => implicit::gmm_report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
         // The charts sit beside report.md; the markdown links them in
