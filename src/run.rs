@@ -615,6 +615,23 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     } else {
         shape
     };
+    // GMM reads no grid shape: its basis over the node clouds instead.
+    let shape = match &model.integrator {
+        crate::model::Integrator::Implicit(crate::model::ImplicitSettings {
+            gmm: Some(gm),
+            ..
+        }) => match gm.basis {
+            crate::scene::GmmBasis::Lme => format!(
+                "GMM-LME over node clouds (gamma = {}, search radius {:.3} h; the grid only seeds the nodes)",
+                gm.gamma, gm.search_radius
+            ),
+            crate::scene::GmmBasis::Mls => format!(
+                "GMM-MLS over node clouds (dilation {:.3} h, search radius {:.3} h; the grid only seeds the nodes)",
+                gm.dilation, gm.search_radius
+            ),
+        },
+        _ => shape,
+    };
     let step_rule = match model.fixed_dt {
         Some(fixed) => {
             // Courant number of the fixed step at t = 0.

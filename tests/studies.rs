@@ -464,7 +464,8 @@ fn gmm_quick_reports_orders_and_the_paper_ordering() {
     let (results, md, dir) = run(StudyName::Gmm);
     let chart = "study-gmm-cantilever-mesh.png";
     assert!(md.contains(chart) && dir.join(chart).exists(), "{md}");
-    assert_eq!(results.len(), 6);
+    // GMM-LME and GMM-MLS at 3 sizes, implicit MPM Q4 at 2 (the cost rows).
+    assert_eq!(results.len(), 8);
     for r in &results {
         assert!(r.data().is_some_and(|d| d.completed()), "{}", r.job.label);
     }
@@ -472,4 +473,5 @@ fn gmm_quick_reports_orders_and_the_paper_ordering() {
         assert!(md.contains(&format!("- {m}: order")), "{md}");
     }
     assert!(md.contains("GMM-MLS is below at every h"), "{md}");
+    assert!(md.contains("**Cost.**") && md.contains("| 0.250 |"), "{md}");
 }
