@@ -11,8 +11,8 @@
 //! - MLS (eqs. 50–58): linear basis p = [1, (y − x)/h] centred on the
 //!   evaluation point x and scaled by h, weight w_I = W(|x − x_I| / (2 f h))
 //!   with W the cubic spline (support 1), f the dilation:
-//!     N_I = cᵀ p_I w_I,  c = A⁻¹ e₀,  A = Σ_J w_J p_J p_Jᵀ,
-//!     ∂_k N_I = (g_k − q_k)ᵀ p_I w_I + cᵀ p_I ∂_k w_I,
+//!   N_I = cᵀ p_I w_I,  c = A⁻¹ e₀,  A = Σ_J w_J p_J p_Jᵀ, and
+//!   ∂_k N_I = (g_k − q_k)ᵀ p_I w_I + cᵀ p_I ∂_k w_I, with
 //!   g_k = A⁻¹ e_{k+1} / h (the basis's own slope), q_k = A⁻¹ (∂_k A) c,
 //!   ∂_k A = Σ_J ∂_k w_J p_J p_Jᵀ (the basis centre held at x while
 //!   differentiating, which is exact: N_I does not depend on the centre).
@@ -123,7 +123,7 @@ fn inverse3(a: &[f64; 6]) -> Option<[[f64; 3]; 3]> {
     let det = a00 * c00 + a01 * c01 + a02 * c02;
     let scale = (a00 * a11 * a22).abs();
     // Also refuses NaN.
-    if !(det.abs() > MLS_SINGULAR * scale) {
+    if det.abs().partial_cmp(&(MLS_SINGULAR * scale)) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let d = 1.0 / det;

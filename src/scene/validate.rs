@@ -305,14 +305,14 @@ fn check_gmm(file: &SceneFile) -> Result<(), SceneError> {
     }
     if let Some(name) = file.walls.keys().next() {
         return Err(SceneError::invalid(
-            &format!("walls.{name}"),
+            format!("walls.{name}"),
             "is not available with method = \"gmm\" yet (walls acting on the cloud's nodes are \
              the rolling disk's part of issue 27)",
         ));
     }
     if let Some(name) = file.contact.keys().next() {
         return Err(SceneError::invalid(
-            &format!("contact.{name}"),
+            format!("contact.{name}"),
             "is not available with method = \"gmm\" (a node cloud per body would need its own \
              contact between clouds)",
         ));

@@ -108,11 +108,11 @@ impl GmmNodes {
     pub fn advance(&mut self, du: &[[f64; 2]], newmark: &Newmark) {
         let c = &mut self.cloud;
         let (gamma, dt) = (newmark.gamma, newmark.dt);
-        for n in 0..c.len() {
-            let a = newmark.accel(du[n], c.v[n], c.a[n]);
+        for (n, dn) in du.iter().enumerate() {
+            let a = newmark.accel(*dn, c.v[n], c.a[n]);
             for d in 0..2 {
-                c.x[n][d] += du[n][d];
-                c.u[n][d] += du[n][d];
+                c.x[n][d] += dn[d];
+                c.u[n][d] += dn[d];
                 if newmark.is_static {
                     c.v[n][d] = 0.0;
                 } else {
