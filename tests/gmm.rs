@@ -258,8 +258,14 @@ fn dynamic_cantilever_swings_to_twice_its_static_deflection_on_the_moving_cloud(
     }
 }
 
+/// GMM against implicit MPM (B-splines) over the dynamic swing, both at
+/// h = 0.0625 (the same particles, so the same probe particle), at the
+/// sample times both reached: the largest difference over the peak.
+/// Measured 1.23 % (LME) and 1.17 % (MLS) at 29 common samples.
+const AGAINST_MPM: f64 = 0.02;
+
 #[test]
-#[ignore = "a reference run of 50 s: the dynamic swing against implicit MPM (bspline2, h = 0.0625)"]
+#[ignore = "a reference run of a minute: the dynamic swing against implicit MPM (bspline2)"]
 fn dynamic_cantilever_against_implicit_mpm() {
     let run = |extra: &[&str]| {
         let r = common::run(
@@ -267,6 +273,7 @@ fn dynamic_cantilever_against_implicit_mpm() {
             &sets(
                 extra,
                 &[
+                    "grid.h=0.0625",
                     "solver.static=false",
                     "solver.dt=0.02",
                     "solver.t_end=0.8",
@@ -280,22 +287,27 @@ fn dynamic_cantilever_against_implicit_mpm() {
         r.recorder
             .samples
             .iter()
-            .map(|s| y0 - s.probes[0].x[1])
-            .collect::<Vec<f64>>()
+            .map(|s| (s.t, y0 - s.probes[0].x[1]))
+            .collect::<Vec<(f64, f64)>>()
     };
-    let mpm = run(&["solver.shape=bspline2", "grid.h=0.0625"]);
-    let peak = mpm.iter().fold(0.0f64, |a, &b| a.max(b));
+    let mpm = run(&["solver.shape=bspline2"]);
+    let peak = mpm.iter().fold(0.0f64, |a, &b| a.max(b.1));
     for basis in [&LME[..], &MLS[..]] {
-        let g = run(&sets(basis, &["grid.h=0.125"]));
-        let d = g
-            .iter()
-            .zip(&mpm)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let g = run(basis);
+        let mut d = 0.0f64;
+        let mut n = 0;
+        for &(t, v) in &g {
+            if let Some(&(_, w)) = mpm.iter().find(|(tm, _)| (tm - t).abs() < 1e-9) {
+                d = d.max((v - w).abs());
+                n += 1;
+            }
+        }
         println!(
-            "{basis:?} h = 0.125 against MPM bspline2 h = 0.0625: max |Δδ| {d:.5} m of a {peak:.4} m swing ({:.2} %)",
+            "{basis:?} against MPM bspline2, h = 0.0625, {n} common samples: max |Δδ| {d:.5} m of a {peak:.4} m swing ({:.2} %)",
             100.0 * d / peak
         );
-        assert!(d < 0.02 * peak, "{basis:?}: {d}");
+        // MPM halves some steps (Newton cuts), so not every time is shared.
+        assert!(n >= 20, "{n} common samples");
+        assert!(d < AGAINST_MPM * peak, "{basis:?}: {d}");
     }
 }
