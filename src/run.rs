@@ -615,6 +615,13 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     } else {
         shape
     };
+    // GMM's constraints hold the cloud's nodes, not the grid's.
+    let cloud = match &model.integrator {
+        crate::model::Integrator::Implicit(crate::model::ImplicitSettings {
+            gmm: Some(_), ..
+        }) => crate::gmm::Cloud::from_model(model).ok(),
+        _ => None,
+    };
     // GMM reads no grid shape: its basis over the node clouds instead.
     let shape = match &model.integrator {
         crate::model::Integrator::Implicit(crate::model::ImplicitSettings {
@@ -726,7 +733,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             .constraints
             .groups
             .iter()
-            .map(|c| format!("{} ({} nodes)", c.name, c.nodes.len()))
+            .enumerate()
+            .map(|(k, c)| match &cloud {
+                Some(cl) => format!("{} ({} nodes of the GMM cloud)", c.name, cl.groups[k].len()),
+                None => format!("{} ({} nodes)", c.name, c.nodes.len()),
+            })
             .chain(model.walls.list.iter().map(|w| format!(
                 "wall {} ({} nodes)",
                 w.name,
