@@ -1,6 +1,9 @@
 // Stage `clear_grid`: zero the nodal accumulators and the reactions (and,
 // with walls, the nodes' contact weights and walls' forces, which the
 // CPU's `wall_touch` and `wall_contact` zero).
+// With CONTACT, every field's nodes, the fields' mass gradients and
+// volumes (`contact_grad.wgsl` scatters them) and the smallest particle
+// half-width (`contact_slack`, kept by atomicMin).
 // CPU twin: src/cpu/clear_grid.rs.
 #include "shared/common.wgsl"
 
@@ -13,6 +16,10 @@
 @group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read_write> wall_pre_force: array<f32>;
 #endif
 #endif
+#if CONTACT
+@group(0) @binding({{B_CONTACT_GRAD}}) var<storage, read_write> contact_grad: array<f32>;
+@group(0) @binding({{B_CONTACT_SLACK}}) var<storage, read_write> contact_slack: array<u32>;
+#endif
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -24,9 +31,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if n < arrayLength(&reactions) {
         reactions[n] = 0.0;
     }
+#if CONTACT
+    if n == 0u {
+        // The largest finite f32: atomicMin on the bits of positive floats.
+        contact_slack[0] = 0x7f7fffffu;
+    }
+    if n >= field_nodes() {
+        return;
+    }
+    for (var k = 0u; k < 3u; k++) {
+        contact_grad[3u * n + k] = 0.0;
+    }
+#else
     if n >= params.n_nodes {
         return;
     }
+#endif
     for (var k = 0u; k < NODE_STRIDE; k++) {
         node_acc[n * NODE_STRIDE + k] = 0.0;
     }

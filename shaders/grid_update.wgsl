@@ -8,6 +8,9 @@
 // With LOCAL_DAMPING, before the update each force component of a node
 // with mass (the walls' forces included) loses α |f_i| sign(v_i), v the
 // predicted nodal velocity (Cundall).
+// With CONTACT, one invocation per node of every field (the constraints
+// act on each field's copy of their nodes); `contact_exchange.wgsl`
+// follows each entry point.
 // CPU twin: src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
 
@@ -62,11 +65,19 @@ fn prescribe(i: u32, j: u32, v_in: vec2<f32>, t: f32) -> vec2<f32> {
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let n = linear_index(gid, nwg);
+#if CONTACT
+    if sim.running == 0u || n >= field_nodes() {
+        return;
+    }
+    let i = n % params.n_nodes % params.nx;
+    let j = n % params.n_nodes / params.nx;
+#else
     if sim.running == 0u || n >= params.n_nodes {
         return;
     }
     let i = n % params.nx;
     let j = n / params.nx;
+#endif
     let b = n * NODE_STRIDE;
     let m = node_acc[b];
 #if CORRECT

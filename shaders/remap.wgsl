@@ -14,9 +14,15 @@
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = linear_index(gid, nwg);
+#if CONTACT
+    if sim.running == 0u || i >= field_nodes() {
+        return;
+    }
+#else
     if sim.running == 0u || i >= params.n_nodes {
         return;
     }
+#endif
     node_acc[i * NODE_STRIDE + 1u] = 0.0;
     node_acc[i * NODE_STRIDE + 2u] = 0.0;
 }

@@ -10,6 +10,9 @@ pub const COLUMN_COLLAPSE: &str = include_str!("../cases/column_collapse.toml");
 pub const GRANULAR_COLLAPSE: &str = include_str!("../cases/granular_collapse.toml");
 pub const CANTILEVER: &str = include_str!("../cases/cantilever.toml");
 pub const CLAY_BIAXIAL: &str = include_str!("../cases/clay_biaxial.toml");
+pub const CONTACT_BLOCK: &str = include_str!("../cases/contact_block.toml");
+pub const CONTACT_DISKS: &str = include_str!("../cases/contact_disks.toml");
+pub const CONTACT_ROLLING: &str = include_str!("../cases/contact_rolling.toml");
 
 /// Dyka's bar length (m), as in `cases/dyka_bar.toml`.
 pub const DYKA_L: f64 = 0.1333;

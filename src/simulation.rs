@@ -92,26 +92,6 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         };
     }
-    if model.contact.is_some() {
-        // The GPU twin of the per-body fields is not written yet.
-        return match spec.choice() {
-            BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
-                "contact",
-                "pairs run on the CPU path only for now: use --backend cpu or auto",
-            )
-            .into()),
-            _ => {
-                let b = CpuBackend::new(model);
-                if spec.verbose && spec.choice() == BackendChoice::Auto {
-                    crate::say!(
-                        "backend: {} (auto: contact pairs run on the CPU only)",
-                        b.name()
-                    );
-                }
-                Ok(Box::new(b))
-            }
-        };
-    }
     match spec.choice() {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
         BackendChoice::Gpu => {

@@ -156,6 +156,16 @@ pub enum Pass {
     /// (wall_contact.wgsl), before `GridCorrect`.
     WallContact,
     GridCorrect,
+    /// Contact pairs only (`cpu::contact`): `detect` as the fields' mass
+    /// gradients and volumes (contact_grad.wgsl, a scatter per particle)
+    /// then each pair node's normal and gap (contact_detect.wgsl, over the
+    /// particles binned in `shape_eval`), before `GridPredict`; `exchange`
+    /// after `GridPredict` (contact_exchange.wgsl) and, as forces, after
+    /// `GridCorrect` (`ContactExchangeForce`, built with CORRECT).
+    ContactGrad,
+    ContactDetect,
+    ContactExchange,
+    ContactExchangeForce,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
     /// then scatter the new velocities from particles (`Remap`) or Gauss
@@ -170,7 +180,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 34] = [
+    pub const ALL: [Pass; 38] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -198,6 +208,10 @@ impl Pass {
         Pass::MlsStrain,
         Pass::WallContact,
         Pass::GridCorrect,
+        Pass::ContactGrad,
+        Pass::ContactDetect,
+        Pass::ContactExchange,
+        Pass::ContactExchangeForce,
         Pass::G2p,
         Pass::RemapClear,
         Pass::Remap,
@@ -218,6 +232,9 @@ impl Pass {
             Pass::WallTouch => "wall_touch.wgsl",
             Pass::WallContact => "wall_contact.wgsl",
             Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
+            Pass::ContactGrad => "contact_grad.wgsl",
+            Pass::ContactDetect => "contact_detect.wgsl",
+            Pass::ContactExchange | Pass::ContactExchangeForce => "contact_exchange.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
             Pass::G2p => "g2p.wgsl",
@@ -261,7 +278,9 @@ pub struct PlanInputs {
     /// Rigid walls: the nodes they act on are found before `GridPredict`.
     pub walls: bool,
     /// Contact pairs: `shape_eval` must offset the nodes into each body's
-    /// field before `p2g` scatters (so the two do not fuse on the CPU).
+    /// field before `p2g` scatters (so the two do not fuse on the CPU); on
+    /// the GPU `shape_eval` bins the particles (for the gaps) and
+    /// `GridPredict`, `GridCorrect` and `Remap` add the contact passes.
     pub contact: bool,
 }
 
@@ -356,15 +375,16 @@ impl StepPlan {
             gather,
             patch,
             walls,
-            ..
+            contact,
         } = self.inputs;
+        let binned = gather || patch || contact;
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
-            Stage::ShapeEval if (gather || patch) && lme => {
+            Stage::ShapeEval if binned && lme => {
                 &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
             }
-            Stage::ShapeEval if gather || patch => &BINS,
+            Stage::ShapeEval if binned => &BINS,
             Stage::ShapeEval if lme => &[Pass::LmeNewton],
             Stage::ShapeEval => &[],
             Stage::P2g if mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
@@ -384,6 +404,19 @@ impl StepPlan {
             ],
             Stage::Forces if gather => &[Pass::ForcesGather],
             Stage::Forces if patch => &[Pass::ForcesPatch],
+            Stage::GridPredict if walls && contact => &[
+                Pass::WallTouch,
+                Pass::ContactGrad,
+                Pass::ContactDetect,
+                Pass::GridPredict,
+                Pass::ContactExchange,
+            ],
+            Stage::GridPredict if contact => &[
+                Pass::ContactGrad,
+                Pass::ContactDetect,
+                Pass::GridPredict,
+                Pass::ContactExchange,
+            ],
             Stage::GridPredict if walls => &[Pass::WallTouch, Pass::GridPredict],
             Stage::GridPredict => &[Pass::GridPredict],
             // The fit at the forces' positions: MUSL's forces came first
@@ -409,10 +442,23 @@ impl StepPlan {
             ],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
+            Stage::GridCorrect if walls && contact => &[
+                Pass::WallContact,
+                Pass::GridCorrect,
+                Pass::ContactExchangeForce,
+            ],
+            Stage::GridCorrect if contact => &[Pass::GridCorrect, Pass::ContactExchangeForce],
             Stage::GridCorrect if walls => &[Pass::WallContact, Pass::GridCorrect],
             Stage::GridCorrect => &[Pass::GridCorrect],
             Stage::G2p => &[Pass::G2p],
             Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
+            // The contacts stay those of the step's start (`GridPredict`).
+            Stage::Remap if contact => &[
+                Pass::RemapClear,
+                Pass::Remap,
+                Pass::GridPredict,
+                Pass::ContactExchange,
+            ],
             Stage::Remap => &[Pass::RemapClear, Pass::Remap, Pass::GridPredict],
         }
     }
@@ -529,6 +575,61 @@ mod tests {
             assert_eq!(p.gpu_uses(Pass::LmeNewton), lme, "{bits:05b}");
             assert_eq!(p.gpu_uses(Pass::RemapClear), musl, "{bits:05b}");
             assert_eq!(p.gpu_uses(Pass::WallTouch), p.inputs.walls, "{bits:05b}");
+        }
+    }
+
+    /// Contact pairs add their passes where the CPU does its work (detect
+    /// before `predict`, the exchange after it, after `correct` and after
+    /// MUSL's remap) and the binning in `shape_eval`; without pairs the
+    /// step is the same, pass for pass.
+    #[test]
+    fn contact_pairs_add_their_passes_only_with_pairs() {
+        let contact_passes = [
+            Pass::ContactGrad,
+            Pass::ContactDetect,
+            Pass::ContactExchange,
+            Pass::ContactExchangeForce,
+        ];
+        for musl in [false, true] {
+            for walls in [false, true] {
+                let base = PlanInputs {
+                    lme: false,
+                    mls: false,
+                    mls_force: false,
+                    musl,
+                    gather: false,
+                    patch: false,
+                    walls,
+                    contact: false,
+                };
+                let without = StepPlan::new(base);
+                let with = StepPlan::new(PlanInputs {
+                    contact: true,
+                    ..base
+                });
+                for pass in contact_passes {
+                    assert!(!without.gpu_uses(pass), "{pass:?}");
+                    assert!(with.gpu_step.contains(&pass), "{pass:?}");
+                }
+                let at = |p: Pass| with.gpu_step.iter().position(|x| *x == p).unwrap();
+                assert!(at(Pass::BinFill) < at(Pass::P2g));
+                assert!(at(Pass::P2g) < at(Pass::ContactGrad));
+                assert!(at(Pass::ContactDetect) < at(Pass::GridPredict));
+                assert!(at(Pass::GridPredict) < at(Pass::ContactExchange));
+                assert!(at(Pass::GridCorrect) < at(Pass::ContactExchangeForce));
+                assert!(at(Pass::ContactExchangeForce) < at(Pass::G2p));
+                if musl {
+                    let remap = with.passes_for(Stage::Remap);
+                    assert_eq!(remap.last(), Some(&Pass::ContactExchange));
+                }
+                let stripped: Vec<Pass> = with
+                    .gpu_step
+                    .iter()
+                    .copied()
+                    .filter(|p| !contact_passes.contains(p) && !BINS.contains(p))
+                    .collect();
+                assert_eq!(stripped, without.gpu_step);
+            }
         }
     }
 }

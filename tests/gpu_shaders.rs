@@ -3,7 +3,7 @@
 //! for, and every struct shared with Rust has the same layout on both sides.
 
 use lme_mpm::gpu::context::AtomicMode;
-use lme_mpm::gpu::layout::{GpuConstraint, GpuMaterial, GpuWall, Params, Sim};
+use lme_mpm::gpu::layout::{GpuConstraint, GpuContactPair, GpuMaterial, GpuWall, Params, Sim};
 use lme_mpm::gpu::pipelines::{self, Pass, Variant};
 use lme_mpm::gpu::preprocess::SOURCES;
 use lme_mpm::model::Integrator;
@@ -165,6 +165,7 @@ fn variants() -> Vec<Variant> {
                                                             | ShapeKind::Bspline2
                                                             | ShapeKind::Bspline3
                                                     )),
+                                        contact: None,
                                     });
                                 }
                             }
@@ -174,6 +175,19 @@ fn variants() -> Vec<Variant> {
             }
         }
     }
+    // Contact pairs (four fields, three pairs) on every variant they
+    // allow (no MLS; they scatter per particle), with several materials.
+    let contact: Vec<Variant> = out
+        .iter()
+        .filter(|v| !v.mls && v.multi_material)
+        .map(|v| Variant {
+            gather: false,
+            patch: false,
+            contact: Some([4, 3]),
+            ..*v
+        })
+        .collect();
+    out.extend(contact);
     out
 }
 
@@ -196,7 +210,9 @@ fn every_pass_validates_in_every_variant() {
             assert_eq!(
                 has(Buf::NodePos),
                 v.perturbed
-                    && (pass_uses_shape(pass) || (pass == Pass::BinCount && (v.gather || v.patch))),
+                    && (pass_uses_shape(pass)
+                        || (pass == Pass::BinCount
+                            && (v.gather || v.patch || v.contact.is_some()))),
                 "{pass:?} {v:?}: node_pos"
             );
             assert!(
@@ -231,9 +247,25 @@ fn every_pass_validates_in_every_variant() {
                 "{pass:?} {v:?}: MLS buffers without MLS"
             );
             assert!(
-                !(has(Buf::CellCount) || has(Buf::CellOrder)) || v.mls || v.gather || v.patch,
-                "{pass:?} {v:?}: cell bins without MLS, gather or patch"
+                !(has(Buf::CellCount) || has(Buf::CellOrder))
+                    || v.mls
+                    || v.gather
+                    || v.patch
+                    || v.contact.is_some(),
+                "{pass:?} {v:?}: cell bins without MLS, gather, patch or contact pairs"
             );
+            assert!(
+                !(has(Buf::Field)
+                    || has(Buf::ContactPairs)
+                    || has(Buf::ContactGrad)
+                    || has(Buf::ContactNormal))
+                    || v.contact.is_some(),
+                "{pass:?} {v:?}: contact buffers without contact pairs"
+            );
+            // Every pass that walks a particle's nodes offsets them by its field.
+            if v.contact.is_some() && pass_uses_shape(pass) && pass != Pass::LmeNewton {
+                assert!(has(Buf::Field), "{pass:?} {v:?}: nodes not offset by field");
+            }
             assert!(
                 !(has(Buf::Walls) || has(Buf::WallForce) || has(Buf::WallTouch)) || v.walls,
                 "{pass:?} {v:?}: wall buffers without walls"
@@ -280,6 +312,8 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::MlsForceGauss
             | Pass::WallTouch
             | Pass::WallContact
+            | Pass::ContactGrad
+            | Pass::ContactDetect
     )
 }
 
@@ -328,6 +362,11 @@ fn shared_structs_match_rust_layouts() {
     let wall =
         rust_fields!(GpuWall; point, normal, mu, contact, stiffness, offset, appear_at, remove_at);
     assert_eq!(wgsl_struct(&module, "Wall"), wall);
+    let v = *variants().iter().find(|v| v.contact.is_some()).unwrap();
+    let src = pipelines::expand(Pass::ContactExchange, &v.defines()).unwrap();
+    let module = pipelines::validate(&src, "contact_exchange.wgsl", v.atomics).unwrap();
+    let pair = rust_fields!(GpuContactPair; fields, law, mu, reaction);
+    assert_eq!(wgsl_struct(&module, "ContactPair"), pair);
 }
 
 /// A WGSL constant's value as naga's front end evaluated it.
@@ -374,8 +413,9 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
             .unwrap()
     };
     let walls = all.iter().find(|v| v.walls).unwrap();
+    let contact = all.iter().find(|v| v.contact.is_some()).unwrap();
     let mut out = Vec::new();
-    for v in [mls, lme, musl(true), musl(false), walls] {
+    for v in [mls, lme, musl(true), musl(false), walls, contact] {
         let d = v.defines();
         for pass in Pass::ALL {
             if v.plan().gpu_uses(pass) {
@@ -410,10 +450,7 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("FAULT_LME_NOT_CONVERGED", u(l::FAULT_LME_NOT_CONVERGED)),
         ("FAULT_LME_SINGULAR", u(l::FAULT_LME_SINGULAR)),
         ("FAULT_MLS_SINGULAR", u(l::FAULT_MLS_SINGULAR)),
-        (
-            "FAULT_RETURN_NOT_CONVERGED",
-            u(l::FAULT_RETURN_NOT_CONVERGED),
-        ),
+        ("FAULT_MATERIAL", u(l::FAULT_MATERIAL)),
         ("CONTACT_STICK", u(lme_mpm::model::walls::CONTACT_STICK)),
         ("CONTACT_SLIP", u(lme_mpm::model::walls::CONTACT_SLIP)),
         (
@@ -433,6 +470,10 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("MLS_SUPPORT", f(lme_mpm::cpu::mls::SUPPORT_CELLS)),
         ("WALL_DAMPING", f(lme_mpm::model::walls::WALL_DAMPING)),
         ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
+        (
+            "CONTACT_GAP_SLACK",
+            f(lme_mpm::cpu::contact::CONTACT_GAP_SLACK),
+        ),
     ];
     let modules = every_pass_module();
     // Every model's code, generated from the registry.

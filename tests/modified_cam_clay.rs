@@ -163,7 +163,15 @@ fn kernel() -> String {
     format!("#include \"shared/common.wgsl\"\n#include \"shared/material.wgsl\"\n{KERNEL_MAIN}")
 }
 
-const MCC_FAULT_NOT_CONVERGED: u32 = lme_mpm::gpu::layout::FAULT_RETURN_NOT_CONVERGED;
+/// The GPU code of the model's one fault, as the registry numbers it.
+fn mcc_fault_not_converged() -> u32 {
+    lme_mpm::model::material::registry()
+        .into_iter()
+        .find(|e| e.name == "modified_cam_clay")
+        .expect("registered")
+        .gpu_fault_code(lme_mpm::model::material::modified_cam_clay::NOT_CONVERGED.code)
+        .expect("Cam-clay declares its fault")
+}
 
 /// GPU vs CPU, one step, on stresses relative to the scale max(|σ|, p_c):
 /// the return converges to MCC_RETURN_TOL = 1e-5 on scaled residuals in
@@ -485,7 +493,9 @@ fn wgsl_constants_match_rust() {
             Some("MCC_MAX_ITER") => naga::Literal::U32(MAX_ITER),
             Some("MCC_RETURN_ELLIPSE") => naga::Literal::U32(ACTIVE_MAIN),
             Some("MCC_RETURN_APEX") => naga::Literal::U32(ACTIVE_APEX),
-            Some("FAULT_RETURN_NOT_CONVERGED") => naga::Literal::U32(MCC_FAULT_NOT_CONVERGED),
+            Some("MODIFIED_CAM_CLAY_FAULT_RETURN_NOT_CONVERGED") => {
+                naga::Literal::U32(mcc_fault_not_converged())
+            }
             _ => continue,
         };
         assert_eq!(lit, want, "{:?}", c.name);
@@ -829,5 +839,33 @@ fn large_steps_converge_on_the_gpu() {
         close * 100 >= cases.len() * 99,
         "{close} of {}",
         cases.len()
+    );
+}
+
+/// The GPU's fault word for Cam-clay's return decodes, through the faulting
+/// particle's material, to the fault the model declares (the same code in
+/// summary.json as the CPU's); on a material that declares none the same
+/// word is an unknown code, never another model's fault.
+#[test]
+fn gpu_fault_word_decodes_to_the_models_own_fault() {
+    use lme_mpm::gpu::decode_fault;
+    use lme_mpm::model::Model;
+    use lme_mpm::model::fault::FaultKind;
+    let scene = common::scene("clay_biaxial.toml", &[]);
+    let model = Model::new(&scene).unwrap();
+    let word = (5 << 4) | mcc_fault_not_converged();
+    let f = decode_fault(&model, 50, word);
+    assert_eq!(f.particle, Some(5));
+    assert_eq!(f.code(), "return_not_converged");
+    assert!(
+        matches!(f.kind, FaultKind::Material { fault, .. }
+            if fault == lme_mpm::model::material::modified_cam_clay::NOT_CONVERGED),
+        "{f}"
+    );
+    let lin = Model::new(&common::scene("elastic_block.toml", &[])).unwrap();
+    let g = decode_fault(&lin, 50, word);
+    assert!(
+        matches!(g.kind, FaultKind::NonFinite { field } if field.contains("unknown")),
+        "{g}"
     );
 }

@@ -422,6 +422,47 @@ impl Report {
     }
 }
 
+/// Contact pairs' `detect` (the first passes of `GridPredict`): the same
+/// pair nodes in contact on both twins, their normals (unit vectors) to
+/// `normal_tol` and their gaps to `CONTACT_GAP_TOL` h.
+fn check_detect(
+    rep: &mut Report,
+    st: &lme_mpm::cpu::contact::ContactState,
+    gpu: &[([f64; 2], Option<f64>)],
+    h: f64,
+    normal_tol: f64,
+) {
+    assert_eq!(gpu.len(), st.normal.len());
+    let (mut touching, mut differ, mut dn, mut dg) = (0, 0, 0.0f64, 0.0f64);
+    for (o, (n, gap)) in gpu.iter().enumerate() {
+        let (cn, cg) = (st.normal[o], st.gap[o]);
+        let (on_cpu, on_gpu) = (cn != [0.0, 0.0], *n != [0.0, 0.0]);
+        if on_cpu != on_gpu {
+            differ += 1;
+            continue;
+        }
+        if on_cpu {
+            touching += 1;
+            dn = dn.max((n[0] - cn[0]).abs().max((n[1] - cn[1]).abs()));
+        }
+        // A gap is measured where the pair has a normal (before the gap
+        // test), on both twins.
+        assert_eq!(
+            gap.is_some(),
+            cg.is_finite(),
+            "pair node {o}: gap {gap:?} against {cg}"
+        );
+        if let Some(g) = gap {
+            dg = dg.max((g - cg).abs() / h);
+        }
+    }
+    println!("  contact detect: {touching} pair nodes in contact on both, {differ} on one only");
+    assert!(touching > 0, "no pair node in contact: detect untested");
+    assert_eq!(differ, 0, "pair nodes in contact on one twin only");
+    rep.check("contact detect: normal", dn, normal_tol);
+    rep.check("contact detect: gap / h", dg, CONTACT_GAP_TOL);
+}
+
 /// Runs every stage once on both backends from the same state.
 fn parity(label: &str, sets: &[&str], force_cas: bool) {
     parity_with(label, sets, force_cas, GpuOptions::default());
@@ -439,7 +480,27 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
     println!("{label} ({:?} atomics)", ctx.atomics);
     let lme = matches!(model.shape, lme_mpm::model::shape::Shape::Lme(_));
     let family = Family::of(&model);
-    let tol = family.tolerances();
+    let contact_tol;
+    let tol = match &model.contact {
+        // The exchange moves velocities along the contact normals, which
+        // carry their own f32 error (`CONTACT_NORMAL_TOL`).
+        Some(_) => {
+            let t = family.tolerances();
+            let exchange = if family == Family::Lme {
+                CONTACT_EXCHANGE_TOL_LME
+            } else {
+                CONTACT_EXCHANGE_TOL
+            };
+            contact_tol = StageTol {
+                grid_predict: t.grid_predict.max(exchange),
+                grid_correct: t.grid_correct.max(exchange),
+                remap: t.remap.max(CONTACT_REMAP_TOL),
+                ..*t
+            };
+            &contact_tol
+        }
+        None => family.tolerances(),
+    };
     let mut cpu = CpuBackend::new(model.clone());
     cpu.set_time(t);
     let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
@@ -532,6 +593,15 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                 );
             }
             Stage::GridPredict => {
+                if let Some(st) = &cpu.contact {
+                    let normal_tol = if family == Family::Lme {
+                        CONTACT_NORMAL_TOL_LME
+                    } else {
+                        CONTACT_NORMAL_TOL
+                    };
+                    let g = gpu.read_contact().unwrap();
+                    check_detect(&mut rep, st, &g, cpu.model.grid.h, normal_tol);
+                }
                 rep.check(
                     "grid_update predict: vx",
                     rel_err(&col(1), &cpu_col(1), None),
@@ -1287,5 +1357,105 @@ fn stages_match_wall_preload() {
             m.particles.stress[i] = m.particles.stress[i].map(|c| s * c);
         }
         parity_of(label, m, false, GpuOptions::default(), 0.0);
+    }
+}
+
+/// Contact normals, |GPU − CPU| of the unit vectors' components: f32
+/// sums of m_p ∇N normalised. Measured (stages_match_contact_pairs) 3.3e-7
+/// linear, 6.3e-7 uGIMP, 1.5e-6 B-spline, 10 times rounded up; LME 2.6e-5,
+/// its f32 Newton leaving Σ∇N ≈ 1e-5/h (as in its stress and forces).
+const CONTACT_NORMAL_TOL: f64 = 2e-5;
+const CONTACT_NORMAL_TOL_LME: f64 = 3e-4;
+/// The exchange's velocities, forces and the pairs' reactions (in
+/// `GridPredict` and `GridCorrect`), relative as the stages' own: they move
+/// along the normals and carry their error. Measured 7.3e-7 (B-spline,
+/// correct: vy change), 10 times rounded up; LME 2.0e-5 (the reactions).
+const CONTACT_EXCHANGE_TOL: f64 = 8e-6;
+const CONTACT_EXCHANGE_TOL_LME: f64 = 2e-4;
+/// MUSL's remap with contact pairs: a field node that holds a sliver of
+/// one body (6e-6 kg beside 26 kg of another field at the same node) gets
+/// v = q/m from f32 atomics whose terms cancel, 5e-3 of its own velocity;
+/// measured 6.4e-4 of the largest (B-spline), 10 times rounded up.
+const CONTACT_REMAP_TOL: f64 = 7e-3;
+/// Contact gaps, |GPU − CPU| / h: f32 distances of positions ~1 m.
+/// Measured 4.4e-7 (uGIMP), 10 times rounded up.
+const CONTACT_GAP_TOL: f64 = 5e-6;
+
+/// Four bodies: "a" and "b" a frictional pair, "b" and "c" a frictionless
+/// one, "d" in no pair (field 0). Random positions put every body
+/// everywhere: pairs in contact approaching and separating, friction that
+/// sticks and slips, fields that merge (d with the others, a with c).
+const CONTACT_SCENE: &str = r#"
+[grid]
+h = 0.5
+min = [0.0, 0.0]
+max = [4.0, 3.0]
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.a]
+material = "m"
+rects = [[0.5, 0.5, 2.0, 1.5]]
+[bodies.b]
+material = "m"
+rects = [[2.0, 0.5, 3.5, 1.5]]
+[bodies.c]
+material = "m"
+rects = [[0.5, 1.5, 2.0, 2.5]]
+[bodies.d]
+material = "m"
+rects = [[2.0, 1.5, 3.5, 2.5]]
+[contact.ab]
+bodies = ["a", "b"]
+law = "friction"
+friction = 0.3
+[contact.cb]
+bodies = ["c", "b"]
+law = "slip"
+[constraints.base]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "y"
+[constraints.pin]
+min = [2.0, 1.0]
+max = [2.0, 2.0]
+fix = "xy"
+[gravity]
+g = [0.0, -9.81]
+[solver]
+lme_gamma = 3.0
+t_end = 1.0
+"#;
+
+/// Contact pairs (issue 24): every stage with the bodies on their fields,
+/// `detect` (normals, gaps) after `GridPredict`, the exchange after
+/// `GridPredict` and, as forces with the pairs' reactions, after
+/// `GridCorrect`; four shape families, the three integrators, a perturbed
+/// grid and CAS atomics.
+#[test]
+fn stages_match_contact_pairs() {
+    for (label, sets, cas) in [
+        ("contact, linear npc", &["solver.shape=linear"][..], false),
+        (
+            "contact, ugimp fe, CAS atomics",
+            &["solver.shape=ugimp", "solver.integrator=fe"][..],
+            true,
+        ),
+        (
+            "contact, lme npc perturbed",
+            &["solver.shape=lme", "grid.perturb=0.2"][..],
+            false,
+        ),
+        (
+            "contact, bspline2 musl",
+            &["solver.shape=bspline2", "solver.integrator=musl"][..],
+            false,
+        ),
+    ] {
+        let m = random_model_of(CONTACT_SCENE, sets, 5);
+        assert_eq!(m.n_fields(), 4, "{label}");
+        parity_of(label, m, cas, GpuOptions::default(), 0.0);
     }
 }

@@ -456,6 +456,62 @@ fn implicit_quick_compares_schemes_per_case() {
     }
 }
 
+/// Contact between bodies, quick: the off-centre disks with their pair
+/// and with one shared field, and the disk rolling on a slab at R/h = 10.
+#[test]
+fn contact_quick_measures_collisions_and_rolling() {
+    use lme_mpm::study::contact::{collision, history};
+    let (results, md, _) = run(StudyName::Contact);
+    assert!(md.contains("Two disks colliding") && md.contains("rolling on an elastic body"));
+    let by = |label: &str| {
+        results
+            .iter()
+            .find(|r| r.job.label == label)
+            .unwrap_or_else(|| panic!("no run {label}"))
+    };
+    for r in &results {
+        assert!(
+            r.completed(),
+            "{}: {:?}",
+            r.job.label,
+            r.data().map(|d| d.status_text())
+        );
+    }
+    let pair = collision(by("cpu-disks-off-centre-pair")).unwrap();
+    let one = collision(by("cpu-disks-off-centre-one")).unwrap();
+    println!("off-centre: pair {pair:?}\none field {one:?}");
+    // The exchange conserves momentum (tests/contact.rs: 3e-15 per step).
+    assert!(pair.momentum_drift < 1e-12, "{}", pair.momentum_drift);
+    // No interpenetration beyond one cell (h = 0.025 m).
+    assert!(pair.max_overlap < 0.025, "{}", pair.max_overlap);
+    // Contact starts when the surfaces meet (0.025 s), not a cell early
+    // (a cell at the 2 m/s closing speed is 0.0125 s).
+    let onset = pair.onset.expect("the pair never touched");
+    assert!((0.0225..0.0275).contains(&onset), "{onset}");
+    // One shared field: the disks never get within a cell of each other's
+    // domains (they meet through shared nodes, apart).
+    assert!(one.max_overlap < 0.0, "{}", one.max_overlap);
+    // Rolling at R/h = 10: the pair rolls, the shared field glues the disk.
+    let a = 2.0 / 3.0 * 9.81 * 0.5;
+    let rolled = |label: &str| {
+        let (t, b) = history(by(label)).pop().unwrap();
+        b[0].displacement[0] / (0.5 * a * t * t)
+    };
+    let (p, o) = (
+        rolled("cpu-rolling-h0.05-pair"),
+        rolled("cpu-rolling-h0.05-one"),
+    );
+    println!("rolling R/h 10: pair {p:.4}, one field {o:.4} of the exact distance");
+    assert!(o < 0.05, "{o}");
+    // Not issue 24's 5 %: measured 0.841 (−15.9 %; −8.5 % at R/h 20), the
+    // nodal exchange's rolling resistance (docs/verification.md, "Contact
+    // between bodies"). The bound holds the figure; a fix shows up here.
+    assert!(p > ROLLING_R10_MIN, "{p}");
+}
+
+/// The rolling disk on a slab at R/h = 10 covers at least this share of
+/// the exact distance: measured 0.841 (2026-11-25).
+const ROLLING_R10_MIN: f64 = 0.82;
 /// `study gmm --quick`: GMM-LME and GMM-MLS on the cantilever at h = 0.5,
 /// 0.25, 0.125 (milliseconds each), with the orders, Richardson limits and
 /// the paper's ordering of the two bases in the section.

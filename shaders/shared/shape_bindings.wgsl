@@ -3,6 +3,19 @@
 #if PERTURBED
 @group(0) @binding({{B_NODE_POS}}) var<storage, read> node_pos: array<vec2<f32>>;
 #endif
+#if CONTACT
+// Contact pairs (`model::contact`): each particle's field, the copy of the
+// grid's nodes its body moves on; node i of field f is f · n_nodes + i, so
+// `shape_node` offsets each particle's nodes into its field (the CPU's
+// `contact::offset_nodes` after `shape_eval`) and every pass that
+// scatters or gathers through it works per field unchanged.
+@group(0) @binding({{B_FIELD}}) var<storage, read> field: array<u32>;
+
+// The first node of particle p's field.
+fn field_base(p: u32) -> u32 {
+    return field[p] * params.n_nodes;
+}
+#endif
 #if SHAPE_LME
 @group(0) @binding({{B_LAMBDA}}) var<storage, {{LME_ACCESS}}> lambda: array<vec2<f32>>;
 #if LME_STORED

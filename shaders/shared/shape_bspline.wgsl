@@ -131,11 +131,19 @@ struct ShapeCtx {
     bx: Basis1,
     by: Basis1,
     ok: bool,
+#if CONTACT
+    // The first node of the particle's field (`field_base`).
+    field_base: u32,
+#endif
 }
 
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
     let q = x * params.inv_h;
+#if CONTACT
+    return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, 0.0), field_base(p));
+#else
     return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, 0.0));
+#endif
 }
 
 fn shape_valid(c: ShapeCtx) -> bool {
@@ -151,6 +159,9 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.node = (c.by.first + b) * params.nx + c.bx.first + a;
     w.n = c.bx.n[a] * c.by.n[b];
     w.dn = vec2<f32>(c.bx.dn[a] * c.by.n[b], c.bx.n[a] * c.by.dn[b]) * params.inv_h;
+#if CONTACT
+    w.node += c.field_base;
+#endif
     return w;
 }
 

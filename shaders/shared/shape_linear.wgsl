@@ -5,10 +5,18 @@ const SHAPE_WIDTH: u32 = 2u;
 
 struct ShapeCtx {
     cp: CellPoint,
+#if CONTACT
+    // The first node of the particle's field (`field_base`).
+    field_base: u32,
+#endif
 }
 
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
+#if CONTACT
+    return ShapeCtx(locate(x), field_base(p));
+#else
     return ShapeCtx(locate(x));
+#endif
 }
 
 fn shape_valid(c: ShapeCtx) -> bool {
@@ -30,6 +38,9 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.n = ns * nt;
     w.dn = to_physical(c.cp.map, vec2<f32>(ds * nt, ns * dt));
     w.ok = c.cp.ok;
+#if CONTACT
+    w.node += c.field_base;
+#endif
     return w;
 }
 

@@ -67,11 +67,19 @@ struct ShapeCtx {
     i0: u32,
     j0: u32,
     ok: bool,
+#if CONTACT
+    // The first node of the particle's field (`field_base`).
+    field_base: u32,
+#endif
 }
 
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
     let b = lme_box(x);
+#if CONTACT
+    return ShapeCtx(p * STENCIL, b.x, b.y, inside_grid(x, 0.0), field_base(p));
+#else
     return ShapeCtx(p * STENCIL, b.x, b.y, inside_grid(x, 0.0));
+#endif
 }
 
 fn shape_valid(c: ShapeCtx) -> bool {
@@ -85,6 +93,9 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.ok = c.ok && w.node != LME_EMPTY;
     w.n = lme_w[3u * s];
     w.dn = vec2<f32>(lme_w[3u * s + 1u], lme_w[3u * s + 2u]);
+#if CONTACT
+    w.node += c.field_base;
+#endif
     return w;
 }
 #else
@@ -96,6 +107,10 @@ struct ShapeCtx {
     // log Z, then J⁻¹ as [00, 01, 11].
     cache: vec4<f32>,
     ok: bool,
+#if CONTACT
+    // The first node of the particle's field (`field_base`).
+    field_base: u32,
+#endif
 }
 
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
@@ -107,6 +122,9 @@ fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
     c.lam = lambda[p];
     c.cache = lme_cache[p];
     c.ok = inside_grid(x, 0.0);
+#if CONTACT
+    c.field_base = field_base(p);
+#endif
     return c;
 }
 
@@ -123,6 +141,9 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.n = exp(f - c.cache.x);
     let jd = vec2<f32>(c.cache.y * a.d.x + c.cache.z * a.d.y, c.cache.z * a.d.x + c.cache.w * a.d.y);
     w.dn = -w.n * jd;
+#if CONTACT
+    w.node += c.field_base;
+#endif
     return w;
 }
 #endif

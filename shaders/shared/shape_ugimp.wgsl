@@ -14,6 +14,10 @@ struct ShapeCtx {
     dwy: vec3<f32>,
     map: CellMap,
     ok: bool,
+#if CONTACT
+    // The first node of the particle's field (`field_base`).
+    field_base: u32,
+#endif
 }
 
 // 1D weight and derivative in lattice units: d = (particle − node)/h, l = lp/h.
@@ -54,6 +58,9 @@ fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
         c.wy[k] = b.x;
         c.dwy[k] = b.y;
     }
+#if CONTACT
+    c.field_base = field_base(p);
+#endif
     return c;
 }
 
@@ -71,6 +78,9 @@ fn shape_node(c: ShapeCtx, k: u32) -> NodeW {
     w.node = u32(max(j, 0)) * params.nx + u32(max(i, 0));
     w.n = c.wx[kx] * c.wy[ky];
     w.dn = to_physical(c.map, vec2<f32>(c.dwx[kx] * c.wy[ky], c.wx[kx] * c.dwy[ky]));
+#if CONTACT
+    w.node += c.field_base;
+#endif
     return w;
 }
 

@@ -16,8 +16,10 @@ const FAULT_LME_NOT_CONVERGED: u32 = 7u;
 const FAULT_LME_SINGULAR: u32 = 8u;
 // MLS moment matrix singular; the index is the Gauss point's, not a particle's.
 const FAULT_MLS_SINGULAR: u32 = 9u;
-// A material's implicit stress return did not converge (Cam-clay's Newton).
-const FAULT_RETURN_NOT_CONVERGED: u32 = 10u;
+// Codes 10..15 are the material models' own faults (Constitutive::FAULTS,
+// in order; generated constants <NAME>_FAULT_<CODE>), decoded through the
+// faulting particle's material.
+const FAULT_MATERIAL: u32 = 10u;
 
 // Scene constants (uniform), fixed for a run.
 struct Params {

@@ -6,7 +6,8 @@
 
 use super::context::GpuContext;
 use super::layout::{
-    GPU_PARAM_SLOTS, GpuConstraint, GpuMaterial, GpuWall, NODE_STRIDE, PROBE_STRIDE, Params, Sim,
+    GPU_PARAM_SLOTS, GpuConstraint, GpuContactPair, GpuMaterial, GpuWall, NODE_STRIDE,
+    PROBE_STRIDE, Params, Sim,
 };
 use super::options::GpuOptions;
 use crate::error::{Error, Result, SceneError};
@@ -79,10 +80,24 @@ pub enum Buf {
     /// MUSL: each particle's position at the step's start (grid-relative),
     /// for the remap and the stress, which run after g2p has moved it.
     XStart,
+    /// Contact pairs only (`model::contact`): per particle, its body's
+    /// field (u32), by which `shape_node` offsets its nodes.
+    Field,
+    /// Contact pairs only: the pairs (`GpuContactPair`).
+    ContactPairs,
+    /// Contact pairs only: per field node, the mass gradient and volume
+    /// [Σ m_p ∇N, Σ N V_p] (contact_grad.wgsl).
+    ContactGrad,
+    /// Contact pairs only: the smallest particle half-width this step (m,
+    /// f32 bits; contact_grad.wgsl), the gap test's slack.
+    ContactSlack,
+    /// Contact pairs only: per pair and grid node, [n_x, n_y, gap]
+    /// (contact_detect.wgsl; n zero where the pair is not in contact).
+    ContactNormal,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 41] = [
+    pub const ALL: [Buf; 46] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -124,6 +139,11 @@ impl Buf {
         Buf::WallPreForce,
         Buf::ExtForce,
         Buf::XStart,
+        Buf::Field,
+        Buf::ContactPairs,
+        Buf::ContactGrad,
+        Buf::ContactSlack,
+        Buf::ContactNormal,
     ];
 
     pub fn binding(self) -> u32 {
@@ -152,7 +172,12 @@ impl Buf {
 pub struct Buffers {
     pub map: BTreeMap<Buf, wgpu::Buffer>,
     pub n_particles: usize,
+    /// Grid nodes (one field's).
     pub n_nodes: usize,
+    /// Copies of the grid's nodes in the nodal buffers (1 without contact
+    /// pairs) and contact pairs (their reactions follow the walls').
+    pub n_fields: usize,
+    pub n_pairs: usize,
     pub n_probes: usize,
     pub n_groups: usize,
     /// Walls (their reactions follow the groups' in `Buf::Reactions`).
@@ -199,7 +224,7 @@ impl Buffers {
             ),
         ];
         particle_data(model, params, opts, &mut data);
-        let bins = model.mls || opts.gathers(model) || opts.patches(model);
+        let bins = binned(model, opts);
         grid_and_output_data(model, params, bins, &mut data);
         let map = upload(ctx, data, model)?;
         let g = &model.grid;
@@ -209,6 +234,8 @@ impl Buffers {
             map,
             n_particles: n,
             n_nodes: g.n_nodes(),
+            n_fields: model.n_fields(),
+            n_pairs: model.contact.as_ref().map_or(0, |c| c.pairs.len()),
             n_probes: model.probes.len(),
             n_groups: groups,
             n_walls: model.walls.list.len(),
@@ -220,6 +247,12 @@ impl Buffers {
             },
         })
     }
+}
+
+/// Whether particles are binned by cell: for MLS, the gather and per-bin
+/// passes, and contact pairs' gaps (`contact_detect.wgsl`).
+pub fn binned(model: &Model, opts: &GpuOptions) -> bool {
+    model.mls || opts.gathers(model) || opts.patches(model) || model.contact.is_some()
 }
 
 /// The materials as the shaders read them.
@@ -338,14 +371,16 @@ fn grid_and_output_data(
     let rel = |x: [f64; 2]| [(x[0] - origin[0]) as f32, (x[1] - origin[1]) as f32];
     let bytes = |v: &[f32]| bytemuck::cast_slice::<f32, u8>(v).to_vec();
     let flat2 = |it: &mut dyn Iterator<Item = [f32; 2]>| it.flatten().collect::<Vec<f32>>();
-    data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * g.n_nodes()]));
+    // One copy of the nodes per field (contact pairs), stacked.
+    let field_nodes = g.n_nodes() * model.n_fields();
+    data.push((Buf::NodeAcc, vec![0u8; 4 * NODE_STRIDE * field_nodes]));
     if g.is_perturbed() {
         data.push((
             Buf::NodePos,
             bytes(&flat2(&mut g.pos.iter().map(|x| rel(*x)))),
         ));
     }
-    let reactions = model.constraints.groups.len() + model.walls.list.len();
+    let reactions = model.reaction_names().len();
     data.push((Buf::Reactions, vec![0u8; 8 * reactions.max(1)]));
     if !model.walls.is_empty() {
         let walls: Vec<GpuWall> = model
@@ -372,12 +407,12 @@ fn grid_and_output_data(
             })
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
-        data.push((Buf::WallForce, vec![0u8; 8 * g.n_nodes()]));
-        data.push((Buf::WallTouch, vec![0u8; 4 * g.n_nodes()]));
+        data.push((Buf::WallForce, vec![0u8; 8 * field_nodes]));
+        data.push((Buf::WallTouch, vec![0u8; 4 * field_nodes]));
         if !model.walls.preload.is_empty() {
             let pre: Vec<f32> = model.walls.preload.iter().map(|&t| t as f32).collect();
             data.push((Buf::WallPreload, bytemuck::cast_slice(&pre).to_vec()));
-            data.push((Buf::WallPreForce, vec![0u8; 8 * g.n_nodes()]));
+            data.push((Buf::WallPreForce, vec![0u8; 8 * field_nodes]));
         }
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();
@@ -392,6 +427,36 @@ fn grid_and_output_data(
         vec![0u8; 4 * PROBE_STRIDE * model.probes.len().max(1)],
     ));
     data.push((Buf::EnergyOut, vec![0u8; 16]));
+    if let Some(c) = &model.contact {
+        let field: Vec<u32> = model
+            .particles
+            .body
+            .iter()
+            .map(|b| c.field_of_body[*b as usize])
+            .collect();
+        data.push((Buf::Field, bytemuck::cast_slice(&field).to_vec()));
+        let first = model.constraints.groups.len() + model.walls.list.len();
+        let pairs: Vec<GpuContactPair> = c
+            .pairs
+            .iter()
+            .enumerate()
+            .map(|(k, p)| GpuContactPair {
+                fields: p.fields,
+                law: p.law,
+                mu: p.mu as f32,
+                reaction: (first + k) as u32,
+                _pad: 0,
+            })
+            .collect();
+        data.push((Buf::ContactPairs, bytemuck::cast_slice(&pairs).to_vec()));
+        data.push((Buf::ContactGrad, vec![0u8; 12 * field_nodes]));
+        // The largest finite f32 (clear_grid resets it each step).
+        data.push((Buf::ContactSlack, f32::MAX.to_ne_bytes().to_vec()));
+        data.push((
+            Buf::ContactNormal,
+            vec![0u8; 12 * c.pairs.len() * g.n_nodes()],
+        ));
+    }
     if bins {
         let cells = (g.nx - 1) * (g.ny - 1);
         data.push((Buf::CellCount, vec![0u8; 4 * cells]));

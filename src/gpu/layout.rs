@@ -129,6 +129,21 @@ pub struct GpuWall {
 }
 const _: () = assert!(std::mem::size_of::<GpuWall>() == 40);
 
+/// A contact pair (shaders/shared/contact.wgsl `ContactPair`): the fields
+/// of its first and second body, its law (`model::walls::CONTACT_*`),
+/// Coulomb μ (friction only) and the index of its reaction in
+/// `Buf::Reactions` (after the constraint groups' and the walls').
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuContactPair {
+    pub fields: [u32; 2],
+    pub law: u32,
+    pub mu: f32,
+    pub reaction: u32,
+    pub _pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<GpuContactPair>() == 24);
+
 /// Floats per node in the nodal accumulator: mass, momentum/velocity (2), force (2).
 pub const NODE_STRIDE: usize = 5;
 /// Floats per probe in the probe buffer.
@@ -150,8 +165,9 @@ pub const FAULT_LME_NOT_CONVERGED: u32 = 7;
 pub const FAULT_LME_SINGULAR: u32 = 8;
 /// The index field holds the Gauss point, not a particle.
 pub const FAULT_MLS_SINGULAR: u32 = 9;
-/// A material's implicit stress return did not converge.
-pub const FAULT_RETURN_NOT_CONVERGED: u32 = 10;
+/// The first code of the material models' own faults (codes
+/// `FAULT_MATERIAL..16`, `Constitutive::FAULTS` in order).
+pub const FAULT_MATERIAL: u32 = crate::model::material::registry::GPU_FAULT_BASE;
 
 /// Splits an f64 into a two-float sum hi + lo (for times in f32).
 pub fn split_f64(v: f64) -> (f32, f32) {

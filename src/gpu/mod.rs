@@ -70,13 +70,6 @@ impl GpuBackend {
             )
             .into());
         }
-        if model.contact.is_some() {
-            return Err(crate::error::SceneError::invalid(
-                "contact",
-                "pairs run on the CPU path only for now (--backend cpu or auto)",
-            )
-            .into());
-        }
         let params = params(&model);
         let buffers = Buffers::new(&ctx, &model, &params, &opts)?;
         let pipelines = Pipelines::new(&ctx, &model, &buffers, &opts)?;
@@ -186,21 +179,46 @@ impl GpuBackend {
         Ok(self.read(&[Buf::Sim])?.sim())
     }
 
-    /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32).
+    /// Nodal accumulators: per node [mass, vx, vy, fx, fy] (f32), every
+    /// field's nodes in turn with contact pairs (as the CPU's `mv`).
     pub fn read_nodes(&self) -> Result<Vec<[f32; NODE_STRIDE]>> {
         let b = self.read(&[Buf::NodeAcc])?;
         Ok(b.f32s(Buf::NodeAcc)
             .chunks_exact(NODE_STRIDE)
-            .take(self.buffers.n_nodes)
+            .take(self.buffers.n_nodes * self.buffers.n_fields)
             .map(|c| c.try_into().expect("chunk of NODE_STRIDE"))
             .collect())
     }
 
-    /// Reactions per constraint group then per wall, as last computed on the device.
+    /// Reactions per constraint group, then per wall, then per contact
+    /// pair, as last computed on the device.
     pub fn read_reactions(&self) -> Result<Vec<[f64; 2]>> {
         Ok(self
             .read(&[Buf::Reactions])?
-            .pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls))
+            .pairs(Buf::Reactions, self.n_reactions()))
+    }
+
+    fn n_reactions(&self) -> usize {
+        self.buffers.n_groups + self.buffers.n_walls + self.buffers.n_pairs
+    }
+
+    /// Contact pairs' detection as last computed on the device: per pair
+    /// and grid node (`pair · n_nodes + node`), the normal (zero where the
+    /// pair is not in contact) and the gap (m; `None` where none was
+    /// measured), as the CPU's `contact::ContactState`. Empty without pairs.
+    pub fn read_contact(&self) -> Result<Vec<([f64; 2], Option<f64>)>> {
+        if self.buffers.n_pairs == 0 {
+            return Ok(Vec::new());
+        }
+        let b = self.read(&[Buf::ContactNormal])?;
+        Ok(b.f32s(Buf::ContactNormal)
+            .chunks_exact(3)
+            .take(self.buffers.n_pairs * self.buffers.n_nodes)
+            .map(|c| {
+                let gap = (c[2] < f32::MAX).then_some(c[2] as f64);
+                ([c[0] as f64, c[1] as f64], gap)
+            })
+            .collect())
     }
 
     /// Sets the device's stop time (`Sim::t_stop_hi`, `t_stop_lo`: adjacent
@@ -303,49 +321,10 @@ impl GpuBackend {
         self.fresh = false;
     }
 
-    fn fault_of(&self, word: u32) -> Fault {
-        let particle = (word >> 4) as usize;
-        if word & 0xf == FAULT_MLS_SINGULAR {
-            let at = crate::model::gauss::gauss_point_position(
-                &self.model.shape,
-                &self.model.grid,
-                particle,
-            );
-            return Fault {
-                particle: None,
-                kind: FaultKind::MlsSingular { at },
-            };
-        }
-        let kind = match word & 0xf {
-            FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
-            FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
-            FAULT_NON_FINITE_STRESS => FaultKind::NonFinite { field: "stress" },
-            FAULT_NON_FINITE_MOTION => FaultKind::NonFinite {
-                field: "position or velocity",
-            },
-            FAULT_DENSITY => FaultKind::NonPositiveDensity,
-            FAULT_LME_FEW_NODES => FaultKind::Shape(ShapeFault::LmeTooFewNodes { nodes: None }),
-            FAULT_LME_NOT_CONVERGED => FaultKind::Shape(ShapeFault::LmeNotConverged {
-                iterations: self.params.lme_max_iter,
-                residual: None,
-            }),
-            FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
-            // The shader does not report its residual.
-            FAULT_RETURN_NOT_CONVERGED => FaultKind::ReturnNotConverged { residual: f64::NAN },
-            code => FaultKind::NonFinite {
-                field: if code == 0 {
-                    "unknown (fault code 0)"
-                } else {
-                    "unknown fault code"
-                },
-            },
-        };
-        Fault::at(particle, kind)
-    }
-
     /// The fault the device recorded, if any.
     pub fn fault(&self) -> Option<Fault> {
-        (self.sim.fault != FAULT_NONE).then(|| self.fault_of(self.sim.fault))
+        (self.sim.fault != FAULT_NONE)
+            .then(|| decode_fault(&self.model, self.params.lme_max_iter, self.sim.fault))
     }
 
     fn t(&self) -> f64 {
@@ -547,7 +526,7 @@ impl Backend for GpuBackend {
                 strain: e[1] as f64,
                 gravity_work_bound: e[2] as f64,
             },
-            reactions: b.pairs(Buf::Reactions, self.buffers.n_groups + self.buffers.n_walls),
+            reactions: b.pairs(Buf::Reactions, self.n_reactions()),
             newton: None,
         })
     }
@@ -662,4 +641,55 @@ impl ReadBack {
     pub fn sim(&self) -> Sim {
         bytemuck::pod_read_unaligned(&self.bytes(Buf::Sim)[..std::mem::size_of::<Sim>()])
     }
+}
+
+/// The fault of `Sim::fault`'s `word` ((index << 4) | code) for `model`:
+/// the solver's codes of `layout`, and from `FAULT_MATERIAL` on the faults
+/// the faulting particle's material declares (`Constitutive::FAULTS`).
+/// `lme_max_iter` is the scene's LME Newton limit (its fault's message).
+pub fn decode_fault(model: &Model, lme_max_iter: u32, word: u32) -> Fault {
+    let particle = (word >> 4) as usize;
+    if word & 0xf == FAULT_MLS_SINGULAR {
+        let at = crate::model::gauss::gauss_point_position(&model.shape, &model.grid, particle);
+        return Fault {
+            particle: None,
+            kind: FaultKind::MlsSingular { at },
+        };
+    }
+    let kind = match word & 0xf {
+        FAULT_LEFT_GRID => FaultKind::Shape(ShapeFault::OutsideGrid),
+        FAULT_NON_FINITE_STRAIN => FaultKind::NonFinite { field: "strain" },
+        FAULT_NON_FINITE_STRESS => FaultKind::NonFinite { field: "stress" },
+        FAULT_NON_FINITE_MOTION => FaultKind::NonFinite {
+            field: "position or velocity",
+        },
+        FAULT_DENSITY => FaultKind::NonPositiveDensity,
+        FAULT_LME_FEW_NODES => FaultKind::Shape(ShapeFault::LmeTooFewNodes { nodes: None }),
+        FAULT_LME_NOT_CONVERGED => FaultKind::Shape(ShapeFault::LmeNotConverged {
+            iterations: lme_max_iter,
+            residual: None,
+        }),
+        FAULT_LME_SINGULAR => FaultKind::Shape(ShapeFault::LmeSingular { iterations: 0 }),
+        // The material's own fault, through the particle's material;
+        // the shader does not report its figure.
+        code if code >= FAULT_MATERIAL && particle < model.particles.len() => {
+            match model.material_of(particle).entry().fault_of_gpu_code(code) {
+                Some(fault) => FaultKind::Material {
+                    fault,
+                    value: f64::NAN,
+                },
+                None => FaultKind::NonFinite {
+                    field: "unknown material fault code",
+                },
+            }
+        }
+        code => FaultKind::NonFinite {
+            field: if code == 0 {
+                "unknown (fault code 0)"
+            } else {
+                "unknown fault code"
+            },
+        },
+    };
+    Fault::at(particle, kind)
 }

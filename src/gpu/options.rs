@@ -34,7 +34,12 @@ impl GpuOptions {
     /// Whether `p2g` and `forces` gather (`pipelines::Variant::gather`).
     pub fn gathers(&self, model: &Model) -> bool {
         let auto = matches!(model.shape, Shape::Linear) && !model.grid.is_perturbed();
-        self.gather.unwrap_or(auto) && !model.mls && model.integrator != Integrator::Musl
+        // Contact pairs scatter: a node of one field would walk the
+        // particles of every field near it.
+        self.gather.unwrap_or(auto)
+            && !model.mls
+            && model.integrator != Integrator::Musl
+            && model.contact.is_none()
     }
 
     /// Whether `p2g` and `forces` scatter per bin (`pipelines::Variant::patch`).
@@ -47,8 +52,12 @@ impl GpuOptions {
             Shape::Linear | Shape::Bspline(_) => !model.grid.is_perturbed(),
             Shape::Ugimp(_) => false,
         };
-        let fits =
-            shares && !model.mls && model.integrator != Integrator::Musl && !self.gathers(model);
+        // A bin's particles may belong to different fields with contact pairs.
+        let fits = shares
+            && !model.mls
+            && model.integrator != Integrator::Musl
+            && model.contact.is_none()
+            && !self.gathers(model);
         let auto = matches!(model.shape, Shape::Bspline(_) | Shape::Lme(_));
         self.patch.unwrap_or(auto) && fits
     }

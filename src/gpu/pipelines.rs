@@ -19,12 +19,15 @@ pub use crate::step::Pass;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Domain {
     Particles,
-    /// Nodes, and at least 2 per constraint group and wall (clear_grid zeroes reactions).
+    /// Nodes (of every field, with contact pairs), and at least 2 per
+    /// reaction (clear_grid zeroes them).
     Nodes,
     One,
     Probes,
     /// Grid cells or integration cells, whichever are more (MLS).
     Cells,
+    /// Contact pairs × grid nodes.
+    PairNodes,
     /// Gauss points (MLS).
     GaussPoints,
 }
@@ -48,6 +51,8 @@ fn domain(pass: Pass) -> Domain {
         | Pass::RemapClear
         | Pass::P2gGather
         | Pass::ForcesGather => Domain::Nodes,
+        Pass::ContactExchange | Pass::ContactExchangeForce => Domain::Nodes,
+        Pass::ContactDetect => Domain::PairNodes,
         Pass::Probes => Domain::Probes,
         _ => Domain::Particles,
     }
@@ -112,6 +117,9 @@ pub struct Variant {
     /// before the atomics (PATCH): linear and B-splines on a regular grid,
     /// LME, where they do not gather (`GpuOptions::patches`).
     pub patch: bool,
+    /// Contact pairs (CONTACT): [fields, pairs] (`model::contact`); the
+    /// nodal buffers hold one copy of the nodes per field.
+    pub contact: Option<[u32; 2]>,
 }
 
 impl Variant {
@@ -141,6 +149,10 @@ impl Variant {
             ext_force: model.external.is_some(),
             gather: opts.gathers(model),
             patch: opts.patches(model),
+            contact: model
+                .contact
+                .as_ref()
+                .map(|c| [c.n_fields as u32, c.pairs.len() as u32]),
             bspline_small_grid: match &model.shape {
                 Shape::Bspline(b) => {
                     !(crate::model::shape::bspline::table_fits(model.grid.nx, b.degree)
@@ -161,7 +173,7 @@ impl Variant {
             gather: self.gather,
             patch: self.patch,
             walls: self.walls,
-            contact: false,
+            contact: self.contact.is_some(),
         })
     }
 
@@ -194,7 +206,11 @@ impl Variant {
             .flag("PIC", self.pic)
             .flag("LOCAL_DAMPING", self.local_damping)
             .flag("EXT_FORCE", self.ext_force)
-            .flag("ANCHOR_BINS", self.gather || self.patch)
+            .flag(
+                "ANCHOR_BINS",
+                self.gather || self.patch || self.contact.is_some(),
+            )
+            .flag("CONTACT", self.contact.is_some())
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
@@ -217,6 +233,9 @@ impl Variant {
             },
         );
         d.value("LME_SIDE", self.lme_side);
+        if let Some([fields, pairs]) = self.contact {
+            d.value("N_FIELDS", fields).value("N_PAIRS", pairs);
+        }
         d.value(
             "BSPLINE_DEGREE",
             match self.shape {
@@ -261,7 +280,10 @@ pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
         "GATHER",
         matches!(pass, Pass::P2gGather | Pass::ForcesGather),
     )
-    .flag("CORRECT", pass == Pass::GridCorrect)
+    .flag(
+        "CORRECT",
+        matches!(pass, Pass::GridCorrect | Pass::ContactExchangeForce),
+    )
     .flag(
         "PATCH",
         matches!(
@@ -350,6 +372,7 @@ pub struct Pipelines {
     built: Vec<Built>,
     n_particles: u32,
     n_nodes_or_groups: u32,
+    n_pair_nodes: u32,
     n_probes: u32,
     n_cells: u32,
     n_gauss: u32,
@@ -459,10 +482,10 @@ impl Pipelines {
         Ok(Pipelines {
             built,
             n_particles: buffers.n_particles as u32,
-            n_nodes_or_groups: buffers
-                .n_nodes
-                .max(2 * (buffers.n_groups + buffers.n_walls))
+            n_nodes_or_groups: (buffers.n_nodes * buffers.n_fields)
+                .max(2 * (buffers.n_groups + buffers.n_walls + buffers.n_pairs))
                 as u32,
+            n_pair_nodes: (buffers.n_nodes * buffers.n_pairs) as u32,
             n_probes: buffers.n_probes as u32,
             n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
             n_gauss: buffers.n_gauss as u32,
@@ -482,6 +505,7 @@ impl Pipelines {
             Domain::Particles => grid_2d(self.n_particles, self.max_groups),
             Domain::Nodes => grid_2d(self.n_nodes_or_groups, self.max_groups),
             Domain::Cells => grid_2d(self.n_cells, self.max_groups),
+            Domain::PairNodes => grid_2d(self.n_pair_nodes, self.max_groups),
             Domain::GaussPoints => grid_2d(self.n_gauss, self.max_groups),
         };
         cpass.set_pipeline(&b.pipeline);
@@ -568,6 +592,7 @@ mod tests {
                                 gather: false,
                                 bspline_small_grid: perturbed,
                                 patch: false,
+                                contact: None,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)

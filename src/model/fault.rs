@@ -21,9 +21,31 @@ pub enum FaultKind {
     /// iterations even after `cuts` halvings of Δt; `ratio` is the last
     /// residual norm over the step's reference norm.
     NewtonDiverged { cuts: u32, ratio: f64 },
-    /// A material's implicit stress return (modified Cam-clay's Newton)
-    /// did not converge; `residual` is its largest scaled residual.
-    ReturnNotConverged { residual: f64 },
+    /// A fault its material model declares (`Constitutive::FAULTS`), e.g.
+    /// modified Cam-clay's stress return that did not converge; `value` is
+    /// the figure the model reports with it (NaN when the GPU found it: the
+    /// shaders report the code alone).
+    Material { fault: MaterialFault, value: f64 },
+}
+
+/// A fault a material model can report, declared in the model's own file
+/// (`Constitutive::FAULTS`) so no other file names it: the CPU returns
+/// `FaultKind::Material`, the GPU reports code `GPU_FAULT_BASE + i` for the
+/// model's i-th fault (the WGSL constant `<NAME>_FAULT_<CODE>` is generated
+/// by `material::registry::wgsl`) and `gpu::GpuBackend` decodes it through
+/// the faulting particle's material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MaterialFault {
+    /// Machine-friendly reason in `summary.json` (snake_case; also the
+    /// suffix of the WGSL constant).
+    pub code: &'static str,
+    /// What happened, as a sentence fragment ("the material's stress return
+    /// did not converge").
+    pub what: &'static str,
+    /// Name of the figure reported beside it ("scaled residual"), or "".
+    pub value: &'static str,
+    /// What the user can do about it, or "".
+    pub advice: &'static str,
 }
 
 /// The first problem a step found.
@@ -63,7 +85,7 @@ impl Fault {
             FaultKind::EnergyRunaway { .. } => "energy_runaway",
             FaultKind::MlsSingular { .. } => "mls_singular",
             FaultKind::NewtonDiverged { .. } => "newton_diverged",
-            FaultKind::ReturnNotConverged { .. } => "return_not_converged",
+            FaultKind::Material { fault, .. } => fault.code,
         }
     }
 }
@@ -91,15 +113,15 @@ impl std::fmt::Display for Fault {
                  halvings of the time step: lower solver.cfl / solver.dt, raise solver.load_steps or \
                  solver.newton_max_iter"
             )?,
-            FaultKind::ReturnNotConverged { residual } if residual.is_nan() => write!(
-                f,
-                "the material's stress return did not converge: lower solver.cfl / solver.dt"
-            )?,
-            FaultKind::ReturnNotConverged { residual } => write!(
-                f,
-                "the material's stress return did not converge (scaled residual {residual:.3e}): \
-                 lower solver.cfl / solver.dt"
-            )?,
+            FaultKind::Material { fault, value } => {
+                write!(f, "{}", fault.what)?;
+                if !fault.value.is_empty() && value.is_finite() {
+                    write!(f, " ({} {value:.3e})", fault.value)?;
+                }
+                if !fault.advice.is_empty() {
+                    write!(f, ": {}", fault.advice)?;
+                }
+            }
         }
         if let Some(p) = self.particle {
             write!(f, " (particle {p})")?;

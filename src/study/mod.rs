@@ -5,6 +5,7 @@
 
 pub mod block;
 pub mod column;
+pub mod contact;
 pub mod disk;
 pub mod dyka;
 pub mod implicit;
@@ -49,6 +50,10 @@ pub enum StudyName {
     /// bar and the rolling disk, error against wall time per case, and the
     /// Newton iteration's cost split (CPU only).
     Implicit,
+    /// Contact between bodies: block on a slab (μ = 0–0.7), two disks
+    /// colliding head-on and off-centre, a disk rolling on an elastic slab
+    /// (R/h = 10–40), each beside the single shared field (CPU; about 20 minutes, --quick about 1).
+    Contact,
     /// The Galerkin meshfree method on the static cantilever: GMM-LME and
     /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson (the
     /// implicit study's GMM rows alone, seconds).
@@ -68,6 +73,7 @@ impl StudyName {
             StudyName::Disk => "disk",
             StudyName::Column => "column",
             StudyName::Implicit => "implicit",
+            StudyName::Contact => "contact",
             StudyName::Gmm => "gmm",
             StudyName::All => "all",
         }
@@ -144,6 +150,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk,
             StudyName::Column,
             StudyName::Implicit,
+            StudyName::Contact,
             StudyName::Gmm,
         ],
         n => vec![n],
@@ -162,6 +169,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::jobs(opts.quick, &backends),
             StudyName::Column => column::jobs(opts.quick, &backends),
             StudyName::Implicit => implicit::jobs(opts.quick),
+            StudyName::Contact => contact::jobs(opts.quick, &backends),
             StudyName::Gmm => implicit::gmm_jobs(opts.quick),
             StudyName::All => unreachable!(),
         };
@@ -189,6 +197,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
+            StudyName::Contact => contact::report(&results, &dir, opts.quick)?,
             StudyName::Gmm => implicit::gmm_report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };

@@ -12,7 +12,7 @@ pub mod plastic;
 pub mod registry;
 pub mod state;
 
-pub use registry::{Constitutive, Entry, Key, Keys, StateKind};
+pub use registry::{Constitutive, Entry, Key, Keys, MaterialFault, StateKind};
 pub use state::{DefGrad, PlasticState};
 
 use crate::error::SceneError;
@@ -40,6 +40,7 @@ macro_rules! register {
                 state: <$ty as Constitutive>::STATE,
                 gpu_params: <$ty as Constitutive>::GPU_PARAMS,
                 keys: <$ty as Constitutive>::KEYS,
+                faults: <$ty as Constitutive>::FAULTS,
             }),*]
             .into_iter()
             .enumerate()
@@ -265,5 +266,57 @@ mod tests {
         let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
         println!("DP ψ = 0: peak {got:.2} vs MC {want:.2}");
         assert!(got < want, "{got} vs {want}");
+    }
+
+    /// A model's faults are its own: declared once (`FAULTS`), numbered
+    /// for the GPU by the registry, written into the generated WGSL and
+    /// decoded back to the same fault; the solver's codes stay below them.
+    #[test]
+    fn material_faults_round_trip_through_the_gpu_codes() {
+        use crate::model::fault::{Fault, FaultKind};
+        for e in registry() {
+            assert!(e.faults.len() <= registry::FAULT_SLOTS, "{}", e.name);
+            let wgsl = registry::wgsl(&[e], 1 << e.code);
+            for (i, f) in e.faults.iter().enumerate() {
+                assert!(f.code.chars().all(|c| c.is_ascii_lowercase() || c == '_'));
+                let code = e.gpu_fault_code(f.code).unwrap();
+                assert_eq!(code, registry::GPU_FAULT_BASE + i as u32);
+                assert!(code < 16, "fits the fault word's four bits");
+                assert_eq!(e.fault_of_gpu_code(code), Some(*f));
+                let line = format!(
+                    "const {}_FAULT_{}: u32 = {code}u;",
+                    e.name.to_uppercase(),
+                    f.code.to_uppercase()
+                );
+                assert!(wgsl.contains(&line), "{line}");
+            }
+            assert_eq!(e.fault_of_gpu_code(registry::GPU_FAULT_BASE - 1), None);
+        }
+        let mcc = registry()
+            .into_iter()
+            .find(|e| e.name == "modified_cam_clay")
+            .unwrap();
+        assert_eq!(mcc.faults, &[modified_cam_clay::NOT_CONVERGED]);
+        let fault = Fault::at(
+            7,
+            FaultKind::Material {
+                fault: modified_cam_clay::NOT_CONVERGED,
+                value: 2.5e-3,
+            },
+        );
+        assert_eq!(fault.code(), "return_not_converged");
+        assert_eq!(
+            fault.to_string(),
+            "the material's stress return did not converge (scaled residual 2.500e-3): \
+             lower solver.cfl / solver.dt (particle 7)"
+        );
+        let gpu = Fault::at(
+            7,
+            FaultKind::Material {
+                fault: modified_cam_clay::NOT_CONVERGED,
+                value: f64::NAN,
+            },
+        );
+        assert!(!gpu.to_string().contains("residual"), "{gpu}");
     }
 }

@@ -19,8 +19,8 @@
 //!   and Borja (1991, CMAME 88): here a 3×3 Newton on (ln p′, ln p_c, Δγ)
 //!   scaled by p_c, steps limited to one e-fold in p′ and p_c. A step whose
 //!   return does not converge in `MAX_ITER` is split into 8, then 64 parts
-//!   (`SUBSTEPS`); past that it is `FaultKind::ReturnNotConverged`, never
-//!   a NaN.
+//!   (`SUBSTEPS`); past that it is the model's fault `NOT_CONVERGED`
+//!   (`return_not_converged` in summary.json), never a NaN.
 //! - Tension: the stiffness uses max(p′, p_floor). From p′ ≥ p_floor the
 //!   trial p′ stays positive (p′ e^x); from below (a particle at zero
 //!   stress) a trial with p′ ≤ 0 goes to the apex of the ellipse, σ = 0
@@ -34,7 +34,25 @@
 //! WGSL twin: `shaders/shared/material_modified_cam_clay.wgsl`.
 
 use super::plastic::{self, ACTIVE_APEX, ACTIVE_MAIN, PlasticState};
-use crate::model::fault::FaultKind;
+use crate::model::fault::{FaultKind, MaterialFault};
+
+/// The model's one fault: the return did not converge even split into
+/// `SUBSTEPS[last]` parts. Its WGSL twin reports
+/// `MODIFIED_CAM_CLAY_FAULT_RETURN_NOT_CONVERGED` (generated from this).
+pub const NOT_CONVERGED: MaterialFault = MaterialFault {
+    code: "return_not_converged",
+    what: "the material's stress return did not converge",
+    value: "scaled residual",
+    advice: "lower solver.cfl / solver.dt",
+};
+
+/// `NOT_CONVERGED` with its residual.
+fn not_converged(residual: f64) -> FaultKind {
+    FaultKind::Material {
+        fault: NOT_CONVERGED,
+        value: residual,
+    }
+}
 
 /// Index of p_c (Pa) in the plastic state.
 pub const PC: usize = 1;
@@ -258,9 +276,7 @@ impl ModifiedCamClay {
         de: [f64; 4],
         q: &PlasticState,
     ) -> Result<([f64; 4], PlasticState), FaultKind> {
-        let mut last = FaultKind::ReturnNotConverged {
-            residual: f64::INFINITY,
-        };
+        let mut last = not_converged(f64::INFINITY);
         for n in SUBSTEPS {
             let ev = de[0] + de[1] + de[2];
             // Diagonal scale c: (1 + c ev / n)^n = 1 + ev.
@@ -282,7 +298,7 @@ impl ModifiedCamClay {
             }
             match failed {
                 None => return Ok((sk, qk)),
-                Some(e @ FaultKind::ReturnNotConverged { .. }) => last = e,
+                Some(e @ FaultKind::Material { .. }) => last = e,
                 Some(e) => return Err(e),
             }
         }
@@ -386,7 +402,7 @@ impl ModifiedCamClay {
             w = if w_new < 0.0 { 0.5 * w } else { w_new };
         }
         if !converged {
-            return Err(FaultKind::ReturnNotConverged { residual: res });
+            return Err(not_converged(res));
         }
         let p = y.exp() * pc;
         let pc_new = z.exp() * pc;
@@ -546,6 +562,7 @@ impl super::Constitutive for ModifiedCamClay {
     const GPU_PARAMS: &'static [&'static str] = &[
         "kappa", "lambda", "m_cs", "nu", "shear", "p_floor", "rho_v0", "n_pa",
     ];
+    const FAULTS: &'static [MaterialFault] = &[NOT_CONVERGED];
 
     fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
         let keys = CamClayKeys {

@@ -10,16 +10,26 @@
 //! -> f32` and `<name>_wave_speed(m, rho: f32, s, q) -> f32`, mirroring
 //! the Rust `update`, `strain_energy_density` and `wave_speed`, and reads
 //! its parameters as `m.p[<NAME>_<PARAM>]`: the constants are generated
-//! from `GPU_PARAMS`, in the order `gpu_params` packs them.
+//! from `GPU_PARAMS`, in the order `gpu_params` packs them. A model that
+//! can fail in its own way declares its faults in `FAULTS`; its WGSL
+//! reports the i-th as `report_fault(<NAME>_FAULT_<CODE>, particle)` (a
+//! generated constant, `GPU_FAULT_BASE + i`), and the GPU backend decodes
+//! it through the particle's material: no other file names the fault.
 
 use super::{DefGrad, PlasticState};
 use crate::error::SceneError;
 use crate::model::fault::FaultKind;
+pub use crate::model::fault::MaterialFault;
 use crate::scene::MaterialSpec;
 use std::collections::BTreeSet;
 
 /// Parameter slots of `GpuMaterial::p` (shared/types.wgsl `Material.p`).
 pub const GPU_PARAM_SLOTS: usize = 9;
+/// The first GPU fault code of the material faults (`Sim::fault`'s low
+/// four bits; codes below it are the solver's, shared/types.wgsl).
+pub const GPU_FAULT_BASE: u32 = 10;
+/// How many faults one model may declare: the codes `GPU_FAULT_BASE..16`.
+pub const FAULT_SLOTS: usize = 16 - GPU_FAULT_BASE as usize;
 
 /// The per-particle state a model keeps beside the stress.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,6 +63,9 @@ pub trait Constitutive: Sized {
     /// Names of its GPU parameters, in `gpu_params` order (at most
     /// `GPU_PARAM_SLOTS`); WGSL reads them as `m.p[<NAME>_<PARAM>]`.
     const GPU_PARAMS: &'static [&'static str];
+    /// The faults its update can report beyond the solver's own (at most
+    /// `FAULT_SLOTS`); none unless the model says.
+    const FAULTS: &'static [MaterialFault] = &[];
 
     /// Builds the model from its keys, each checked (the error names it).
     fn from_keys(k: &Keys) -> Result<Self, SceneError>;
@@ -212,6 +225,7 @@ pub struct Entry {
     pub state: StateKind,
     pub gpu_params: &'static [&'static str],
     pub keys: &'static [Key],
+    pub faults: &'static [MaterialFault],
 }
 
 impl Entry {
@@ -224,11 +238,24 @@ impl Entry {
     pub fn model_const(&self) -> String {
         format!("MODEL_{}", self.name.to_uppercase())
     }
+
+    /// The GPU fault code of its fault `code` (`FAULTS`' `code`).
+    pub fn gpu_fault_code(&self, code: &str) -> Option<u32> {
+        let i = self.faults.iter().position(|f| f.code == code)?;
+        Some(GPU_FAULT_BASE + i as u32)
+    }
+
+    /// Its fault whose GPU code is `gpu_code`, if it declares one.
+    pub fn fault_of_gpu_code(&self, gpu_code: u32) -> Option<MaterialFault> {
+        let i = gpu_code.checked_sub(GPU_FAULT_BASE)? as usize;
+        self.faults.get(i).copied()
+    }
 }
 
 /// The WGSL of the material interface for the models whose codes are in
 /// `used` (a bit per code): every model's `MODEL_*` and parameter-index
-/// constants, the used models' files, and `material_update`,
+/// constants, its fault codes (`<NAME>_FAULT_<CODE>`), the used models'
+/// files, and `material_update`,
 /// `strain_energy_density` and `wave_speed` dispatching on `m.model`.
 /// Included by `shaders/shared/material.wgsl` as `generated/materials.wgsl`.
 pub fn wgsl(entries: &[Entry], used: u32) -> String {
@@ -240,6 +267,20 @@ pub fn wgsl(entries: &[Entry], used: u32) -> String {
                 "const {}_{}: u32 = {i}u;\n",
                 e.name.to_uppercase(),
                 p.to_uppercase()
+            );
+        }
+        assert!(
+            e.faults.len() <= FAULT_SLOTS,
+            "model {} declares {} faults; the GPU has codes for {FAULT_SLOTS}",
+            e.name,
+            e.faults.len()
+        );
+        for f in e.faults {
+            s += &format!(
+                "const {}_FAULT_{}: u32 = {}u;\n",
+                e.name.to_uppercase(),
+                f.code.to_uppercase(),
+                e.gpu_fault_code(f.code).expect("its own fault")
             );
         }
     }
