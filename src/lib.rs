@@ -26,6 +26,7 @@ pub mod cpu;
 pub mod docgen;
 pub mod error;
 pub mod exact;
+pub mod gmm;
 pub mod gpu;
 pub mod limits;
 pub mod model;

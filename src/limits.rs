@@ -46,3 +46,26 @@ pub const MAX_POLYGON_VERTICES: usize = 10_000;
 /// least 3 particles per direction).
 pub const MLS_SUPPORT_MIN: f64 = 1.5;
 pub const MLS_SUPPORT_MAX: f64 = 3.0;
+
+/// GMM's search radius (units of the initial node spacing h,
+/// `solver.gmm_search_radius`): default the paper's r = sqrt(2 h²) (§5.1,
+/// §5.3). Below, a point in the middle of a cell edge, whose nearest nodes
+/// are the edge's two and then two at √5/2 h, would see collinear nodes
+/// only: at least √5/2 with 2 % to spare. Above 4 cells a cloud holds
+/// some fifty nodes, far beyond any use of the paper's (at most 1.5 √2).
+pub const GMM_SEARCH_RADIUS_DEFAULT: f64 = std::f64::consts::SQRT_2;
+pub const GMM_SEARCH_RADIUS_MIN: f64 = 1.02 * 1.118_033_988_749_895;
+pub const GMM_SEARCH_RADIUS_MAX: f64 = 4.0;
+
+/// GMM-MLS dilation f (units of h, `solver.gmm_dilation`): the weight
+/// vanishes at 2 f, so 2 f must exceed √5/2 as the search radius must
+/// (0.6 with 7 % to spare); at most the search radius's bound.
+pub const GMM_DILATION_MIN: f64 = 0.6;
+pub const GMM_DILATION_MAX: f64 = 4.0;
+
+/// GMM-LME γ (`solver.lme_gamma` with `method = "gmm"`): the paper's
+/// "0.6 (spread out) to 4 (close to linear finite elements)" (§4.2.2),
+/// widened to [0.5, 10]; the cloud is cut at the search radius, so the
+/// grid's tolerance-based bounds do not apply.
+pub const GMM_LME_GAMMA_MIN: f64 = 0.5;
+pub const GMM_LME_GAMMA_MAX: f64 = 10.0;

@@ -615,6 +615,30 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     } else {
         shape
     };
+    // GMM's constraints hold the cloud's nodes, not the grid's.
+    let cloud = match &model.integrator {
+        crate::model::Integrator::Implicit(crate::model::ImplicitSettings {
+            gmm: Some(_), ..
+        }) => crate::gmm::Cloud::from_model(model).ok(),
+        _ => None,
+    };
+    // GMM reads no grid shape: its basis over the node clouds instead.
+    let shape = match &model.integrator {
+        crate::model::Integrator::Implicit(crate::model::ImplicitSettings {
+            gmm: Some(gm),
+            ..
+        }) => match gm.basis {
+            crate::scene::GmmBasis::Lme => format!(
+                "GMM-LME over node clouds (gamma = {}, search radius {:.3} h; the grid only seeds the nodes)",
+                gm.gamma, gm.search_radius
+            ),
+            crate::scene::GmmBasis::Mls => format!(
+                "GMM-MLS over node clouds (dilation {:.3} h, search radius {:.3} h; the grid only seeds the nodes)",
+                gm.dilation, gm.search_radius
+            ),
+        },
+        _ => shape,
+    };
     let step_rule = match model.fixed_dt {
         Some(fixed) => {
             // Courant number of the fixed step at t = 0.
@@ -709,7 +733,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             .constraints
             .groups
             .iter()
-            .map(|c| format!("{} ({} nodes)", c.name, c.nodes.len()))
+            .enumerate()
+            .map(|(k, c)| match &cloud {
+                Some(cl) => format!("{} ({} nodes of the GMM cloud)", c.name, cl.groups[k].len()),
+                None => format!("{} ({} nodes)", c.name, c.nodes.len()),
+            })
             .chain(model.walls.list.iter().map(|w| format!(
                 "wall {} ({} nodes)",
                 w.name,

@@ -187,6 +187,22 @@ fn layers_point_one_way() {
             "the model layer is the bottom",
         ),
         (
+            "gmm",
+            &[
+                "cpu",
+                "gpu",
+                "backend",
+                "solver",
+                "exact",
+                "run",
+                "output",
+                "study",
+                "step",
+                "simulation",
+            ],
+            "GMM's cloud and bases sit beside the grid, above the model: any backend may use them",
+        ),
+        (
             "scene",
             &["model", "cpu", "gpu", "backend", "solver", "exact", "run"],
             "a scene is validated without the model",

@@ -413,7 +413,9 @@ fn implicit_quick_compares_schemes_per_case() {
     let rows = md
         .lines()
         .filter(|l| {
-            l.starts_with("| implicit | linear |") || l.starts_with("| implicit | bspline2 |")
+            l.starts_with("| implicit | linear |")
+                || l.starts_with("| implicit | bspline2 |")
+                || l.starts_with("| implicit | gmm-")
         })
         .count()
         + md.lines()
@@ -510,3 +512,22 @@ fn contact_quick_measures_collisions_and_rolling() {
 /// The rolling disk on a slab at R/h = 10 covers at least this share of
 /// the exact distance: measured 0.841 (2026-11-25).
 const ROLLING_R10_MIN: f64 = 0.82;
+/// `study gmm --quick`: GMM-LME and GMM-MLS on the cantilever at h = 0.5,
+/// 0.25, 0.125 (milliseconds each), with the orders, Richardson limits and
+/// the paper's ordering of the two bases in the section.
+#[test]
+fn gmm_quick_reports_orders_and_the_paper_ordering() {
+    let (results, md, dir) = run(StudyName::Gmm);
+    let chart = "study-gmm-cantilever-mesh.png";
+    assert!(md.contains(chart) && dir.join(chart).exists(), "{md}");
+    // GMM-LME and GMM-MLS at 3 sizes, implicit MPM Q4 at 2 (the cost rows).
+    assert_eq!(results.len(), 8);
+    for r in &results {
+        assert!(r.data().is_some_and(|d| d.completed()), "{}", r.job.label);
+    }
+    for m in ["gmm-lme", "gmm-mls"] {
+        assert!(md.contains(&format!("- {m}: order")), "{md}");
+    }
+    assert!(md.contains("GMM-MLS is below at every h"), "{md}");
+    assert!(md.contains("**Cost.**") && md.contains("| 0.250 |"), "{md}");
+}

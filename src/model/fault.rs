@@ -78,6 +78,7 @@ impl Fault {
     pub fn code(&self) -> &'static str {
         match self.kind {
             FaultKind::Shape(ShapeFault::OutsideGrid) => "left_grid",
+            FaultKind::Shape(ShapeFault::MlsSingular { .. }) => "mls_singular",
             FaultKind::Shape(_) => "lme_newton",
             FaultKind::NonFinite { .. } => "non_finite",
             FaultKind::NonPositiveDensity => "non_positive_density",

@@ -26,7 +26,9 @@ pub use walls::{Wall, Walls};
 use crate::error::SceneError;
 use crate::model::material::Material;
 use crate::model::shape::Shape;
-use crate::scene::{Fix, ImplicitMass, IntegratorKind, MlsScope, NpcPosition, Scene, seed};
+use crate::scene::{
+    Fix, GmmBasis, ImplicitMass, IntegratorKind, MlsScope, NpcPosition, Scene, SolverMethod, seed,
+};
 
 /// Nodes lighter than this (kg) count as empty. Relative to the lightest
 /// particle: 1e-9 keeps LME tail nodes (N ≳ 1e-6) and drops only round-off.
@@ -128,6 +130,22 @@ pub struct ImplicitSettings {
     pub max_cuts: u32,
     /// Lumped instead of consistent mass.
     pub lumped_mass: bool,
+    /// The Galerkin meshfree method's settings (`solver.method = "gmm"`):
+    /// the step solves on a node cloud that moves with the body instead of
+    /// the grid. None: implicit MPM.
+    pub gmm: Option<GmmSettings>,
+}
+
+/// GMM's basis and cloud (`solver.gmm_*` keys, `solver.lme_gamma`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GmmSettings {
+    pub basis: GmmBasis,
+    /// LME locality γ = β h² (h the initial node spacing, `grid.h`).
+    pub gamma: f64,
+    /// Search radius, in units of h.
+    pub search_radius: f64,
+    /// MLS dilation f, in units of h (the weight vanishes at 2 f).
+    pub dilation: f64,
 }
 
 impl Integrator {
@@ -241,6 +259,12 @@ impl Model {
                 max_iter: f.solver.newton_max_iter,
                 max_cuts: f.solver.newton_max_cuts,
                 lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
+                gmm: (f.solver.method == SolverMethod::Gmm).then_some(GmmSettings {
+                    basis: f.solver.gmm_basis,
+                    gamma: f.solver.lme_gamma,
+                    search_radius: f.solver.gmm_search_radius,
+                    dilation: f.solver.gmm_dilation,
+                }),
             }),
         };
         let mut particles = Particles::from_seeds(
@@ -270,8 +294,13 @@ impl Model {
             .iter()
             .map(|g| (&g.nodes[..], g.fix))
             .collect();
-        let placed = constraint_points::place(scene, &grid, &shape, &particles, &regions)?;
-        constraints.hold_at(placed);
+        // GMM's node cloud ends at the body's cells, so its constraints
+        // select the body's own nodes on the region's edge: no points (and
+        // their weights, over grid nodes, would not index the cloud).
+        if scene.file.solver.method != SolverMethod::Gmm {
+            let placed = constraint_points::place(scene, &grid, &shape, &particles, &regions)?;
+            constraints.hold_at(placed);
+        }
         let mut walls = Walls::new(scene, &grid)?;
         let p_wave = materials
             .iter()

@@ -382,6 +382,34 @@ pub enum ImplicitMass {
     Lumped,
 }
 
+/// What the implicit step solves on (`solver.method`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverMethod {
+    /// The material point method: shape functions on the background grid,
+    /// which is reset every step.
+    #[default]
+    Mpm,
+    /// The Galerkin meshfree method of the implicit-MPM paper (§4.2,
+    /// Algorithm 2): a node cloud that belongs to the body and moves with
+    /// it, meshfree shape functions over each material point's cloud, and
+    /// the Newmark predictor from the nodes' own previous state. Needs
+    /// `integrator = "implicit"`.
+    Gmm,
+}
+
+/// GMM's meshfree basis over a node cloud (`solver.gmm_basis`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GmmBasis {
+    /// Local max-ent with β = `lme_gamma` / h², h the initial node spacing.
+    #[default]
+    Lme,
+    /// Moving least squares, linear basis, cubic-spline weight of support
+    /// radius 2 · `gmm_dilation` · h.
+    Mls,
+}
+
 /// Which nodal velocity moves the particles in the NPC particle update.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -453,6 +481,24 @@ pub struct SolverSpec {
     /// the Δt before the run stops as unstable (`newton_diverged`). Default 6.
     #[serde(default = "default_newton_max_cuts")]
     pub newton_max_cuts: u32,
+    /// `mpm` (the grid) or `gmm` (a node cloud moving with the body; needs
+    /// `integrator = "implicit"`). Default `mpm`.
+    #[serde(default)]
+    pub method: SolverMethod,
+    /// GMM: the meshfree basis, `lme` (γ from `lme_gamma`) or `mls`.
+    /// Default `lme`.
+    #[serde(default)]
+    pub gmm_basis: GmmBasis,
+    /// GMM: the radius within which a material point gathers its cloud of
+    /// nodes, in units of the initial node spacing `grid.h`. Default √2,
+    /// the paper's r = sqrt(2 h²) (§5.1, §5.3); in [1, 4].
+    #[serde(default = "default_gmm_search_radius")]
+    pub gmm_search_radius: f64,
+    /// GMM with `mls`: the dilation f of the weight, in units of `grid.h`;
+    /// the cubic-spline weight reaches zero at 2 f. Default √2/2, the
+    /// paper's f = r/2 (§5.1); in [0.6, 4].
+    #[serde(default = "default_gmm_dilation")]
+    pub gmm_dilation: f64,
     /// End time (s). Required.
     pub t_end: f64,
     /// Fixed time step (s), in place of the CFL condition (the manufactured
@@ -501,6 +547,14 @@ pub enum MlsScope {
     /// f_I = −Σ_p V_p σ_p ∇N_I(x_p) − [Σ_g ω_g σ_h(x_g) ∇N_I(x_g) − Σ_p V_p σ_h(x_p) ∇N_I(x_p)],
     /// and the strain rate by the bracket's transpose (`Mls::strain_correction`).
     Force,
+}
+
+fn default_gmm_search_radius() -> f64 {
+    crate::limits::GMM_SEARCH_RADIUS_DEFAULT
+}
+
+fn default_gmm_dilation() -> f64 {
+    0.5 * crate::limits::GMM_SEARCH_RADIUS_DEFAULT
 }
 
 fn default_mls_support() -> f64 {

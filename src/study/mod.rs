@@ -54,6 +54,10 @@ pub enum StudyName {
     /// colliding head-on and off-centre, a disk rolling on an elastic slab
     /// (R/h = 10–40), each beside the single shared field (CPU; about 20 minutes, --quick about 1).
     Contact,
+    /// The Galerkin meshfree method on the static cantilever: GMM-LME and
+    /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson (the
+    /// implicit study's GMM rows alone, seconds).
+    Gmm,
     /// All of them, in that order.
     All,
 }
@@ -70,6 +74,7 @@ impl StudyName {
             StudyName::Column => "column",
             StudyName::Implicit => "implicit",
             StudyName::Contact => "contact",
+            StudyName::Gmm => "gmm",
             StudyName::All => "all",
         }
     }
@@ -146,6 +151,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Column,
             StudyName::Implicit,
             StudyName::Contact,
+            StudyName::Gmm,
         ],
         n => vec![n],
     };
@@ -164,6 +170,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Column => column::jobs(opts.quick, &backends),
             StudyName::Implicit => implicit::jobs(opts.quick),
             StudyName::Contact => contact::jobs(opts.quick, &backends),
+            StudyName::Gmm => implicit::gmm_jobs(opts.quick),
             StudyName::All => unreachable!(),
         };
         if opts.progress || opts.progress_lines {
@@ -191,6 +198,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
             StudyName::Contact => contact::report(&results, &dir, opts.quick)?,
+            StudyName::Gmm => implicit::gmm_report(&results, &dir, opts.quick)?,
             StudyName::All => unreachable!(),
         };
         // The charts sit beside report.md; the markdown links them in

@@ -22,9 +22,17 @@
 //! stops as unstable with reason `newton_diverged`. A static analysis
 //! (`solver.static`) drops the inertia and scales every load by t / t_end
 //! over `load_steps` steps of pseudo-time.
+//!
+//! The nodes are the grid's (implicit MPM) or, with `solver.method =
+//! "gmm"`, the body's own node cloud (`gmm`, the paper's Algorithm 2):
+//! the same residual, Jacobian, solve and constraints over "a set of
+//! nodes with shape functions per particle" (`Nodes`); only the shape
+//! evaluation, the predictor's nodal velocity and acceleration, and the
+//! nodes' own update after convergence differ.
 
 pub mod assemble;
 pub mod contact;
+pub mod gmm;
 
 use crate::backend::{Backend, Halt, NewtonSample, NewtonStats, Sample, State, stop_requested};
 use crate::cpu::{ShapeCache, shape_eval};
@@ -32,7 +40,7 @@ use crate::error::{Error, Result};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::increment::StepState;
 use crate::model::walls::CONTACT_STICK;
-use crate::model::{FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
 use assemble::{Dofs, Incidence, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
 use contact::{ContactPair, ContactState};
 use faer::prelude::*;
@@ -70,10 +78,21 @@ enum AttemptFail {
     Newton(f64),
 }
 
+/// The nodes a step solves for.
+pub enum Nodes {
+    /// The background grid's (implicit MPM): N from the particles'
+    /// positions on it; nodal velocity and acceleration mapped from the
+    /// particles each step; the grid reset after it.
+    Grid,
+    /// GMM: the body's node cloud, which keeps its state between steps.
+    Cloud(Box<gmm::GmmNodes>),
+}
+
 /// Runs an implicit `Model` on the CPU.
 pub struct ImplicitBackend {
     pub model: Model,
     pub settings: ImplicitSettings,
+    pub nodes: Nodes,
     cache: ShapeCache,
     /// Per node at the step's start: mass, velocity, acceleration.
     node_mass: Vec<f64>,
@@ -125,7 +144,14 @@ impl ImplicitBackend {
             .into());
         };
         let n = model.particles.len();
-        let nodes = model.grid.n_nodes();
+        let (node_set, nodes, stride) = match &settings.gmm {
+            Some(g) => {
+                let c = gmm::GmmNodes::new(&model, g)?;
+                let (len, stride) = (c.cloud.len(), c.stride());
+                (Nodes::Cloud(Box::new(c)), len, stride)
+            }
+            None => (Nodes::Grid, model.grid.n_nodes(), model.shape.max_nodes()),
+        };
         let min_mass = model.particles.min_mass();
         let stiffest = model
             .materials
@@ -146,7 +172,8 @@ impl ImplicitBackend {
             j: 1.0,
         };
         Ok(ImplicitBackend {
-            cache: ShapeCache::new(n, model.shape.max_nodes()),
+            nodes: node_set,
+            cache: ShapeCache::new(n, stride),
             node_mass: vec![0.0; nodes],
             node_v: vec![[0.0; 2]; nodes],
             node_a: vec![[0.0; 2]; nodes],
@@ -263,7 +290,12 @@ impl ImplicitBackend {
         let clock = Instant::now();
         let m = &mut self.model;
         let p = &mut m.particles;
-        shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
+        match &mut self.nodes {
+            Nodes::Grid => {
+                shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?
+            }
+            Nodes::Cloud(c) => c.shape_eval(&p.x, &mut self.cache)?,
+        }
         self.node_mass.fill(0.0);
         self.node_v.fill([0.0; 2]);
         self.node_a.fill([0.0; 2]);
@@ -291,6 +323,11 @@ impl ImplicitBackend {
                 self.node_v[n] = [0.0; 2];
                 self.node_a[n] = [0.0; 2];
             }
+        }
+        // GMM's predictor reads the nodes' own state (Algorithm 2, step 1).
+        if let Nodes::Cloud(c) = &self.nodes {
+            self.node_v.copy_from_slice(&c.cloud.v);
+            self.node_a.copy_from_slice(&c.cloud.a);
         }
         for i in 0..p.len() {
             self.start[i] = StepState {
@@ -322,6 +359,11 @@ impl ImplicitBackend {
     fn build_pairs(&self) -> Vec<ContactPair> {
         let walls = &self.model.walls;
         let mut pairs = Vec::new();
+        // GMM scenes have no walls (refused by validation): its nodes are
+        // not the grid's, which the walls' masks index.
+        if let Nodes::Cloud(_) = self.nodes {
+            return pairs;
+        }
         for (n, &mask) in walls.mask.iter().enumerate() {
             if mask == 0 || self.dofs.id[n] == NO_DOF {
                 continue;
@@ -342,7 +384,7 @@ impl ImplicitBackend {
     /// (constraints and stick walls).
     fn build_dofs(&self) -> Dofs {
         let m = &self.model;
-        let nodes = m.grid.n_nodes();
+        let nodes = self.node_mass.len();
         let stick = |n: usize| {
             m.walls.mask.get(n).is_some_and(|&mask| {
                 m.walls
@@ -361,10 +403,10 @@ impl ImplicitBackend {
             }
             id[n] = active;
             active += 1;
-            held[n] = if stick(n) {
-                FIX_X | FIX_Y
-            } else {
-                m.constraints.fix[n]
+            held[n] = match &self.nodes {
+                Nodes::Cloud(c) => c.cloud.fix[n],
+                Nodes::Grid if stick(n) => FIX_X | FIX_Y,
+                Nodes::Grid => m.constraints.fix[n],
             };
         }
         Dofs {
@@ -390,9 +432,12 @@ impl ImplicitBackend {
             let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
             *target = std::array::from_fn(|d| 0.5 * dt * (v0[d] + v1[d]));
         }
-        for g in self.model.constraints.groups.iter().filter(|g| g.moves()) {
+        for (k, g) in self.model.constraints.groups.iter().enumerate() {
+            if !g.moves() {
+                continue;
+            }
             let (v0, v1) = (g.velocity_at(self.t), g.velocity_at(self.t + dt));
-            for &n in &g.nodes {
+            for &n in group_nodes(&self.nodes, g, k) {
                 for (d, bit) in [(0, FIX_X), (1, FIX_Y)] {
                     if g.fix & bit != 0 {
                         self.du[n as usize][d] = 0.5 * dt * (v0[d] + v1[d]);
@@ -785,9 +830,15 @@ impl ImplicitBackend {
         }
         // The support's reaction is minus the residual on its components.
         let groups = m.constraints.groups.len();
-        for (g, r) in m.constraints.groups.iter().zip(self.reactions.iter_mut()) {
+        for (k, (g, r)) in m
+            .constraints
+            .groups
+            .iter()
+            .zip(self.reactions.iter_mut())
+            .enumerate()
+        {
             *r = [0.0; 2];
-            for &n in &g.nodes {
+            for &n in group_nodes(&self.nodes, g, k) {
                 let n = n as usize;
                 if g.fix & FIX_X != 0 {
                     r[0] -= self.r[n][0];
@@ -825,6 +876,17 @@ impl ImplicitBackend {
                 [-self.wall_force[k][0], -self.wall_force[k][1]]
             };
         }
+        if let Nodes::Cloud(c) = &mut self.nodes {
+            c.advance(&self.du, &newmark);
+        }
+    }
+}
+
+/// Constraint group `k`'s nodes in the step's node set.
+fn group_nodes<'a>(nodes: &'a Nodes, g: &'a ConstraintGroup, k: usize) -> &'a [u32] {
+    match nodes {
+        Nodes::Grid => &g.nodes,
+        Nodes::Cloud(c) => &c.cloud.groups[k],
     }
 }
 
@@ -843,8 +905,12 @@ fn held_residual(
 
 impl Backend for ImplicitBackend {
     fn name(&self) -> String {
+        let method = match &self.nodes {
+            Nodes::Grid => String::new(),
+            Nodes::Cloud(c) => format!(" {}", c.label()),
+        };
         format!(
-            "cpu implicit (f64, {} threads, faer sparse LU)",
+            "cpu implicit{method} (f64, {} threads, faer sparse LU)",
             rayon::current_num_threads()
         )
     }
@@ -915,6 +981,13 @@ impl Backend for ImplicitBackend {
 
     fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
         crate::backend::check_state(&self.model, state)?;
+        if let Nodes::Cloud(_) = self.nodes {
+            return Err(Error::Checkpoint(
+                "is of a GMM run (solver.method = \"gmm\"), whose node cloud a checkpoint does \
+                 not hold yet: run it again from the start"
+                    .into(),
+            ));
+        }
         // The contact states the next step starts from (none saved: a run
         // from before they were kept, or an explicit run's state).
         let held = if state.held_contacts.is_empty() {

@@ -17,6 +17,9 @@ pub enum ShapeFault {
     },
     /// LME: the Hessian J became singular (the particle is on or outside the nodes' hull).
     LmeSingular { iterations: u32 },
+    /// GMM-MLS: the moment matrix of the particle's node cloud is singular
+    /// (fewer than 3 nodes with weight, or all on a line).
+    MlsSingular { nodes: usize },
 }
 
 impl std::fmt::Display for ShapeFault {
@@ -42,6 +45,10 @@ impl std::fmt::Display for ShapeFault {
             } => {
                 write!(f, "LME Newton did not converge in {iterations} iterations")
             }
+            ShapeFault::MlsSingular { nodes } => write!(
+                f,
+                "MLS moment matrix singular over a cloud of {nodes} weighted node(s)"
+            ),
             ShapeFault::LmeSingular { iterations } => {
                 write!(
                     f,

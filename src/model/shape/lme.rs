@@ -117,8 +117,11 @@ impl Lme {
     }
 
     /// Damped Newton on λ over the gathered nodes (`w[k] = [_, dx, dy]` in,
-    /// `[N, ∂N/∂x, ∂N/∂y]` out). Returns the iterations taken.
-    fn newton(&self, w: &mut [[f64; 3]], lambda: &mut [f64; 2]) -> Result<u32, ShapeFault> {
+    /// d = x − x_a, `[N, ∂N/∂x, ∂N/∂y]` out), warm-started from `lambda`,
+    /// which receives the solution. Returns the iterations taken. Any node
+    /// set will do (the grid's support here, a GMM node cloud in
+    /// `gmm::basis`); only `beta`, `h`, `tol` and `max_iter` are read.
+    pub fn newton(&self, w: &mut [[f64; 3]], lambda: &mut [f64; 2]) -> Result<u32, ShapeFault> {
         let mut lam = *lambda;
         let mut cur = self.objective(w, lam);
         for it in 0..=self.max_iter {

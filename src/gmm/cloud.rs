@@ -1,0 +1,272 @@
+//! GMM's node cloud (implicit-MPM paper §4.2, Algorithm 2): nodes that
+//! belong to the body and move with it, each with its position and the
+//! Newmark state of the last converged step (total displacement, velocity,
+//! acceleration), plus a cell list over the current positions for the
+//! search-in-radius that gathers a material point's cloud.
+//!
+//! The initial nodes are the grid lattice (`grid.h`, perturbed if the grid
+//! is) restricted to the cells the bodies cover: the four corners of every
+//! cell that holds a particle. Constraints select the cloud's nodes as they
+//! select the grid's (membership of the node's lattice position in the
+//! constraint's box, `Model::constraints`), through the grid index each
+//! cloud node was made from.
+
+use crate::error::SceneError;
+use crate::model::{FIX_X, FIX_Y, Model};
+
+/// A cloud of nodes that moves with the body.
+#[derive(Debug, Clone)]
+pub struct Cloud {
+    /// Initial node spacing h (m): the lattice's.
+    pub h: f64,
+    /// Current position (m).
+    pub x: Vec<[f64; 2]>,
+    /// Displacement since the start (m).
+    pub u: Vec<[f64; 2]>,
+    /// Velocity and acceleration at the end of the last converged step
+    /// (m/s, m/s²): Newmark's predictor reads them (Algorithm 2, step 1).
+    pub v: Vec<[f64; 2]>,
+    pub a: Vec<[f64; 2]>,
+    /// The grid node each cloud node was made from.
+    pub grid_node: Vec<u32>,
+    /// Per node: `FIX_X | FIX_Y` bits from the constraints.
+    pub fix: Vec<u8>,
+    /// Per constraint group (`Model::constraints.groups` order): its nodes.
+    pub groups: Vec<Vec<u32>>,
+    cells: CellList,
+}
+
+impl Cloud {
+    /// The lattice nodes of the cells the particles occupy, with the
+    /// particles' initial velocity (the mean over the particles of each
+    /// node's cells would smear a velocity jump; every scene today starts
+    /// each body at one velocity, which the nodes of its cells then take)
+    /// and zero acceleration.
+    pub fn from_model(model: &Model) -> Result<Cloud, SceneError> {
+        let g = &model.grid;
+        let p = &model.particles;
+        let mut used = vec![u32::MAX; g.n_nodes()];
+        let mut v_sum = vec![[0.0f64; 3]; g.n_nodes()];
+        for (i, x) in p.x.iter().enumerate() {
+            let q = g.logical(*x);
+            let (ci, cj) = (q[0].floor(), q[1].floor());
+            if ci < 0.0 || cj < 0.0 || ci as usize + 1 >= g.nx || cj as usize + 1 >= g.ny {
+                return Err(SceneError::invalid(
+                    "grid",
+                    "a particle lies outside the grid's cells, so GMM has no lattice cell to put nodes on",
+                ));
+            }
+            let (ci, cj) = (ci as usize, cj as usize);
+            for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let n = g.index(ci + di, cj + dj);
+                used[n] = 0;
+                v_sum[n][0] += p.v[i][0];
+                v_sum[n][1] += p.v[i][1];
+                v_sum[n][2] += 1.0;
+            }
+        }
+        let mut grid_node = Vec::new();
+        let mut x = Vec::new();
+        let mut v = Vec::new();
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                let n = g.index(i, j);
+                if used[n] == u32::MAX {
+                    continue;
+                }
+                used[n] = grid_node.len() as u32;
+                grid_node.push(n as u32);
+                x.push(g.node_pos(i, j));
+                let s = v_sum[n];
+                v.push([s[0] / s[2], s[1] / s[2]]);
+            }
+        }
+        let fix: Vec<u8> = grid_node
+            .iter()
+            .map(|&n| model.constraints.fix[n as usize])
+            .collect();
+        let mut groups = Vec::new();
+        for grp in &model.constraints.groups {
+            let nodes: Vec<u32> = grp
+                .nodes
+                .iter()
+                .filter_map(|&n| (used[n as usize] != u32::MAX).then_some(used[n as usize]))
+                .collect();
+            if nodes.is_empty() {
+                return Err(SceneError::invalid(
+                    format!("constraints.{}", grp.name),
+                    "holds none of the GMM cloud's nodes (the nodes of the cells the bodies cover)",
+                ));
+            }
+            groups.push(nodes);
+        }
+        let n = x.len();
+        debug_assert!(fix.iter().all(|&f| f & !(FIX_X | FIX_Y) == 0));
+        Ok(Cloud {
+            h: g.h,
+            x,
+            u: vec![[0.0; 2]; n],
+            v,
+            a: vec![[0.0; 2]; n],
+            grid_node,
+            fix,
+            groups,
+            cells: CellList::default(),
+        })
+    }
+
+    /// A cloud of free nodes at `x` (tests; no constraints).
+    pub fn from_points(h: f64, x: Vec<[f64; 2]>) -> Cloud {
+        let n = x.len();
+        Cloud {
+            h,
+            u: vec![[0.0; 2]; n],
+            v: vec![[0.0; 2]; n],
+            a: vec![[0.0; 2]; n],
+            grid_node: vec![u32::MAX; n],
+            fix: vec![0; n],
+            groups: Vec::new(),
+            x,
+            cells: CellList::default(),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Rebuilds the cell list over the current positions, cells of side
+    /// `radius` (m), so a search reaches the 3 × 3 cells around a point.
+    pub fn rebuild(&mut self, radius: f64) {
+        self.cells.build(&self.x, radius);
+    }
+
+    /// The nodes within `radius` (m, at most the last `rebuild`'s) of `x`,
+    /// in increasing index, into `out` (cleared first).
+    pub fn gather(&self, x: [f64; 2], radius: f64, out: &mut Vec<u32>) {
+        out.clear();
+        let c = &self.cells;
+        if c.nx == 0 {
+            return;
+        }
+        let r2 = radius * radius;
+        let (ci, cj) = c.cell_of(x);
+        for j in cj.saturating_sub(1)..=(cj + 1).min(c.ny - 1) {
+            for i in ci.saturating_sub(1)..=(ci + 1).min(c.nx - 1) {
+                let cell = j * c.nx + i;
+                for &n in &c.items[c.start[cell]..c.start[cell + 1]] {
+                    let xn = self.x[n as usize];
+                    let d = [x[0] - xn[0], x[1] - xn[1]];
+                    if d[0] * d[0] + d[1] * d[1] <= r2 {
+                        out.push(n);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+    }
+}
+
+/// Nodes binned by square cells (a counting sort), rebuilt each step.
+#[derive(Debug, Clone, Default)]
+struct CellList {
+    lo: [f64; 2],
+    side: f64,
+    nx: usize,
+    ny: usize,
+    /// Per cell: `items[start[c]..start[c + 1]]`.
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl CellList {
+    fn cell_of(&self, x: [f64; 2]) -> (usize, usize) {
+        let q = |v: f64, lo: f64, n: usize| {
+            let c = ((v - lo) / self.side).floor();
+            if c.is_nan() || c < 0.0 {
+                0
+            } else {
+                (c as usize).min(n - 1)
+            }
+        };
+        (q(x[0], self.lo[0], self.nx), q(x[1], self.lo[1], self.ny))
+    }
+
+    fn build(&mut self, x: &[[f64; 2]], side: f64) {
+        if x.is_empty() {
+            self.nx = 0;
+            return;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in x {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        self.lo = lo;
+        self.side = side;
+        // Points outside the box (queries) fall in the edge cells, which
+        // the 3 × 3 search still covers: a node within `side` of a query
+        // outside the box lies in an edge cell or its neighbour.
+        self.nx = (((hi[0] - lo[0]) / side).floor() as usize + 1).max(1);
+        self.ny = (((hi[1] - lo[1]) / side).floor() as usize + 1).max(1);
+        let cells = self.nx * self.ny;
+        self.start.clear();
+        self.start.resize(cells + 1, 0);
+        let cell: Vec<usize> = x
+            .iter()
+            .map(|&p| {
+                let (i, j) = self.cell_of(p);
+                j * self.nx + i
+            })
+            .collect();
+        for &c in &cell {
+            self.start[c + 1] += 1;
+        }
+        for c in 0..cells {
+            self.start[c + 1] += self.start[c];
+        }
+        let mut next = self.start.clone();
+        self.items.clear();
+        self.items.resize(x.len(), 0);
+        for (n, &c) in cell.iter().enumerate() {
+            self.items[next[c]] = n as u32;
+            next[c] += 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    #[test]
+    fn gather_finds_exactly_the_nodes_within_the_radius() {
+        let mut rng = SplitMix64::new(7);
+        let x: Vec<[f64; 2]> = (0..400)
+            .map(|_| [rng.range(-2.0, 3.0), rng.range(0.0, 1.5)])
+            .collect();
+        let mut c = Cloud::from_points(0.1, x.clone());
+        let r = 0.17;
+        c.rebuild(r);
+        let mut got = Vec::new();
+        for _ in 0..200 {
+            // Queries inside and somewhat outside the nodes' box.
+            let q = [rng.range(-2.3, 3.3), rng.range(-0.3, 1.8)];
+            c.gather(q, r, &mut got);
+            let want: Vec<u32> = (0..x.len() as u32)
+                .filter(|&n| {
+                    let d = [q[0] - x[n as usize][0], q[1] - x[n as usize][1]];
+                    d[0] * d[0] + d[1] * d[1] <= r * r
+                })
+                .collect();
+            assert_eq!(got, want, "at {q:?}");
+        }
+    }
+}
