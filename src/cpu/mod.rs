@@ -288,6 +288,24 @@ impl CpuBackend {
         )
     }
 
+    /// The predictor's nodal rule, after P2G and after MUSL's remap: the
+    /// constraints at `t_end` on the nodes, then at their points, then the
+    /// contact pairs' exchange (with the contacts `detect` found).
+    fn predict_nodes(
+        mv: &mut [[f64; 3]],
+        m: &Model,
+        contact: Option<&contact::ContactState>,
+        t_end: f64,
+        mass_eps: f64,
+    ) {
+        let c = &m.constraints;
+        grid_update::predict(mv, &c.fix, &c.groups, t_end, mass_eps);
+        constraint_points::hold(mv, &c.fix, &c.points, &c.groups, t_end, mass_eps, None);
+        if let (Some(pairs), Some(st)) = (&m.contact, contact) {
+            contact::exchange(pairs, st, mv, &c.fix, mass_eps, None);
+        }
+    }
+
     /// Stages `stress` and `forces` fused (`stress::stress_forces`).
     fn stress_forces(&mut self) -> std::result::Result<(), Fault> {
         let m = &mut self.model;
@@ -383,25 +401,13 @@ impl CpuBackend {
                         st,
                     );
                 }
-                grid_update::predict(
+                Self::predict_nodes(
                     &mut self.mv,
-                    &m.constraints.fix,
-                    &m.constraints.groups,
+                    m,
+                    self.contact.as_ref(),
                     self.t + self.dt,
                     self.mass_eps,
                 );
-                constraint_points::hold(
-                    &mut self.mv,
-                    &m.constraints.fix,
-                    &m.constraints.points,
-                    &m.constraints.groups,
-                    self.t + self.dt,
-                    self.mass_eps,
-                    None,
-                );
-                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
-                    contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);
-                }
             }
             Stage::Stress => {
                 if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
@@ -563,25 +569,13 @@ impl CpuBackend {
                 }
                 // The contacts stay those of the step's start
                 // (`GridPredict`).
-                grid_update::predict(
+                Self::predict_nodes(
                     &mut self.mv,
-                    &m.constraints.fix,
-                    &m.constraints.groups,
+                    m,
+                    self.contact.as_ref(),
                     self.t + self.dt,
                     self.mass_eps,
                 );
-                constraint_points::hold(
-                    &mut self.mv,
-                    &m.constraints.fix,
-                    &m.constraints.points,
-                    &m.constraints.groups,
-                    self.t + self.dt,
-                    self.mass_eps,
-                    None,
-                );
-                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
-                    contact::exchange(c, st, &mut self.mv, &m.constraints.fix, self.mass_eps, None);
-                }
             }
         }
         Ok(())
