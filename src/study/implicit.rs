@@ -382,7 +382,7 @@ fn gmm_disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
     let _ = writeln!(
         md,
         "**GMM (issue 27).** GMM-LME γ = 2.8 against implicit MPM (Q4): {}; {} at every Δt run. At the finest Δt \
-         ({}): {} (acceptance: below {} %). Walls act on the cloud's nodes, each meeting the wall when the body's \
+         (Δt{n}): {} (acceptance: below {} %). Walls act on the cloud's nodes, each meeting the wall when the body's \
          edge beside it does ([methods](methods.md#gmm)).\n",
         pairs
             .iter()
@@ -390,7 +390,6 @@ fn gmm_disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
             .collect::<Vec<_>>()
             .join(", "),
         if below { "below" } else { "not below" },
-        format!("Δt{n}"),
         finest.map_or("no completed run".into(), |e| format!("{} %", sig(e))),
         sig(GMM_DISK_FINEST)
     );
