@@ -34,7 +34,7 @@ fn sets<'a>(a: &[&'a str], b: &[&'a str]) -> Vec<&'a str> {
 
 #[test]
 fn gmm_keys_are_checked_and_what_gmm_lacks_is_refused_naming_the_key() {
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 7] = [
         (
             &[
                 "solver.method=gmm",
@@ -59,15 +59,6 @@ fn gmm_keys_are_checked_and_what_gmm_lacks_is_refused_naming_the_key() {
         (
             &["solver.method=gmm", "solver.mls_support=2"],
             "solver.mls_support",
-        ),
-        (
-            &[
-                "solver.method=gmm",
-                "walls.floor.point=[0.0, -0.5]",
-                "walls.floor.normal=[0.0, 1.0]",
-                "walls.floor.contact=slip",
-            ],
-            "is not available with method = \"gmm\" yet",
         ),
         (&["solver.method=fem"], "unknown variant `fem`"),
     ];
@@ -310,4 +301,267 @@ fn dynamic_cantilever_against_implicit_mpm() {
         assert!(n >= 20, "{n} common samples");
         assert!(d < AGAINST_MPM * peak, "{basis:?}: {d}");
     }
+}
+
+/// A 1 m × 0.5 m elastic block (ρ = 1000 kg/m³, E = 10 MPa, ν = 0.3) on
+/// the floor y = 0, its lower face on a lattice line, the floor's
+/// contact `contact`; gravity `g`; implicit GMM-LME γ = 2.8.
+fn block_scene(contact: &str, g: [f64; 2], solver: &str) -> String {
+    format!(
+        r#"name = "gmm_block"
+[grid]
+h = 0.1
+origin = [0.0, 0.0]
+margin = 0.6
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.block]
+material = "m"
+ppc = 2
+rects = [[0.0, 0.0, 1.0, 0.5]]
+[walls.floor]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+{contact}
+[gravity]
+g = [{}, {}]
+[solver]
+method = "gmm"
+lme_gamma = 2.8
+integrator = "implicit"
+implicit_mass = "lumped"
+newton_tol = 1e-9
+{solver}
+[output]
+sample_interval = 0.01
+"#,
+        g[0], g[1]
+    )
+}
+
+/// Runs a scene's text in memory on the CPU: status, the samples, and the
+/// mass-weighted mean displacement of the particles at the end (m).
+fn run_text(text: &str) -> (RunStatus, Vec<lme_mpm::backend::Sample>, [f64; 2]) {
+    let scene = Scene::from_str(text, "gmm_block", "gmm_block", &[]).unwrap();
+    let mut sim =
+        lme_mpm::simulation::Simulation::new(&scene, &lme_mpm::simulation::BackendSpec::cpu())
+            .unwrap();
+    let mut rec = lme_mpm::solver::Recorder::default();
+    let schedule = lme_mpm::solver::Schedule {
+        vtk_interval: None,
+        ..sim.schedule()
+    };
+    let status = sim.drive_with(schedule, &mut rec).unwrap();
+    let p = sim.backend().particles().unwrap();
+    let m: f64 = p.mass.iter().sum();
+    let mut u = [0.0; 2];
+    for i in 0..p.len() {
+        for (d, ud) in u.iter_mut().enumerate() {
+            *ud += p.mass[i] * (p.x[i][d] - p.x0[i][d]) / m;
+        }
+    }
+    (status, rec.samples, u)
+}
+
+/// The block's weight, ρ g × area (N/m).
+const BLOCK_WEIGHT: f64 = 1000.0 * 9.81 * 0.5;
+/// A static floor's reaction against the weight: Newton's tolerance
+/// (1e-9 of the load) leaves this much; measured 1e-12 or less.
+const REACTION_REL: f64 = 1e-6;
+
+#[test]
+fn a_block_rests_on_a_floor_that_acts_on_the_clouds_nodes() {
+    for contact in [
+        "contact = \"friction\"\nfriction = 0.5",
+        "contact = \"stick\"",
+    ] {
+        let text = block_scene(
+            contact,
+            [0.0, -9.81],
+            "static = true\nload_steps = 2\nt_end = 1.0",
+        );
+        let (status, samples, u) = run_text(&text);
+        assert_eq!(status, RunStatus::Completed, "{contact}");
+        let r = samples.last().unwrap().reactions[0];
+        println!(
+            "{contact:?}: floor reaction ({:.6}, {:.6}) N/m against a weight {BLOCK_WEIGHT}, mean u ({:.3e}, {:.3e}) m",
+            r[0], r[1], u[0], u[1]
+        );
+        // The force on the floor is the block's weight, straight down.
+        assert!(
+            (r[1] + BLOCK_WEIGHT).abs() < REACTION_REL * BLOCK_WEIGHT,
+            "{r:?}"
+        );
+        assert!(r[0].abs() < REACTION_REL * BLOCK_WEIGHT, "{r:?}");
+        // It settles by its elastic squash, ρ g H² / (2 M) ≈ 0.9 mm at
+        // the top (half that on average), not through the floor.
+        assert!(u[1] < 0.0 && u[1] > -1e-3, "{u:?}");
+    }
+}
+
+/// Gravity tilted by θ = 30° over the floor: the block slides at
+/// a = g (sin θ − μ cos θ) (μ = 0.2: 3.206 m/s²) from rest. The implicit
+/// step starts from a = 0 (the particles' initial acceleration), so the
+/// trapezoidal rule (β = 1/4, γ = 1/2) lags the continuous ½ a t² by
+/// ½ a Δt t − ¼ a Δt² (2.5 % at 0.2 s with Δt = 5 ms): the test compares
+/// with that discrete motion. Measured within 0.03 % of it; the bound
+/// leaves room for the contact's ringing under the sudden load.
+const SLIDE_REL: f64 = 0.005;
+/// A stick floor under the same load: the block's mean moves by its
+/// shear and rocking only, 0.80 mm against the 98 mm it would slide
+/// without friction (8.1e-3 of it; its static shear alone moves the mean
+/// about 0.16 mm, and the sudden load swings it to twice that and more).
+const STICK_REL: f64 = 0.02;
+
+#[test]
+fn a_block_slides_on_a_friction_floor_and_a_stick_floor_holds_it() {
+    let theta = 30f64.to_radians();
+    let g = [9.81 * theta.sin(), -9.81 * theta.cos()];
+    let (t, dt) = (0.2, 5e-3);
+    let solver = format!("dt = {dt}\nt_end = {t}");
+    let free = 0.5 * g[0] * t * t;
+    let mu = 0.2;
+    let text = block_scene(
+        &format!("contact = \"friction\"\nfriction = {mu}"),
+        g,
+        &solver,
+    );
+    let (status, _, u) = run_text(&text);
+    assert_eq!(status, RunStatus::Completed);
+    let a = 9.81 * (theta.sin() - mu * theta.cos());
+    let exact = 0.5 * a * t * t - 0.5 * a * dt * t + 0.25 * a * dt * dt;
+    let rel = (u[0] - exact).abs() / exact;
+    println!(
+        "friction μ = {mu}: u_x {:.6} m against {exact:.6} m (trapezoidal from a = 0; ½ a t² {:.6} m): {:.3} %, u_y {:.2e} m",
+        u[0],
+        0.5 * a * t * t,
+        100.0 * rel,
+        u[1]
+    );
+    assert!(rel < SLIDE_REL, "{rel}");
+    let (status, _, u) = run_text(&block_scene("contact = \"stick\"", g, &solver));
+    assert_eq!(status, RunStatus::Completed);
+    println!(
+        "stick: u_x {:.3e} m against {free:.4} m free ({:.2e})",
+        u[0],
+        u[0].abs() / free
+    );
+    assert!(u[0].abs() < STICK_REL * free, "{u:?}");
+}
+
+/// The rolling disk with GMM (issue 27, paper §5.2): GMM-LME γ = 2.8 at
+/// the study's Δt1 against implicit MPM (Q4, the paper's MPM) at the same
+/// short end time, and on a stick wall. The final displacement's error at
+/// 0.1 s: measured 2.57 % (friction) and 2.98 % (stick) against implicit
+/// MPM's 4.19 %, of which 2.0 % is the implicit step's start from a = 0
+/// (the trapezoidal rule lags ½ a t² by about ½ a Δt t, Δt / t of it);
+/// the bound is 1.2–1.4 times them. Eq. 67 over so short a history is
+/// that start's (20 % at the first sample, 0.01 s): 6.3 % GMM, 5.6 % MPM;
+/// over the study's 0.5 s, 0.77 % against 10.4 % (docs/methods.md, GMM).
+const GMM_DISK_SHORT: f64 = 0.035;
+
+#[test]
+fn gmm_rolling_disk_beats_implicit_mpm_at_a_short_end_time() {
+    let common_sets = [
+        "solver.integrator=implicit",
+        "solver.implicit_mass=lumped",
+        "solver.dt=2e-3",
+        "solver.t_end=0.1",
+    ];
+    let gmm = sets(&common_sets, &["solver.method=gmm", "solver.lme_gamma=2.8"]);
+    let g = common::disk::disk_run(&gmm);
+    let m = common::disk::disk_run(&sets(&common_sets, &["solver.shape=linear"]));
+    let stick = common::disk::disk_run_text(&lme_mpm::study::disk::stick_variant(), &gmm);
+    for (name, r) in [
+        ("GMM-LME", &g),
+        ("implicit MPM Q4", &m),
+        ("GMM-LME stick", &stick),
+    ] {
+        println!(
+            "{name}: {:?}, eq. 67 {:.3} %, final {:.3} %, {:.2} iterations per step, {} cuts, {:.1} s",
+            r.status,
+            r.error_percent,
+            100.0 * r.final_rel,
+            r.newton.mean_iterations(),
+            r.newton.cuts,
+            r.wall
+        );
+        assert_eq!(r.status, RunStatus::Completed, "{name}");
+    }
+    assert!(g.final_rel < GMM_DISK_SHORT, "{}", g.final_rel);
+    assert!(stick.final_rel < GMM_DISK_SHORT, "{}", stick.final_rel);
+    assert!(g.final_rel < m.final_rel, "{} {}", g.final_rel, m.final_rel);
+}
+
+/// GMM's rolling disk as `study implicit` runs it (0.5 s, Δt1 = 2 ms =
+/// 2Δt2 = 4Δt3): a measurement for docs/methods.md, not a check.
+/// `cargo test --release --test gmm -- --ignored --nocapture gmm_disk_`
+fn gmm_disk_rows(label: &str, keys: &[&str], dts: &[f64]) {
+    for dt in dts {
+        let d = format!("solver.dt={dt}");
+        let all = sets(
+            &[
+                "solver.integrator=implicit",
+                "solver.implicit_mass=lumped",
+                &d,
+            ],
+            keys,
+        );
+        let r = common::disk::disk_run(&all);
+        println!(
+            "| {label} | {dt} | {:?} | {:.3} | {:.3} | {:.0} | {:.2} / {} | {} |",
+            r.status,
+            r.error_percent,
+            100.0 * r.final_rel,
+            r.wall,
+            r.newton.mean_iterations(),
+            r.newton.max_iterations,
+            r.newton.cuts
+        );
+    }
+}
+
+#[test]
+#[ignore = "measurement: GMM-LME γ = 2.8 disk at three Δt (minutes)"]
+fn gmm_disk_lme_28() {
+    gmm_disk_rows(
+        "GMM-LME γ = 2.8",
+        &["solver.method=gmm", "solver.lme_gamma=2.8"],
+        &[2e-3, 1e-3, 5e-4],
+    );
+}
+
+#[test]
+#[ignore = "measurement: GMM-LME γ = 0.8 and 1.8 disk at three Δt (minutes)"]
+fn gmm_disk_lme_other() {
+    for g in ["0.8", "1.8"] {
+        let k = format!("solver.lme_gamma={g}");
+        gmm_disk_rows(
+            &format!("GMM-LME γ = {g}"),
+            &["solver.method=gmm", &k],
+            &[2e-3, 1e-3, 5e-4],
+        );
+    }
+}
+
+#[test]
+#[ignore = "measurement: GMM-MLS disk at three Δt (minutes)"]
+fn gmm_disk_mls() {
+    gmm_disk_rows(
+        "GMM-MLS",
+        lme_mpm::study::implicit::DISK_GMM[3].1,
+        &[2e-3, 1e-3, 5e-4],
+    );
+}
+
+#[test]
+#[ignore = "measurement: one disk run, Δt and keys from LME_MPM_DISK_DT and LME_MPM_DISK_SETS"]
+fn gmm_disk_one() {
+    let dt: f64 = std::env::var("LME_MPM_DISK_DT").map_or(2e-3, |v| v.parse().unwrap());
+    let keys = std::env::var("LME_MPM_DISK_SETS").unwrap_or_default();
+    let keys: Vec<&str> = keys.split_whitespace().collect();
+    gmm_disk_rows("one", &keys, &[dt]);
 }

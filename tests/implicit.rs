@@ -7,17 +7,14 @@
 
 mod common;
 
-use lme_mpm::backend::{Backend, NewtonStats, Sample};
+use common::disk::DiskRun;
 use lme_mpm::cpu::implicit::ImplicitBackend;
 use lme_mpm::exact::Errors;
 use lme_mpm::exact::cantilever::{CantileverErrors, PAPER_NONLINEAR};
-use lme_mpm::exact::rolling::RollingDisk;
 use lme_mpm::model::Model;
 use lme_mpm::model::fault::FaultKind;
-use lme_mpm::simulation::{BackendSpec, Simulation};
-use lme_mpm::solver::{Observer, RunStatus};
+use lme_mpm::solver::RunStatus;
 use std::process::Command;
-use std::time::Instant;
 
 /// The bound on the cantilever at h = 0.25 (relative to 0.67433 m).
 const CANTILEVER_H025: f64 = 0.02;
@@ -255,62 +252,12 @@ fn jacobian_is_the_derivative_of_the_residual_with_friction_contact() {
     }
 }
 
-/// Centre-of-mass displacement along x at each snapshot: eq. 67's samples.
-#[derive(Default)]
-struct CentreHistory(Vec<(f64, f64)>);
-
-impl Observer for CentreHistory {
-    fn sample(&mut self, _: &Sample) -> lme_mpm::error::Result<()> {
-        Ok(())
-    }
-    fn snapshot(&mut self, b: &mut dyn Backend) -> lme_mpm::error::Result<()> {
-        let t = b.time();
-        if t > 0.0 {
-            let (u, _) = RollingDisk::centre(b.particles()?);
-            self.0.push((t, u[0]));
-        }
-        Ok(())
-    }
-}
-
-/// An implicit rolling disk run: its end, eq. 67 (percent), the final
-/// centre displacement's relative error, Newton's figures, wall time.
-struct DiskRun {
-    status: RunStatus,
-    error_percent: f64,
-    final_rel: f64,
-    newton: NewtonStats,
-    wall: f64,
-}
-
 /// Runs `cases/rolling_disk.toml` with the implicit step, lumped mass and
 /// `sets`, sampling the centre every 0.01 s as `study disk` does.
 fn implicit_disk(sets: &[&str]) -> DiskRun {
     let mut all = vec!["solver.integrator=implicit", "solver.implicit_mass=lumped"];
     all.extend_from_slice(sets);
-    let scene = common::scene("rolling_disk.toml", &all);
-    let exact = RollingDisk::from_scene(&scene);
-    let t_end = scene.file.solver.t_end;
-    let mut sim = Simulation::new(&scene, &BackendSpec::cpu()).unwrap();
-    let n = (t_end / 0.01).round() as usize;
-    let schedule = lme_mpm::solver::Schedule {
-        vtk_interval: None,
-        snapshot_times: (1..=n).map(|k| k as f64 * 0.01).collect(),
-        ..sim.schedule()
-    };
-    let mut history = CentreHistory::default();
-    let start = Instant::now();
-    let status = sim.drive_with(schedule, &mut history).unwrap();
-    let wall = start.elapsed().as_secs_f64();
-    let &(t, u) = history.0.last().expect("a snapshot");
-    let final_rel = (u - exact.displacement(t)[0]).abs() / exact.displacement(t)[0];
-    DiskRun {
-        status,
-        error_percent: exact.history_error_percent(&history.0),
-        final_rel,
-        newton: sim.backend_ref().newton().unwrap().clone(),
-        wall,
-    }
+    common::disk::disk_run(&all)
 }
 
 /// The short disk's centre displacement at 0.1 s against ½ a t²

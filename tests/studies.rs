@@ -422,8 +422,13 @@ fn implicit_quick_compares_schemes_per_case() {
         + md.lines()
             .filter(|l| l.starts_with("| explicit | "))
             .count();
-    // Cantilever rows, plus the disk's two rows per scheme.
-    assert_eq!(rows, cantilever + 4, "{md}");
+    // Cantilever rows, plus the disk's two rows per scheme and its GMM
+    // rows (implicit only).
+    assert_eq!(
+        rows,
+        cantilever + 4 + lme_mpm::study::implicit::DISK_GMM.len(),
+        "{md}"
+    );
     for r in results
         .iter()
         .filter(|r| r.job.tag_value("scheme") == Some("implicit"))

@@ -10,9 +10,14 @@
 //! select the grid's (membership of the node's lattice position in the
 //! constraint's box, `Model::constraints`), through the grid index each
 //! cloud node was made from.
+//!
+//! Walls act on the cloud's nodes (`cpu::implicit::gmm`), and a lattice
+//! node of a cell the body only partly covers lies outside the body, by
+//! up to a cell's diagonal: each node keeps how far (`outside`), so that it
+//! meets a wall when the body's edge beside it does, not before.
 
 use crate::error::SceneError;
-use crate::model::{FIX_X, FIX_Y, Model};
+use crate::model::{BodyOutline, FIX_X, FIX_Y, Model};
 
 /// A cloud of nodes that moves with the body.
 #[derive(Debug, Clone)]
@@ -33,6 +38,11 @@ pub struct Cloud {
     pub fix: Vec<u8>,
     /// Per constraint group (`Model::constraints.groups` order): its nodes.
     pub groups: Vec<Vec<u32>>,
+    /// Per node: its distance (m) from the body at the start, measured to
+    /// the bodies' shapes (`BodyOutline`; 0 for a node inside one). The
+    /// node moves with the body, so it keeps this distance as the body
+    /// turns (`set_outside`; 0 until then).
+    pub outside: Vec<f64>,
     cells: CellList,
 }
 
@@ -111,6 +121,7 @@ impl Cloud {
             grid_node,
             fix,
             groups,
+            outside: vec![0.0; n],
             cells: CellList::default(),
         })
     }
@@ -126,9 +137,16 @@ impl Cloud {
             grid_node: vec![u32::MAX; n],
             fix: vec![0; n],
             groups: Vec::new(),
+            outside: vec![0.0; n],
             x,
             cells: CellList::default(),
         }
+    }
+
+    /// Measures each node's distance from the bodies' `outline` (m, 0
+    /// inside), into `outside`.
+    pub fn set_outside(&mut self, outline: &BodyOutline) {
+        self.outside = self.x.iter().map(|&p| distance(outline, p)).collect();
     }
 
     pub fn len(&self) -> usize {
@@ -169,6 +187,47 @@ impl Cloud {
         }
         out.sort_unstable();
     }
+}
+
+/// Distance (m) from `p` to the union of the `outline`'s shapes: 0 inside
+/// one, else the nearest shape's boundary.
+pub fn distance(outline: &BodyOutline, p: [f64; 2]) -> f64 {
+    let rects = outline.rects.iter().map(|r| {
+        let dx = (r[0] - p[0]).max(p[0] - r[2]).max(0.0);
+        let dy = (r[1] - p[1]).max(p[1] - r[3]).max(0.0);
+        dx.hypot(dy)
+    });
+    let disks = outline
+        .disks
+        .iter()
+        .map(|d| ((p[0] - d[0]).hypot(p[1] - d[1]) - d[2]).max(0.0));
+    let polygons = outline.polygons.iter().map(|poly| {
+        // Even-odd inside test (as the seeding's), else the nearest edge.
+        let n = poly.len();
+        let mut inside = false;
+        let mut nearest = f64::INFINITY;
+        for i in 0..n {
+            let (a, b) = (poly[i], poly[(i + n - 1) % n]);
+            if (a[1] > p[1]) != (b[1] > p[1])
+                && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+            {
+                inside = !inside;
+            }
+            let e = [b[0] - a[0], b[1] - a[1]];
+            let len2 = e[0] * e[0] + e[1] * e[1];
+            let s = if len2 > 0.0 {
+                (((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            nearest = nearest.min((p[0] - a[0] - s * e[0]).hypot(p[1] - a[1] - s * e[1]));
+        }
+        if inside { 0.0 } else { nearest }
+    });
+    rects
+        .chain(disks)
+        .chain(polygons)
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Nodes binned by square cells (a counting sort), rebuilt each step.
@@ -245,6 +304,26 @@ impl CellList {
 mod tests {
     use super::*;
     use crate::rng::SplitMix64;
+
+    #[test]
+    fn distance_to_the_outline_is_zero_inside_and_the_boundarys_outside() {
+        let o = BodyOutline {
+            rects: vec![[0.0, 0.0, 1.0, 1.0]],
+            disks: vec![[3.0, 0.0, 0.5]],
+            polygons: vec![vec![[5.0, 0.0], [6.0, 0.0], [5.0, 1.0]]],
+        };
+        let close = |p: [f64; 2], want: f64| {
+            let d = distance(&o, p);
+            assert!((d - want).abs() < 1e-14, "{p:?}: {d} against {want}");
+        };
+        close([0.5, 0.5], 0.0);
+        close([1.3, 1.4], 0.5);
+        close([3.0, 0.8], 0.3);
+        close([3.1, 0.1], 0.0);
+        close([5.2, 0.2], 0.0);
+        close([6.0, 1.0], 0.5f64.sqrt());
+        close([5.5, -0.25], 0.25);
+    }
 
     #[test]
     fn gather_finds_exactly_the_nodes_within_the_radius() {

@@ -148,6 +148,15 @@ pub struct GmmSettings {
     pub dilation: f64,
 }
 
+/// Every body's shapes as the scene gives them (m): rectangles
+/// `[xmin, ymin, xmax, ymax]`, disks `[cx, cy, r]`, simple polygons.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BodyOutline {
+    pub rects: Vec<[f64; 4]>,
+    pub disks: Vec<[f64; 3]>,
+    pub polygons: Vec<Vec<[f64; 2]>>,
+}
+
 impl Integrator {
     pub fn kind(&self) -> IntegratorKind {
         match self {
@@ -212,6 +221,9 @@ pub struct Model {
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
     pub manufactured: Option<AlignedVibration>,
+    /// The bodies' shapes, kept for GMM (`solver.method = "gmm"`: a cloud
+    /// node's distance from the body is measured to them); empty otherwise.
+    pub outline: BodyOutline,
 }
 
 impl Model {
@@ -349,6 +361,15 @@ impl Model {
             local_damping: f.solver.local_damping,
             probes,
             manufactured,
+            outline: if f.solver.method == SolverMethod::Gmm {
+                BodyOutline {
+                    rects: f.bodies.values().flat_map(|b| b.rects.clone()).collect(),
+                    disks: f.bodies.values().flat_map(|b| b.disks.clone()).collect(),
+                    polygons: f.bodies.values().flat_map(|b| b.polygons.clone()).collect(),
+                }
+            } else {
+                BodyOutline::default()
+            },
         })
     }
 

@@ -248,8 +248,8 @@ fn check_implicit(s: &SolverSpec) -> Result<(), SceneError> {
 
 /// `solver.method = "gmm"` and its keys (checked whatever the method, so a
 /// typo is caught before it matters): GMM runs the implicit step only,
-/// and what it does not yet do (walls, contact pairs, the grid's MLS
-/// keys) is refused, naming the key.
+/// and what it does not do (contact pairs, the grid's MLS keys) is
+/// refused, naming the key; walls act on the cloud's nodes.
 fn check_gmm(file: &SceneFile) -> Result<(), SceneError> {
     let s = &file.solver;
     finite("solver.gmm_search_radius", s.gmm_search_radius)?;
@@ -302,13 +302,6 @@ fn check_gmm(file: &SceneFile) -> Result<(), SceneError> {
                 ),
             ));
         }
-    }
-    if let Some(name) = file.walls.keys().next() {
-        return Err(SceneError::invalid(
-            format!("walls.{name}"),
-            "is not available with method = \"gmm\" yet (walls acting on the cloud's nodes are \
-             the rolling disk's part of issue 27)",
-        ));
     }
     if let Some(name) = file.contact.keys().next() {
         return Err(SceneError::invalid(

@@ -12,9 +12,10 @@
 //!   order ≥ 1.8, the finest within 0.1 % of the Richardson limit).
 //! - Dyka's bar (LME γ = 4, h = 1 mm): implicit at Courant 0.5, 1, 2
 //!   against NPC at Courant 0.1, 0.5, 0.9.
-//! - Rolling disk (§5.2): implicit and NPC, Q4 and bspline2, three time
-//!   steps each, beside the paper's Table 1; a run that stops is a row
-//!   with its reason and the time it reached.
+//! - Rolling disk (§5.2): implicit and NPC, Q4 and bspline2, and GMM
+//!   (LME γ = 0.8, 1.8, 2.8 and MLS, implicit), three time steps each,
+//!   beside the paper's Table 1; a run that stops is a row with its
+//!   reason and the time it reached.
 //!
 //! Every run is on the CPU: the implicit step has no GPU twin.
 
@@ -88,6 +89,44 @@ pub const DYKA_NPC: [f64; 3] = [0.1, 0.5, 0.9];
 pub const DISK_IMPLICIT_DT1: f64 = 2e-3;
 /// `--quick`: the disk's end time (s), three eq. 67 samples.
 const DISK_T_END_QUICK: f64 = 0.03;
+
+/// GMM on the rolling disk (issue 27; paper §5.2, Table 1), implicit at
+/// the implicit Δt1..Δt3: (label, scene keys). LME with the paper's
+/// r = sqrt(2 h²) (the key's default) and γ = 0.8, 1.8, 2.8; MLS with its
+/// r = 1.5 sqrt(2 h²) and f = sqrt(2 h²) (in units of h).
+pub const DISK_GMM: [(&str, &[&str]); 4] = [
+    (
+        "gmm-lme-g0.8",
+        &["solver.method=gmm", "solver.lme_gamma=0.8"],
+    ),
+    (
+        "gmm-lme-g1.8",
+        &["solver.method=gmm", "solver.lme_gamma=1.8"],
+    ),
+    (
+        "gmm-lme-g2.8",
+        &["solver.method=gmm", "solver.lme_gamma=2.8"],
+    ),
+    (
+        "gmm-mls",
+        &[
+            "solver.method=gmm",
+            "solver.gmm_basis=mls",
+            "solver.gmm_search_radius=2.1213203435596424",
+            "solver.gmm_dilation=1.4142135623730951",
+        ],
+    ),
+];
+
+/// The paper's Table 1 rows that `DISK_GMM` and Q4 stand beside (error %
+/// at Δt1, Δt2, Δt3).
+const PAPER_TABLE1: [(&str, [f64; 3]); 5] = [
+    ("MPM (implicit)", super::disk::PAPER_MPM),
+    ("GMM-MLS", [0.84, 0.26, 0.20]),
+    ("GMM-LME γ = 0.8", [1.37, 0.07, 0.06]),
+    ("GMM-LME γ = 1.8", [0.9, 0.23, 0.07]),
+    ("GMM-LME γ = 2.8", super::disk::PAPER_LME_28),
+];
 
 const SCHEMES: [&str; 2] = ["implicit", "explicit"];
 
@@ -231,6 +270,19 @@ pub fn jobs(quick: bool) -> Vec<Job> {
             }
         }
     }
+    for (label, keys) in DISK_GMM {
+        for (k, dt) in disk_steps("implicit", quick).into_iter().enumerate() {
+            let mut j = super::disk::job(b, (label, "lme", 0.0), k + 1, dt, disk_t_end(quick))
+                .tag("case", "disk")
+                .tag("scheme", "implicit")
+                .set("solver.integrator=implicit");
+            for key in keys {
+                j = j.set(*key);
+            }
+            j.label = format!("disk-implicit-{label}-dt{}", k + 1);
+            out.push(j);
+        }
+    }
     let (h, implicit, npc) = dyka_runs(quick);
     for (scheme, courants) in [("implicit", implicit), ("explicit", npc)] {
         let integrator = if scheme == "implicit" {
@@ -309,6 +361,42 @@ fn disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
         sig(worst)
     );
 }
+
+/// Issue 27's acceptance on the disk: GMM-LME γ = 2.8 below
+/// `GMM_DISK_FINEST` % at the finest Δt, and below implicit MPM (Q4, the
+/// paper's MPM) at every Δt.
+fn gmm_disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
+    let gmm = "gmm-lme-g2.8";
+    let pairs: Vec<(usize, f64, f64)> = (1..=n)
+        .filter_map(|k| {
+            let g = done.get(&("implicit", gmm, k))?;
+            let m = done.get(&("implicit", "linear", k))?;
+            Some((k, g.0, m.0))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return;
+    }
+    let below = pairs.iter().all(|&(_, g, m)| g < m);
+    let finest = done.get(&("implicit", gmm, n)).map(|g| g.0);
+    let _ = writeln!(
+        md,
+        "**GMM (issue 27).** GMM-LME γ = 2.8 against implicit MPM (Q4): {}; {} at every Δt run. At the finest Δt \
+         (Δt{n}): {} (acceptance: below {} %). Walls act on the cloud's nodes, each meeting the wall when the body's \
+         edge beside it does ([methods](methods.md#gmm)).\n",
+        pairs
+            .iter()
+            .map(|&(k, g, m)| format!("Δt{k} {} % against {} %", sig(g), sig(m)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if below { "below" } else { "not below" },
+        finest.map_or("no completed run".into(), |e| format!("{} %", sig(e))),
+        sig(GMM_DISK_FINEST)
+    );
+}
+
+/// Issue 27's bound on GMM-LME γ = 2.8's disk error at the finest Δt (%).
+pub const GMM_DISK_FINEST: f64 = 1.0;
 
 /// The run whose tags include every (key, value) of `tags`.
 fn find<'a>(results: &'a [JobResult], tags: &[(&str, &str)]) -> Option<&'a JobResult> {
@@ -1149,7 +1237,14 @@ impl Report<'_> {
         let mut stopped_text = Vec::new();
         let mut done = DiskRuns::new();
         for (scheme, dashed) in [("implicit", false), ("explicit", true)] {
-            for (ci, (label, _)) in SHAPES.iter().enumerate() {
+            // GMM runs implicit only.
+            let labels = SHAPES.iter().map(|(l, _)| *l).chain(
+                DISK_GMM
+                    .iter()
+                    .filter(|_| scheme == "implicit")
+                    .map(|(l, _)| *l),
+            );
+            for (ci, label) in labels.enumerate() {
                 let mut row = vec![scheme.to_string(), label.to_string()];
                 let mut points = Vec::new();
                 let mut stopped = Vec::new();
@@ -1201,10 +1296,7 @@ impl Report<'_> {
                 });
             }
         }
-        for (name, fig) in [
-            ("MPM (implicit)", super::disk::PAPER_MPM),
-            ("GMM-LME γ = 2.8", super::disk::PAPER_LME_28),
-        ] {
+        for (name, fig) in PAPER_TABLE1 {
             let mut row = vec!["paper".to_string(), name.to_string()];
             for f in fig.iter().take(n) {
                 row.push(sig(*f));
@@ -1240,6 +1332,7 @@ impl Report<'_> {
             }
         );
         disk_findings(md, &done, n);
+        gmm_disk_findings(md, &done, n);
         Ok(files)
     }
 

@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod disk;
+
 use lme_mpm::exact::Errors;
 use lme_mpm::scene::{Override, Scene};
 use lme_mpm::simulation::{BackendSpec, Simulation};

@@ -221,7 +221,8 @@ pub struct StepInputs<'a> {
     pub dofs: &'a Dofs,
     /// Wall contact penalty k (N/m per metre of thickness).
     pub penalty: f64,
-    /// The nodes behind `slip` and `friction` walls that are unknowns.
+    /// The step's wall contacts: unknown nodes behind `slip` and
+    /// `friction` walls (the grid), or near any wall (a GMM cloud).
     pub pairs: &'a [ContactPair],
     /// Lumped mass, M_II = Σ_p m_p N_I, instead of the consistent one.
     pub lumped_mass: bool,
@@ -331,8 +332,11 @@ pub fn add_contact(
     let walls = &inp.model.walls.list;
     for (i, pair) in inp.pairs.iter().enumerate() {
         let (n, k) = (pair.node as usize, pair.wall as usize);
-        let state = states.map_or_else(|| contact::natural_state(&walls[k], du[n]), |s| s[i]);
-        let (f, _) = contact::force(&walls[k], du[n], inp.penalty, state);
+        let state = states.map_or_else(
+            || contact::natural_state(&walls[k], pair.gap, du[n]),
+            |s| s[i],
+        );
+        let (f, _) = contact::force(&walls[k], pair.gap, du[n], inp.penalty, state);
         r[n][0] += f[0];
         r[n][1] += f[1];
         if let Some(wf) = wall_force.as_deref_mut() {
@@ -381,7 +385,7 @@ pub fn natural_states(inp: &StepInputs, du: &[[f64; 2]], states: &mut Vec<Contac
     states.extend(
         inp.pairs
             .iter()
-            .map(|p| contact::natural_state(&walls[p.wall as usize], du[p.node as usize])),
+            .map(|p| contact::natural_state(&walls[p.wall as usize], p.gap, du[p.node as usize])),
     );
 }
 
@@ -620,7 +624,13 @@ pub fn jacobian(
     for (pair, &state) in inp.pairs.iter().zip(states) {
         let n = pair.node as usize;
         let id = dofs.id[n];
-        let (_, dk) = contact::force(&walls[pair.wall as usize], du[n], inp.penalty, state);
+        let (_, dk) = contact::force(
+            &walls[pair.wall as usize],
+            pair.gap,
+            du[n],
+            inp.penalty,
+            state,
+        );
         for i in 0..2 {
             for c in 0..2 {
                 values[pattern.slot(id, id, i, c)] += dk[2 * i + c];

@@ -3,15 +3,20 @@
 //! hold the state of every wall node fixed while it converges (an active
 //! set), and the rule that revises a held state from the law's own.
 //!
-//! A node is in contact when its increment moves it further behind the
-//! wall's line, g = Δu·n ≤ 0; the normal force is then −k g n. Coulomb's
+//! A node is in contact when its gap to the wall's contact line at the
+//! step's end is closed, g = g₀ + Δu·n ≤ 0, g₀ the gap at the step's start
+//! (`ContactPair::gap`): 0 for a grid node behind the wall (implicit MPM:
+//! the node holds where it is, its increment may not move it further
+//! behind), the node's distance to the line for a GMM cloud node, which
+//! moves with the body (`gmm::GmmNodes::wall_pairs`). The normal force is
+//! then −k g n. Coulomb's
 //! law on the tangential increment s = Δu·t (t = n rotated a quarter turn)
 //! is a return map: the trial (stick) force −k s t if |k s| ≤ μ k |g|,
 //! else μ k |g| against the slip. Within one state the force is linear in
 //! Δu, so its derivative is exact there; the law as a whole is only
 //! piecewise smooth, which is why Newton holds the states (`mod.rs`).
 
-use crate::model::walls::{CONTACT_FRICTION, Wall};
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK, Wall};
 
 /// A wall node's contact state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,28 +52,43 @@ pub fn from_code(code: u8) -> Option<ContactState> {
     }
 }
 
-/// A node behind a wall, with mass: one contact of the step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A node that may touch a wall in this step, with mass: one contact of
+/// the step.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactPair {
     pub node: u32,
     /// Index into the model's wall list.
     pub wall: u32,
+    /// The gap g₀ (m) between the node and the wall's contact line at the
+    /// step's start, positive on the material's side: 0 for a grid node
+    /// behind the line, the cloud node's distance for GMM.
+    pub gap: f64,
 }
 
-/// Normal and tangential components of an increment: (g, s).
+/// Normal and tangential components of the gap at the increment `du` of
+/// a node `gap` (m) from the line at the step's start: (g₀ + Δu·n, Δu·t).
 #[inline]
-fn components(wall: &Wall, du: [f64; 2]) -> (f64, f64) {
+fn components(wall: &Wall, gap: f64, du: [f64; 2]) -> (f64, f64) {
     let n = wall.normal;
-    (du[0] * n[0] + du[1] * n[1], -du[0] * n[1] + du[1] * n[0])
+    (
+        gap + du[0] * n[0] + du[1] * n[1],
+        -du[0] * n[1] + du[1] * n[0],
+    )
 }
 
-/// The state Coulomb's law gives at `du`. g = 0 counts as contact (zero
-/// force, full stiffness): a node resting on the wall starts each step in
-/// contact, so Newton does not begin by letting it fall through.
-pub fn natural_state(wall: &Wall, du: [f64; 2]) -> ContactState {
-    let (g, s) = components(wall, du);
+/// The state Coulomb's law gives at `du` for a node `gap` (m) from the
+/// line at the step's start. g = 0 counts as contact (zero force, full
+/// stiffness): a node resting on the wall starts each step in contact, so
+/// Newton does not begin by letting it fall through. A `stick` wall's
+/// contacts (GMM's cloud nodes only: the grid holds a stick wall's nodes
+/// as fixed components instead) stick while closed, as friction with no
+/// bound on μ, and let go when the node lifts off.
+pub fn natural_state(wall: &Wall, gap: f64, du: [f64; 2]) -> ContactState {
+    let (g, s) = components(wall, gap, du);
     if g > 0.0 {
         ContactState::Open
+    } else if wall.contact == CONTACT_STICK {
+        ContactState::Stick
     } else if wall.contact != CONTACT_FRICTION {
         ContactState::Slip(1.0)
     } else if s.abs() <= wall.mu * -g {
@@ -78,14 +98,21 @@ pub fn natural_state(wall: &Wall, du: [f64; 2]) -> ContactState {
     }
 }
 
-/// The force on a node displaced by `du` under `state`, and its derivative
+/// The force on a node `gap` (m) from the line at the step's start and
+/// displaced by `du` under `state`, and its derivative
 /// −∂f/∂Δu (2 × 2, row-major). Linear in Δu: exact for any `du`, also one
 /// outside the state (a held state then gives a tensile normal force, or
 /// friction along the slip, which the state revision removes).
-pub fn force(wall: &Wall, du: [f64; 2], k: f64, state: ContactState) -> ([f64; 2], [f64; 4]) {
+pub fn force(
+    wall: &Wall,
+    gap: f64,
+    du: [f64; 2],
+    k: f64,
+    state: ContactState,
+) -> ([f64; 2], [f64; 4]) {
     let n = wall.normal;
     let t = [-n[1], n[0]];
-    let (g, s) = components(wall, du);
+    let (g, s) = components(wall, gap, du);
     let outer = |a: [f64; 2], b: [f64; 2], c: f64| {
         [
             c * a[0] * b[0],
@@ -119,8 +146,8 @@ pub fn force(wall: &Wall, du: [f64; 2], k: f64, state: ContactState) -> ([f64; 2
 }
 
 /// Coulomb's law itself: the force under the state it gives at `du`.
-pub fn contact(wall: &Wall, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
-    force(wall, du, k, natural_state(wall, du))
+pub fn contact(wall: &Wall, gap: f64, du: [f64; 2], k: f64) -> ([f64; 2], [f64; 4]) {
+    force(wall, gap, du, k, natural_state(wall, gap, du))
 }
 
 /// The state to hold next, from the held one and the law's at Newton's
@@ -163,16 +190,25 @@ mod tests {
     #[test]
     fn states_follow_coulomb() {
         let w = wall(CONTACT_FRICTION);
-        assert_eq!(natural_state(&w, du(&w, 1e-6, 0.0)), ContactState::Open);
-        assert_eq!(natural_state(&w, du(&w, 0.0, 0.0)), ContactState::Stick);
-        assert_eq!(natural_state(&w, du(&w, -1e-6, 4e-7)), ContactState::Stick);
         assert_eq!(
-            natural_state(&w, du(&w, -1e-6, -6e-7)),
+            natural_state(&w, 0.0, du(&w, 1e-6, 0.0)),
+            ContactState::Open
+        );
+        assert_eq!(
+            natural_state(&w, 0.0, du(&w, 0.0, 0.0)),
+            ContactState::Stick
+        );
+        assert_eq!(
+            natural_state(&w, 0.0, du(&w, -1e-6, 4e-7)),
+            ContactState::Stick
+        );
+        assert_eq!(
+            natural_state(&w, 0.0, du(&w, -1e-6, -6e-7)),
             ContactState::Slip(-1.0)
         );
         let s = wall(CONTACT_SLIP);
         assert_eq!(
-            natural_state(&s, du(&s, -1e-6, 0.0)),
+            natural_state(&s, 0.0, du(&s, -1e-6, 0.0)),
             ContactState::Slip(1.0)
         );
     }
@@ -181,7 +217,7 @@ mod tests {
     fn slip_force_is_mu_times_the_normal_one_against_the_slip() {
         let w = wall(CONTACT_FRICTION);
         let k = 1e9;
-        let (f, _) = contact(&w, du(&w, -1e-6, 5e-6), k);
+        let (f, _) = contact(&w, 0.0, du(&w, -1e-6, 5e-6), k);
         let n = w.normal;
         let t = [-n[1], n[0]];
         let fn_ = f[0] * n[0] + f[1] * n[1];
@@ -196,8 +232,8 @@ mod tests {
         let k = 1e9;
         // At |s| = μ|g| both states give the same force.
         let d = du(&w, -1e-6, 0.5e-6);
-        let (a, _) = force(&w, d, k, ContactState::Stick);
-        let (b, _) = force(&w, d, k, ContactState::Slip(1.0));
+        let (a, _) = force(&w, 0.0, d, k, ContactState::Stick);
+        let (b, _) = force(&w, 0.0, d, k, ContactState::Slip(1.0));
         for i in 0..2 {
             assert!((a[i] - b[i]).abs() < 1e-9 * k * 1e-6, "{a:?} {b:?}");
         }
@@ -214,20 +250,52 @@ mod tests {
             ContactState::Slip(1.0),
             ContactState::Slip(-1.0),
         ] {
-            let (_, kt) = force(&w, d, k, state);
+            let (_, kt) = force(&w, 2e-7, d, k, state);
             let eps = 1e-9;
             for c in 0..2 {
                 let (mut p, mut m) = (d, d);
                 p[c] += eps;
                 m[c] -= eps;
-                let (fp, _) = force(&w, p, k, state);
-                let (fm, _) = force(&w, m, k, state);
+                let (fp, _) = force(&w, 2e-7, p, k, state);
+                let (fm, _) = force(&w, 2e-7, m, k, state);
                 for r in 0..2 {
                     let fd = -(fp[r] - fm[r]) / (2.0 * eps);
                     assert!((kt[2 * r + c] - fd).abs() < 1e-6 * k, "{state:?}");
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_gap_shifts_the_contact_line() {
+        let w = wall(CONTACT_FRICTION);
+        let k = 1e9;
+        // A node 2e-6 m off the line closes it only past Δu·n = −2e-6 m,
+        // and presses with what is left beyond.
+        assert_eq!(
+            natural_state(&w, 2e-6, du(&w, -1.5e-6, 0.0)),
+            ContactState::Open
+        );
+        let (f, _) = contact(&w, 2e-6, du(&w, -3e-6, 0.0), k);
+        let fn_ = f[0] * w.normal[0] + f[1] * w.normal[1];
+        assert!((fn_ - 1e3).abs() < 1e-6, "{fn_}");
+        // One pressed in 1e-6 m at the start pushes back before it moves.
+        let (f, _) = contact(&w, -1e-6, [0.0; 2], k);
+        let fn_ = f[0] * w.normal[0] + f[1] * w.normal[1];
+        assert!((fn_ - 1e3).abs() < 1e-6, "{fn_}");
+    }
+
+    #[test]
+    fn a_stick_wall_holds_a_closed_contact_and_lets_an_open_one_go() {
+        let w = wall(CONTACT_STICK);
+        assert_eq!(
+            natural_state(&w, 0.0, du(&w, -1e-6, 1e-3)),
+            ContactState::Stick
+        );
+        assert_eq!(
+            natural_state(&w, -1e-6, du(&w, 2e-6, 0.0)),
+            ContactState::Open
+        );
     }
 
     #[test]

@@ -10,14 +10,23 @@
 //! - Newmark's predictor reads the nodes' own velocity and acceleration
 //!   of the last converged step (like FEM; MPM maps them from the
 //!   particles);
+//! - walls act on the cloud's own nodes (`wall_pairs`): a node moves with
+//!   the body, so its contact gap is its distance to the wall's line,
+//!   g = (x + Δu − point)·n + d, d how far the node lies outside the
+//!   body (`Cloud::outside`, so that it meets the wall when the body's
+//!   edge beside it does); every wall, `stick` included, is a penalty
+//!   contact of `contact` (a stick wall holds a closed contact, and lets
+//!   it go when it opens, which is what lets a disk roll on it);
 //! - after convergence the nodes move with the solution: x += Δu, the
 //!   Newmark acceleration and velocity (eqs. 43–44) become their state.
 
-use super::assemble::Newmark;
+use super::assemble::{Dofs, NO_DOF, Newmark};
+use super::contact::ContactPair;
 use crate::cpu::ShapeCache;
 use crate::error::SceneError;
 use crate::gmm::{Basis, Cloud};
 use crate::model::fault::{Fault, FaultKind};
+use crate::model::walls::Wall;
 use crate::model::{GmmSettings, Model};
 use rayon::prelude::*;
 
@@ -33,13 +42,33 @@ pub struct GmmNodes {
     radius: f64,
     /// Per particle: LME's λ of the last step (warm start; unused by MLS).
     lambda: Vec<[f64; 2]>,
+    /// Per wall: how far (m) the body reached past its line at the start
+    /// (its nodes' deepest gap, 0 if none did): contact is measured from
+    /// there, so a body seeded against the wall starts unloaded, as the
+    /// explicit walls' `Wall::offset`. 0 for a wall that appears later.
+    wall_offset: Vec<f64>,
 }
 
 impl GmmNodes {
     pub fn new(model: &Model, s: &GmmSettings) -> Result<GmmNodes, SceneError> {
-        let cloud = Cloud::from_model(model)?;
+        let mut cloud = Cloud::from_model(model)?;
+        cloud.set_outside(&model.outline);
         let h = cloud.h;
+        let wall_offset = model
+            .walls
+            .list
+            .iter()
+            .map(|w| {
+                if w.appear_at > 0.0 {
+                    return 0.0;
+                }
+                (0..cloud.len())
+                    .map(|n| -raw_gap(&cloud, n, w))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
         Ok(GmmNodes {
+            wall_offset,
             basis: Basis::new(s, h),
             radius: s.search_radius * h,
             lambda: vec![[0.0; 2]; model.particles.len()],
@@ -101,6 +130,38 @@ impl GmmNodes {
         }
     }
 
+    /// The step's wall contacts: every unknown node within one node spacing
+    /// of a wall's contact line (a node moves far less in a step; one that
+    /// starts further off cannot reach the wall, and an open contact costs
+    /// nothing), with its gap (m): its distance to the line, plus how far
+    /// it lies outside the body, less the wall's seeding offset. Every
+    /// wall acts here, gates included only
+    /// while they stand (`Wall::active_at` at the step's start `t`, s).
+    pub fn wall_pairs(&self, model: &Model, dofs: &Dofs, t: f64) -> Vec<ContactPair> {
+        let c = &self.cloud;
+        let reach = c.h;
+        let mut pairs = Vec::new();
+        for n in 0..c.len() {
+            if dofs.id[n] == NO_DOF {
+                continue;
+            }
+            for (k, w) in model.walls.list.iter().enumerate() {
+                if !w.active_at(t) {
+                    continue;
+                }
+                let gap = raw_gap(c, n, w) + self.wall_offset[k];
+                if gap <= reach {
+                    pairs.push(ContactPair {
+                        node: n as u32,
+                        wall: k as u32,
+                        gap,
+                    });
+                }
+            }
+        }
+        pairs
+    }
+
     /// The nodes take the converged step (Algorithm 2, step 3): position
     /// and displacement += Δu, acceleration from Newmark (eq. 44),
     /// velocity by the trapezoid of the accelerations (eq. 43); zero in a
@@ -122,4 +183,11 @@ impl GmmNodes {
             c.a[n] = a;
         }
     }
+}
+
+/// Node `n`'s gap to wall `w`'s line (m): its distance on the material's
+/// side, plus how far it lies outside the body (`Cloud::outside`).
+fn raw_gap(c: &Cloud, n: usize, w: &Wall) -> f64 {
+    let x = c.x[n];
+    (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1] + c.outside[n]
 }

@@ -354,16 +354,15 @@ impl ImplicitBackend {
         Ok(())
     }
 
-    /// The step's wall contacts: every unknown node behind a `slip` or
-    /// `friction` wall (stick walls hold theirs instead).
+    /// The step's wall contacts: every unknown grid node behind a `slip`
+    /// or `friction` wall (stick walls hold theirs instead), at gap 0; or
+    /// the cloud's nodes near any wall (`GmmNodes::wall_pairs`).
     fn build_pairs(&self) -> Vec<ContactPair> {
         let walls = &self.model.walls;
-        let mut pairs = Vec::new();
-        // GMM scenes have no walls (refused by validation): its nodes are
-        // not the grid's, which the walls' masks index.
-        if let Nodes::Cloud(_) = self.nodes {
-            return pairs;
+        if let Nodes::Cloud(c) = &self.nodes {
+            return c.wall_pairs(&self.model, &self.dofs, self.t);
         }
+        let mut pairs = Vec::new();
         for (n, &mask) in walls.mask.iter().enumerate() {
             if mask == 0 || self.dofs.id[n] == NO_DOF {
                 continue;
@@ -373,6 +372,7 @@ impl ImplicitBackend {
                     pairs.push(ContactPair {
                         node: n as u32,
                         wall: k as u32,
+                        gap: 0.0,
                     });
                 }
             }
@@ -584,12 +584,19 @@ impl ImplicitBackend {
                 return Err(AttemptFail::Newton(ratio));
             }
             // The contact states this iteration's Newton step assumes: the
-            // last step's first (Δu = 0 says nothing), then the iterate's,
-            // then held, and revised once their own problem is solved.
+            // last step's first (Δu = 0 says nothing), open for a node off
+            // the wall at the step's start (a GMM cloud node: gap > 0),
+            // then the iterate's, then held, and revised once their own
+            // problem is solved.
             if iter == 0 {
                 self.held.clear();
-                self.held
-                    .extend(self.pairs.iter().map(|p| self.node_states[slot(p)]));
+                self.held.extend(self.pairs.iter().map(|p| {
+                    if p.gap > 0.0 {
+                        ContactState::Open
+                    } else {
+                        self.node_states[slot(p)]
+                    }
+                }));
             } else if iter < FREE_CONTACT_ITERATIONS {
                 self.held.clone_from(&self.natural);
             }
@@ -863,7 +870,8 @@ impl ImplicitBackend {
             }
         }
         for (k, w) in m.walls.list.iter().enumerate() {
-            self.reactions[groups + k] = if w.contact == CONTACT_STICK {
+            let held_nodes = matches!(self.nodes, Nodes::Grid) && w.contact == CONTACT_STICK;
+            self.reactions[groups + k] = if held_nodes {
                 // Stick wall nodes are fixed: minus the residual there.
                 let mut r = [0.0; 2];
                 for &n in &w.nodes {
