@@ -503,13 +503,16 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
             } else {
                 CONTACT_EXCHANGE_TOL
             };
+            let mut g2p = t.g2p;
             if !model.constraints.points.is_empty() {
-                exchange = exchange.max(POINTS_TOL);
+                exchange = exchange.max(POINTS_CONTACT_TOL);
+                g2p = g2p.max(POINTS_CONTACT_G2P_TOL);
             }
             contact_tol = StageTol {
                 grid_predict: t.grid_predict.max(exchange),
                 grid_correct: t.grid_correct.max(exchange),
                 remap: t.remap.max(CONTACT_REMAP_TOL),
+                g2p,
                 ..*t
             };
             &contact_tol
@@ -1492,6 +1495,13 @@ fn stages_match_contact_pairs() {
 /// bspline3 FE), MUSL's remap 1.3e-4, correct 3.7e-5 (force), reactions
 /// 2.5e-5. 1e-3 is 7.7 times the worst.
 const POINTS_TOL: f64 = 1e-3;
+/// The same with contact pairs: each field's nodes carry only their
+/// body's random masses, some of them tiny, so S is worse conditioned.
+/// Measured: predict 6.1e-4 (vy), correct 5.5e-4 (force), reactions
+/// 2.2e-4; g2p's velocity change, from those forces, 3.6e-5. 10 times the
+/// worst, rounded up.
+const POINTS_CONTACT_TOL: f64 = 7e-3;
+const POINTS_CONTACT_G2P_TOL: f64 = 4e-4;
 
 /// SCENE with its base and a left wall two cells inside the grid, where
 /// the body touches them: both hold the body at their edges by points
@@ -1568,7 +1578,7 @@ fn stages_match_constraint_points() {
          [contact.ab]\nbodies = [\"a\", \"b\"]\nlaw = \"friction\"\nfriction = 0.3",
     );
     let m = random_model_of(&pairs, &[], 7);
-    assert_eq!(m.n_fields(), 2);
+    assert!(m.n_fields() >= 2, "{} fields", m.n_fields());
     assert!(!m.constraints.points.is_empty());
     parity_of(
         "points, bspline2 npc, contact pairs",
