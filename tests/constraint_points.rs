@@ -309,3 +309,37 @@ fn gpu_boxes_count_the_freed_nodes() {
     // Region y ≤ 0 on a grid from y = −2: three rows of nodes.
     assert_eq!((b[0].j0, b[0].j1), (0, 2));
 }
+
+/// The GPU marks the nodes a group's points free with a bit per group: a
+/// scene with points and more than 32 groups is refused naming the key
+/// (exit 2), before anything is uploaded.
+#[test]
+fn the_gpu_path_refuses_more_than_32_groups_with_points() {
+    use lme_mpm::gpu::GpuBackend;
+    let mut text = String::from(
+        "[grid]\nh = 1.0\nmin = [-2.0, -2.0]\nmax = [40.0, 12.0]\n\
+         [materials.m]\nmodel = \"linear_elastic\"\ndensity = 1000.0\nE = 1e7\nnu = 0.3\n\
+         [bodies.b]\nmaterial = \"m\"\nrects = [[0.0, 0.0, 36.0, 4.0]]\n\
+         [constraints.base]\nmin = [-inf, -inf]\nmax = [inf, 0.0]\nfix = \"xy\"\n\
+         [solver]\nshape = \"bspline2\"\nt_end = 0.1\n",
+    );
+    // 32 pins (node lines inside the body: no points of their own).
+    for k in 0..32 {
+        text.push_str(&format!(
+            "[constraints.pin{k:02}]\nmin = [{x}.0, 1.0]\nmax = [{x}.0, 2.0]\nfix = \"x\"\n",
+            x = k + 2
+        ));
+    }
+    let scene = lme_mpm::scene::Scene::from_str(&text, "33 groups", "groups", &[]).unwrap();
+    let m = Model::new(&scene).unwrap();
+    assert_eq!(m.constraints.groups.len(), 33);
+    assert!(!m.constraints.points.is_empty());
+    let Some(ctx) = common::gpu::open("33 groups", false) else {
+        return;
+    };
+    let Err(e) = GpuBackend::new(ctx, m) else {
+        panic!("the GPU path took 33 groups with points");
+    };
+    assert_eq!(e.exit_code(), 2, "{e}");
+    assert!(e.to_string().contains("constraints"), "{e}");
+}
