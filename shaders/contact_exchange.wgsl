@@ -14,6 +14,9 @@
 #include "shared/contact.wgsl"
 
 @group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
+#if CONSTRAINT_POINTS
+#include "shared/point_freed.wgsl"
+#endif
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
 @group(0) @binding({{B_CONTACT_PAIRS}}) var<storage, read> contact_pairs: array<ContactPair>;
 @group(0) @binding({{B_CONTACT_NORMAL}}) var<storage, read> contact_normal_in: array<f32>;
@@ -28,6 +31,11 @@ fn node_fixed(i: u32, j: u32) -> bool {
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
         if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 && c.fix != 0u {
+#if CONSTRAINT_POINTS
+            if freed(g, i, j) {
+                continue;
+            }
+#endif
             return true;
         }
     }

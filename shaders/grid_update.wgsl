@@ -8,6 +8,9 @@
 // With LOCAL_DAMPING, before the update each force component of a node
 // with mass (the walls' forces included) loses α |f_i| sign(v_i), v the
 // predicted nodal velocity (Cundall).
+// With CONSTRAINT_POINTS a group leaves out the region nodes its points
+// freed (`constraint_points.wgsl` holds the body there instead, after
+// each entry point).
 // With CONTACT, one invocation per node of every field (the constraints
 // act on each field's copy of their nodes); `contact_exchange.wgsl`
 // follows each entry point.
@@ -15,6 +18,9 @@
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
+#if CONSTRAINT_POINTS
+#include "shared/point_freed.wgsl"
+#endif
 #if CORRECT
 #if WALLS
 @group(0) @binding({{B_WALL_FORCE}}) var<storage, read> wall_force: array<f32>;
@@ -32,6 +38,11 @@ fn fix_bits(i: u32, j: u32) -> u32 {
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
         if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+#if CONSTRAINT_POINTS
+            if freed(g, i, j) {
+                continue;
+            }
+#endif
             f |= c.fix;
         }
     }
@@ -46,6 +57,11 @@ fn prescribe(i: u32, j: u32, v_in: vec2<f32>, t: f32) -> vec2<f32> {
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
         if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+#if CONSTRAINT_POINTS
+            if freed(g, i, j) {
+                continue;
+            }
+#endif
             var r = 1.0;
             if c.ramp_time > 0.0 {
                 r = clamp(t / c.ramp_time, 0.0, 1.0);
@@ -88,6 +104,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
         if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+#if CONSTRAINT_POINTS
+            if freed(g, i, j) {
+                continue;
+            }
+#endif
             if (c.fix & 1u) != 0u && f.x != 0.0 {
                 reaction_add(2u * g, -f.x);
             }

@@ -92,28 +92,6 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         };
     }
-    if let Some(key) = points_key(&model) {
-        // The GPU twin of the constraint points is not written yet.
-        return match spec.choice() {
-            BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
-                key,
-                "has its edge inside the grid where the shape's nodes beyond it reach the body \
-                 (constraint points, docs/methods.md): such constraints run on the CPU path only \
-                 for now: use --backend cpu or auto, or put the grid's edge on the region's",
-            )
-            .into()),
-            _ => {
-                let b = CpuBackend::new(model);
-                if spec.verbose && spec.choice() == BackendChoice::Auto {
-                    crate::say!(
-                        "backend: {} (auto: constraint points run on the CPU only)",
-                        b.name()
-                    );
-                }
-                Ok(Box::new(b))
-            }
-        };
-    }
     match spec.choice() {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
         BackendChoice::Gpu => {
@@ -147,16 +125,6 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         },
     }
-}
-
-/// `constraints.NAME` of the first group that holds points, if any.
-pub fn points_key(model: &Model) -> Option<String> {
-    model.constraints.points.first().map(|p| {
-        format!(
-            "constraints.{}",
-            model.constraints.groups[p.group as usize].name
-        )
-    })
 }
 
 /// A scene on a backend.

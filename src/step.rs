@@ -166,6 +166,14 @@ pub enum Pass {
     ContactDetect,
     ContactExchange,
     ContactExchangeForce,
+    /// Constraint points only (`cpu::constraint_points::hold`): the
+    /// projection that holds the points at their group's velocity
+    /// (constraint_points.wgsl), right after each `GridPredict` pass, and
+    /// as forces with the groups' reactions right after `GridCorrect`
+    /// (`ConstraintPointsForce`, built with CORRECT): before the contact
+    /// exchange, as on the CPU.
+    ConstraintPoints,
+    ConstraintPointsForce,
     G2p,
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
     /// then scatter the new velocities from particles (`Remap`) or Gauss
@@ -180,7 +188,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 38] = [
+    pub const ALL: [Pass; 40] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -212,6 +220,8 @@ impl Pass {
         Pass::ContactDetect,
         Pass::ContactExchange,
         Pass::ContactExchangeForce,
+        Pass::ConstraintPoints,
+        Pass::ConstraintPointsForce,
         Pass::G2p,
         Pass::RemapClear,
         Pass::Remap,
@@ -235,6 +245,7 @@ impl Pass {
             Pass::ContactGrad => "contact_grad.wgsl",
             Pass::ContactDetect => "contact_detect.wgsl",
             Pass::ContactExchange | Pass::ContactExchangeForce => "contact_exchange.wgsl",
+            Pass::ConstraintPoints | Pass::ConstraintPointsForce => "constraint_points.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
             Pass::G2p => "g2p.wgsl",
@@ -282,6 +293,10 @@ pub struct PlanInputs {
     /// the GPU `shape_eval` bins the particles (for the gaps) and
     /// `GridPredict`, `GridCorrect` and `Remap` add the contact passes.
     pub contact: bool,
+    /// Constraint points (`model::constraint_points`): the GPU adds the
+    /// points' projection after every `GridPredict` and `GridCorrect`
+    /// pass (the CPU's `grid_update` stages call it themselves).
+    pub points: bool,
 }
 
 /// The step of one scene, for both backends.
@@ -315,6 +330,7 @@ impl StepPlan {
             patch,
             walls: !model.walls.is_empty(),
             contact: model.contact.is_some(),
+            points: !model.constraints.points.is_empty(),
         })
     }
 
@@ -349,7 +365,7 @@ impl StepPlan {
         let fuse_gpu = fuse_stress && !gather;
         plan.gpu_step = stages
             .iter()
-            .flat_map(|&s| plan.passes_for(s).iter().copied())
+            .flat_map(|&s| plan.passes_for(s))
             .filter_map(|pass| match pass {
                 Pass::Stress if fuse_gpu && inputs.patch => Some(Pass::StressForcesPatch),
                 Pass::Stress if fuse_gpu => Some(Pass::StressForces),
@@ -361,12 +377,30 @@ impl StepPlan {
         plan
     }
 
-    /// The GPU passes that do `stage` on its own. `Cfl` is the reduction
+    /// The GPU passes that do `stage` on its own (`stage_passes`, and with
+    /// constraint points their projection after each grid update).
+    pub fn passes_for(&self, stage: Stage) -> Vec<Pass> {
+        let passes = self.stage_passes(stage);
+        if !self.inputs.points {
+            return passes.to_vec();
+        }
+        passes
+            .iter()
+            .flat_map(|&p| match p {
+                Pass::GridPredict => vec![p, Pass::ConstraintPoints],
+                Pass::GridCorrect => vec![p, Pass::ConstraintPointsForce],
+                p => vec![p],
+            })
+            .collect()
+    }
+
+    /// The GPU passes that do `stage` on its own, constraint points aside.
+    /// `Cfl` is the reduction
     /// plus the one-invocation Δt/stop pass; shape evaluation is LME's
     /// Newton solve and, for the gather and per-bin passes, the binning
     /// (the weights themselves are evaluated inline where used). With MLS,
     /// `p2g` and `forces` work at Gauss points.
-    pub fn passes_for(&self, stage: Stage) -> &'static [Pass] {
+    fn stage_passes(&self, stage: Stage) -> &'static [Pass] {
         let PlanInputs {
             lme,
             mls,
@@ -376,6 +410,7 @@ impl StepPlan {
             patch,
             walls,
             contact,
+            points: _,
         } = self.inputs;
         let binned = gather || patch || contact;
         match stage {
@@ -490,6 +525,7 @@ mod tests {
             patch,
             walls: lme,
             contact: false,
+            points: false,
         })
     }
 
@@ -528,6 +564,7 @@ mod tests {
                 patch: false,
                 walls: false,
                 contact: false,
+                points: false,
             });
             assert_eq!(p.cpu[2], CpuWork::ShapeEvalP2g);
             assert!(!p.cpu.contains(&CpuWork::StressForces));
@@ -601,6 +638,7 @@ mod tests {
                     patch: false,
                     walls,
                     contact: false,
+                    points: false,
                 };
                 let without = StepPlan::new(base);
                 let with = StepPlan::new(PlanInputs {
@@ -630,6 +668,57 @@ mod tests {
                     .collect();
                 assert_eq!(stripped, without.gpu_step);
             }
+        }
+    }
+    /// Constraint points add their projection right after each grid
+    /// update on the GPU (after `GridPredict`, MUSL's remap included, and
+    /// after `GridCorrect`), before the contact exchange as on the CPU;
+    /// without points the step is the same, pass for pass.
+    #[test]
+    fn constraint_points_add_their_passes_only_with_points() {
+        for bits in 0..16u32 {
+            let b = |i: u32| bits & 1 << i != 0;
+            let base = PlanInputs {
+                lme: b(0),
+                mls: false,
+                mls_force: false,
+                musl: b(1),
+                gather: false,
+                patch: false,
+                walls: b(2),
+                contact: b(3),
+                points: false,
+            };
+            let without = StepPlan::new(base);
+            let with = StepPlan::new(PlanInputs {
+                points: true,
+                ..base
+            });
+            for pass in [Pass::ConstraintPoints, Pass::ConstraintPointsForce] {
+                assert!(!without.gpu_uses(pass), "{bits:04b} {pass:?}");
+                assert!(with.gpu_uses(pass), "{bits:04b} {pass:?}");
+            }
+            for (k, p) in with.gpu_step.iter().enumerate() {
+                let next = with.gpu_step.get(k + 1);
+                match p {
+                    Pass::GridPredict => assert_eq!(next, Some(&Pass::ConstraintPoints)),
+                    Pass::GridCorrect => assert_eq!(next, Some(&Pass::ConstraintPointsForce)),
+                    _ => {}
+                }
+            }
+            let predicts =
+                |p: &StepPlan, pass: Pass| p.gpu_step.iter().filter(|x| **x == pass).count();
+            assert_eq!(
+                predicts(&with, Pass::ConstraintPoints),
+                predicts(&without, Pass::GridPredict)
+            );
+            let stripped: Vec<Pass> = with
+                .gpu_step
+                .iter()
+                .copied()
+                .filter(|p| !matches!(p, Pass::ConstraintPoints | Pass::ConstraintPointsForce))
+                .collect();
+            assert_eq!(stripped, without.gpu_step, "{bits:04b}");
         }
     }
 }

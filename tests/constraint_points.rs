@@ -4,7 +4,8 @@
 //! 0.0067806 m) clamped at x = 0, with the grid's edge on the clamp and
 //! with the grid two cells beyond it (implicit, static); an explicit
 //! column on a base two cells inside a B-spline grid against the same
-//! column on the grid's edge; the held velocity at the points themselves.
+//! column on the grid's edge, on the CPU and on the GPU; the held velocity
+//! at the points themselves.
 
 mod common;
 
@@ -236,20 +237,109 @@ fn the_projection_holds_every_point_and_its_force_is_the_reaction() {
     }
 }
 
-#[test]
-fn the_gpu_path_refuses_constraint_points_naming_the_constraint() {
-    use lme_mpm::simulation::{BackendChoice, BackendSpec, Simulation};
-    let s = common::scene(
-        "cantilever.toml",
+/// `column_top` on the GPU backend, or None without an adapter.
+fn column_top_gpu(shape: &str, y0: f64) -> Option<f64> {
+    use lme_mpm::gpu::GpuBackend;
+    use lme_mpm::simulation::Simulation;
+    use lme_mpm::solver::{Recorder, Schedule};
+    let ctx = common::gpu::open(shape, false)?;
+    let scene = common::scene(
+        "elastic_block.toml",
         &[
-            "solver.integrator=npc",
-            "solver.static=false",
-            "grid.min=[-0.5, -1.5]",
-            "grid.max=[9.5, 2.5]",
+            &format!("solver.shape={shape}"),
+            "grid.h=1.0",
+            &format!("grid.min=[-2.0, {y0}]"),
+            "grid.max=[12.0, 12.0]",
         ],
     );
-    let Err(e) = Simulation::new(&s, &BackendSpec::new(BackendChoice::Gpu)) else {
-        panic!("the GPU path took a scene with constraint points");
+    let model = Model::new(&scene).unwrap();
+    let mut sim = Simulation::with_backend(&scene, Box::new(GpuBackend::new(ctx, model).unwrap()));
+    let schedule = Schedule {
+        vtk_interval: None,
+        ..sim.schedule()
     };
-    assert!(e.to_string().contains("constraints.clamp"), "{e}");
+    let status = sim.drive_with(schedule, &mut Recorder::default()).unwrap();
+    assert_eq!(status, RunStatus::Completed, "{shape} y0 = {y0} (GPU)");
+    match sim.score().unwrap() {
+        Some(Errors::Column(e)) => Some(e.settlement_top),
+        other => panic!("not a column score: {other:?}"),
+    }
+}
+
+/// The same acceptance through the GPU backend (f32, the points'
+/// projection in `constraint_points.wgsl`), against the same bound.
+/// Measured on llvmpipe: see the test's output.
+#[test]
+fn explicit_base_inside_the_grid_holds_like_the_grid_edge_on_the_gpu() {
+    for shape in ["bspline2", "bspline3"] {
+        let Some(edge) = column_top_gpu(shape, 0.0) else {
+            return;
+        };
+        let beyond = column_top_gpu(shape, -2.0).expect("the adapter opened once");
+        let rel = (beyond - edge) / edge;
+        println!(
+            "{shape:>8} (GPU): top settlement {edge:.6} m (grid edge on the base), {beyond:.6} m \
+             (two cells beyond), {:+.3} %",
+            100.0 * rel
+        );
+        assert!(rel.abs() < BASE_REL, "{shape} (GPU): {:+.3} %", 100.0 * rel);
+    }
+}
+
+/// On the GPU a constraint group is its region's box of nodes less the
+/// nodes its points freed: the box is whole again with them.
+#[test]
+fn gpu_boxes_count_the_freed_nodes() {
+    use lme_mpm::gpu::buffers::constraint_boxes;
+    let s = common::scene(
+        "elastic_block.toml",
+        &[
+            "solver.shape=bspline3",
+            "grid.h=1.0",
+            "grid.min=[-2.0, -2.0]",
+            "grid.max=[12.0, 12.0]",
+        ],
+    );
+    let m = Model::new(&s).unwrap();
+    let c = &m.constraints;
+    assert!(!c.points.is_empty() && !c.freed[0].is_empty());
+    let b = constraint_boxes(&m).unwrap();
+    let area = ((b[0].i1 - b[0].i0 + 1) * (b[0].j1 - b[0].j0 + 1)) as usize;
+    assert_eq!(area, c.groups[0].nodes.len() + c.freed[0].len());
+    // Region y ≤ 0 on a grid from y = −2: three rows of nodes.
+    assert_eq!((b[0].j0, b[0].j1), (0, 2));
+}
+
+/// The GPU marks the nodes a group's points free with a bit per group: a
+/// scene with points and more than 32 groups is refused naming the key
+/// (exit 2), before anything is uploaded.
+#[test]
+fn the_gpu_path_refuses_more_than_32_groups_with_points() {
+    use lme_mpm::gpu::GpuBackend;
+    let mut text = String::from(
+        "[grid]\nh = 1.0\nmin = [-2.0, -2.0]\nmax = [40.0, 12.0]\n\
+         [materials.m]\nmodel = \"linear_elastic\"\ndensity = 1000.0\nE = 1e7\nnu = 0.3\n\
+         [bodies.b]\nmaterial = \"m\"\nrects = [[0.0, 0.0, 36.0, 4.0]]\n\
+         [constraints.base]\nmin = [-inf, -inf]\nmax = [inf, 0.0]\nfix = \"xy\"\n\
+         [solver]\nshape = \"bspline2\"\nt_end = 0.1\n",
+    );
+    // 32 pins (node lines inside the body: no points of their own).
+    for k in 0..32 {
+        text.push_str(&format!(
+            "[constraints.pin{k:02}]\nmin = [{x}.0, 1.0]\nmax = [{x}.0, 2.0]\nfix = \"x\"\n",
+            x = k + 2
+        ));
+    }
+    let scene = lme_mpm::scene::Scene::from_str(&text, "33 groups", "groups", &[]).unwrap();
+    let m = Model::new(&scene).unwrap();
+    assert_eq!(m.constraints.groups.len(), 33);
+    assert!(!m.constraints.points.is_empty());
+    let Some(ctx) = common::gpu::open("33 groups", false) else {
+        return;
+    };
+    let Err(e) = GpuBackend::new(ctx, m) else {
+        panic!("the GPU path took 33 groups with points");
+    };
+    assert_eq!(e.exit_code(), 2, "{e}");
+    assert!(e.to_string().contains("constraints"), "{e}");
 }

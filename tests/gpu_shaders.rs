@@ -2,6 +2,7 @@
 //! pass expands and validates with naga in every variant a scene can ask
 //! for, and every struct shared with Rust has the same layout on both sides.
 
+use lme_mpm::gpu::constraint_points::PointCounts;
 use lme_mpm::gpu::context::AtomicMode;
 use lme_mpm::gpu::layout::{GpuConstraint, GpuContactPair, GpuMaterial, GpuWall, Params, Sim};
 use lme_mpm::gpu::pipelines::{self, Pass, Variant};
@@ -166,6 +167,7 @@ fn variants() -> Vec<Variant> {
                                                             | ShapeKind::Bspline3
                                                     )),
                                         contact: None,
+                                        points: None,
                                     });
                                 }
                             }
@@ -188,6 +190,34 @@ fn variants() -> Vec<Variant> {
         })
         .collect();
     out.extend(contact);
+    // Constraint points on every shape, integrator and grid without MLS
+    // (linear elastic, one atomic mode), and with contact pairs (two lanes
+    // per field).
+    let points = PointCounts {
+        n_points: 22,
+        slots: 9,
+        n_held: 40,
+        n_list: 180,
+        env: 120,
+        n_fields: 1,
+    };
+    let with_points: Vec<Variant> = out
+        .iter()
+        .filter(|v| {
+            !v.mls
+                && v.atomics == AtomicMode::CompareExchange
+                && !v.lme_stored
+                && (v.contact.is_some() || v.materials == 1)
+        })
+        .map(|v| Variant {
+            points: Some(PointCounts {
+                n_fields: v.contact.map_or(1, |[f, _]| f),
+                ..points
+            }),
+            ..*v
+        })
+        .collect();
+    out.extend(with_points);
     out
 }
 
@@ -282,6 +312,13 @@ fn every_pass_validates_in_every_variant() {
                     has(Buf::WallTouch),
                     "{pass:?} {v:?}: contact weights unread"
                 );
+            }
+            assert!(
+                !(has(Buf::PointTable) || has(Buf::PointWork)) || v.points.is_some(),
+                "{pass:?} {v:?}: constraint points' tables without points"
+            );
+            if v.points.is_some() && matches!(pass, Pass::GridPredict | Pass::GridCorrect) {
+                assert!(has(Buf::PointTable), "{pass:?} {v:?}: freed nodes unread");
             }
             if v.ext_force && matches!(pass, Pass::Forces | Pass::ForcesGather) {
                 assert!(has(Buf::ExtForce), "{pass:?} {v:?}: loads unread");
@@ -414,8 +451,9 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
     };
     let walls = all.iter().find(|v| v.walls).unwrap();
     let contact = all.iter().find(|v| v.contact.is_some()).unwrap();
+    let points = all.iter().find(|v| v.points.is_some()).unwrap();
     let mut out = Vec::new();
-    for v in [mls, lme, musl(true), musl(false), walls, contact] {
+    for v in [mls, lme, musl(true), musl(false), walls, contact, points] {
         let d = v.defines();
         for pass in Pass::ALL {
             if v.plan().gpu_uses(pass) {
@@ -521,6 +559,8 @@ fn workgroup_sizes_match_the_dispatch() {
     for (pass, m) in every_pass_module() {
         let want = match pass {
             Pass::StepBegin | Pass::StepEnd => 1,
+            // One invocation per lane (field × component), a workgroup each.
+            Pass::ConstraintPoints | Pass::ConstraintPointsForce => 1,
             Pass::Probes => PROBES_WG,
             _ => WG,
         };

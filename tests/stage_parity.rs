@@ -481,20 +481,38 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
     let lme = matches!(model.shape, lme_mpm::model::shape::Shape::Lme(_));
     let family = Family::of(&model);
     let contact_tol;
+    let points_tol;
     let tol = match &model.contact {
+        // The points' projection solves a system in f32 (`POINTS_TOL`).
+        None if !model.constraints.points.is_empty() => {
+            let t = family.tolerances();
+            points_tol = StageTol {
+                grid_predict: t.grid_predict.max(POINTS_TOL),
+                grid_correct: t.grid_correct.max(POINTS_TOL),
+                remap: t.remap.max(POINTS_TOL),
+                ..*t
+            };
+            &points_tol
+        }
         // The exchange moves velocities along the contact normals, which
         // carry their own f32 error (`CONTACT_NORMAL_TOL`).
         Some(_) => {
             let t = family.tolerances();
-            let exchange = if family == Family::Lme {
+            let mut exchange = if family == Family::Lme {
                 CONTACT_EXCHANGE_TOL_LME
             } else {
                 CONTACT_EXCHANGE_TOL
             };
+            let mut g2p = t.g2p;
+            if !model.constraints.points.is_empty() {
+                exchange = exchange.max(POINTS_CONTACT_TOL);
+                g2p = g2p.max(POINTS_CONTACT_G2P_TOL);
+            }
             contact_tol = StageTol {
                 grid_predict: t.grid_predict.max(exchange),
                 grid_correct: t.grid_correct.max(exchange),
                 remap: t.remap.max(CONTACT_REMAP_TOL),
+                g2p,
                 ..*t
             };
             &contact_tol
@@ -522,13 +540,13 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
             // GPU LME passes read (λ, log Z, J⁻¹) from lme_newton, warm-started
             // from the CPU's λ; gather passes read the particles' cell bins.
             for pass in gpu.stage_passes(Stage::ShapeEval) {
-                gpu.run_pass(*pass);
+                gpu.run_pass(pass);
             }
         }
         cpu.run_stage(stage)
             .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
         for pass in gpu.stage_passes(stage) {
-            gpu.run_pass(*pass);
+            gpu.run_pass(pass);
         }
         let sim = gpu.read_sim().unwrap();
         assert_eq!(
@@ -1465,4 +1483,108 @@ fn stages_match_contact_pairs() {
         assert_eq!(m.n_fields(), 4, "{label}");
         parity_of(label, m, cas, GpuOptions::default(), 0.0);
     }
+}
+
+/// The constraint points' projection (`constraint_points.wgsl`) against
+/// the CPU's, relative to the largest velocity (or its change, force and
+/// reaction in `correct`): an f32 solve of C M⁻¹ Cᵀ λ = v̄ − C v, whose
+/// small eigenvalues (two points per cell, nodes of random mass) make the
+/// smallest-norm change sensitive to the f32 inputs themselves, whichever
+/// precision solves it afterwards. Measured on llvmpipe
+/// (`stages_match_constraint_points`): predict 6.6e-5 (bspline2 NPC; 2.7e-6
+/// bspline3 FE), MUSL's remap 1.3e-4, correct 3.7e-5 (force), reactions
+/// 2.5e-5. 1e-3 is 7.7 times the worst.
+const POINTS_TOL: f64 = 1e-3;
+/// The same with contact pairs: each field's nodes carry only their
+/// body's random masses, some of them tiny, so S is worse conditioned.
+/// Measured: predict 6.1e-4 (vy), correct 5.5e-4 (force), reactions
+/// 2.2e-4; g2p's velocity change, from those forces, 3.6e-5. 10 times the
+/// worst, rounded up.
+const POINTS_CONTACT_TOL: f64 = 7e-3;
+const POINTS_CONTACT_G2P_TOL: f64 = 4e-4;
+
+/// SCENE with its base and a left wall two cells inside the grid, where
+/// the body touches them: both hold the body at their edges by points
+/// (two groups sharing nodes at the corner), the base with a ramped
+/// prescribed velocity. The groups hold different components, so the
+/// points' targets agree where they share nodes: with a moving group and
+/// a fixed one holding the same component at the corner the system is
+/// inconsistent there, λ grows as 1/ε along S's null space, and the f32
+/// twin's Δv loses digits to the cancellation (5e-3 of the largest
+/// velocity, measured; the CPU's f64 keeps ~1e-6).
+const POINTS_SCENE: &str = r#"
+[grid]
+h = 0.5
+min = [-0.5, -1.0]
+max = [4.0, 3.0]
+[materials.m]
+model = "linear_elastic"
+density = 1000.0
+E = 1e7
+nu = 0.3
+[bodies.b]
+material = "m"
+rects = [[0.5, 0.0, 3.5, 2.5]]
+[constraints.base]
+min = [-inf, -inf]
+max = [inf, 0.0]
+fix = "y"
+velocity = [0.0, -0.2]
+ramp_time = 2.0
+[constraints.left]
+min = [-inf, -inf]
+max = [0.5, inf]
+fix = "x"
+[gravity]
+g = [0.0, -9.81]
+[solver]
+shape = "bspline2"
+t_end = 1.0
+"#;
+
+/// Constraint points (issue 23): `GridPredict` is the nodal rule then the
+/// projection, `GridCorrect` the corrector then the projection as forces
+/// with the groups' reactions, MUSL's remap ends with the projection; the
+/// velocities after it, the forces and the reactions against the CPU's.
+#[test]
+fn stages_match_constraint_points() {
+    for (label, sets, cas) in [
+        ("points, bspline2 npc", &[][..], false),
+        (
+            "points, bspline3 fe, CAS atomics",
+            &["solver.shape=bspline3", "solver.integrator=fe"][..],
+            true,
+        ),
+        (
+            "points, bspline2 musl",
+            &["solver.integrator=musl"][..],
+            false,
+        ),
+    ] {
+        let m = random_model_of(POINTS_SCENE, sets, 7);
+        let groups: std::collections::BTreeSet<u32> =
+            m.constraints.points.iter().map(|p| p.group).collect();
+        assert_eq!(groups.len(), 2, "{label}: both groups hold points");
+        println!("{label}: {} points", m.constraints.points.len());
+        parity_of(label, m, cas, GpuOptions::default(), 0.5);
+    }
+    // With contact pairs: the body cut in two bodies in frictional
+    // contact, each field held at the points on its own (two lanes per
+    // field on the GPU), before the exchange.
+    let pairs = POINTS_SCENE.replace(
+        "[bodies.b]\nmaterial = \"m\"\nrects = [[0.5, 0.0, 3.5, 2.5]]",
+        "[bodies.a]\nmaterial = \"m\"\nrects = [[0.5, 0.0, 2.0, 2.5]]\n\
+         [bodies.b]\nmaterial = \"m\"\nrects = [[2.0, 0.0, 3.5, 2.5]]\n\
+         [contact.ab]\nbodies = [\"a\", \"b\"]\nlaw = \"friction\"\nfriction = 0.3",
+    );
+    let m = random_model_of(&pairs, &[], 7);
+    assert!(m.n_fields() >= 2, "{} fields", m.n_fields());
+    assert!(!m.constraints.points.is_empty());
+    parity_of(
+        "points, bspline2 npc, contact pairs",
+        m,
+        false,
+        GpuOptions::default(),
+        0.5,
+    );
 }

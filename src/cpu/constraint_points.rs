@@ -11,8 +11,8 @@
 //! regularised by `HOLD_REG` because two points per cell can be more than
 //! the nodes they hold). In `correct` the change is a force, m Δv / (γΔt),
 //! added to f_I (so the particles' FLIP update feels it) and to the
-//! group's reaction. No GPU twin yet: the GPU path refuses such scenes
-//! (`simulation::open_backend`).
+//! group's reaction. GPU twin: `shaders/constraint_points.wgsl` (its
+//! tables: `gpu::constraint_points`).
 
 use crate::model::{ConstraintGroup, ConstraintPoint, FIX_X, FIX_Y};
 

@@ -94,10 +94,17 @@ pub enum Buf {
     /// Contact pairs only: per pair and grid node, [n_x, n_y, gap]
     /// (contact_detect.wgsl; n zero where the pair is not in contact).
     ContactNormal,
+    /// Constraint points only: their tables (u32; `gpu::constraint_points`),
+    /// the last of which, per grid node the groups that freed it, is read
+    /// by `grid_update` and `contact_exchange` too.
+    PointTable,
+    /// Constraint points only: per field and component, the projection's
+    /// scratch (f32; `PointCounts::work_stride` each).
+    PointWork,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 46] = [
+    pub const ALL: [Buf; 48] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -144,6 +151,8 @@ impl Buf {
         Buf::ContactGrad,
         Buf::ContactSlack,
         Buf::ContactNormal,
+        Buf::PointTable,
+        Buf::PointWork,
     ];
 
     pub fn binding(self) -> u32 {
@@ -457,6 +466,13 @@ fn grid_and_output_data(
             vec![0u8; 12 * c.pairs.len() * g.n_nodes()],
         ));
     }
+    if let Some((counts, table)) = super::constraint_points::tables(model) {
+        data.push((Buf::PointTable, bytemuck::cast_slice(&table).to_vec()));
+        data.push((
+            Buf::PointWork,
+            vec![0u8; 4 * (counts.lanes() * counts.work_stride()) as usize],
+        ));
+    }
     if bins {
         let cells = (g.nx - 1) * (g.ny - 1);
         data.push((Buf::CellCount, vec![0u8; 4 * cells]));
@@ -539,36 +555,40 @@ pub fn initial_sim() -> Sim {
 
 /// Constraint groups as lattice index boxes (membership is decided on the
 /// unperturbed lattice, exactly as `model::build_constraints` does). The
-/// GPU fixes every node of the box, so a group whose nodes do not fill their
-/// bounding box exactly (not one a scene's `[constraints.*]` rectangle can
-/// select) is refused here rather than fixing nodes the CPU leaves free.
+/// GPU fixes every node of the box, less those the group's constraint
+/// points freed (`Constraints::freed`, marked in `Buf::PointTable`), so a
+/// group whose nodes and freed nodes do not fill their bounding box
+/// exactly (not one a scene's `[constraints.*]` rectangle can select) is
+/// refused here rather than fixing nodes the CPU leaves free.
 pub fn constraint_boxes(model: &Model) -> Result<Vec<GpuConstraint>> {
     let g = &model.grid;
     let mut out = Vec::new();
-    for grp in &model.constraints.groups {
+    for (k, grp) in model.constraints.groups.iter().enumerate() {
+        let freed = model.constraints.freed.get(k).map_or(&[][..], |f| &f[..]);
+        let nodes: Vec<u32> = grp.nodes.iter().chain(freed).copied().collect();
         let (mut i0, mut i1, mut j0, mut j1) = (u32::MAX, 0, u32::MAX, 0);
-        for &n in &grp.nodes {
+        for &n in &nodes {
             let (i, j) = (n % g.nx as u32, n / g.nx as u32);
             i0 = i0.min(i);
             i1 = i1.max(i);
             j0 = j0.min(j);
             j1 = j1.max(j);
         }
-        let mut distinct = grp.nodes.clone();
+        let mut distinct = nodes.clone();
         distinct.sort_unstable();
         distinct.dedup();
-        let area = if grp.nodes.is_empty() {
+        let area = if nodes.is_empty() {
             0
         } else {
             (i1 - i0 + 1) as usize * (j1 - j0 + 1) as usize
         };
-        if area == 0 || distinct.len() != area || grp.nodes.len() != area {
+        if area == 0 || distinct.len() != area || nodes.len() != area {
             return Err(Error::Scene(SceneError::invalid(
                 format!("constraints.{}", grp.name),
                 format!(
                     "its {} nodes do not form a box of the lattice (the bounding box holds {area}); \
                      the GPU path needs a rectangle of nodes",
-                    grp.nodes.len()
+                    nodes.len()
                 ),
             )));
         }

@@ -7,6 +7,7 @@
 //! `preprocess`), `layout` defines the structs shared with WGSL.
 
 pub mod buffers;
+pub mod constraint_points;
 pub mod context;
 pub mod layout;
 pub mod options;
@@ -70,14 +71,15 @@ impl GpuBackend {
             )
             .into());
         }
-        if let Some(p) = model.constraints.points.first() {
+        // The points' tables mark freed nodes with a bit per group.
+        if !model.constraints.points.is_empty() && model.constraints.groups.len() > 32 {
             return Err(crate::error::SceneError::invalid(
+                "constraints",
                 format!(
-                    "constraints.{}",
-                    model.constraints.groups[p.group as usize].name
+                    "{} groups with constraint points: the GPU path marks the nodes they free \
+                     with a bit per group, 32 at most (use --backend cpu, or fewer groups)",
+                    model.constraints.groups.len()
                 ),
-                "holds constraint points, which run on the CPU path only for now (--backend cpu \
-                 or auto)",
             )
             .into());
         }
@@ -125,7 +127,7 @@ impl GpuBackend {
     }
 
     /// The passes of one stage (`StepPlan::passes_for` for this scene).
-    pub fn stage_passes(&self, stage: crate::step::Stage) -> &'static [Pass] {
+    pub fn stage_passes(&self, stage: crate::step::Stage) -> Vec<Pass> {
         self.pipelines.plan.passes_for(stage)
     }
 

@@ -4,6 +4,7 @@
 //! bindings it declares, so no binding number is repeated at a call site.
 
 use super::buffers::{Buf, Buffers};
+use super::constraint_points::PointCounts;
 use super::context::{AtomicMode, GpuContext};
 use super::layout::{PROBES_WG, WG};
 use super::preprocess::{self, Defines};
@@ -30,6 +31,9 @@ enum Domain {
     PairNodes,
     /// Gauss points (MLS).
     GaussPoints,
+    /// One workgroup of one invocation per field and component
+    /// (constraint_points.wgsl).
+    PointLanes,
 }
 
 /// What `pass`'s invocations run over.
@@ -53,6 +57,7 @@ fn domain(pass: Pass) -> Domain {
         | Pass::ForcesGather => Domain::Nodes,
         Pass::ContactExchange | Pass::ContactExchangeForce => Domain::Nodes,
         Pass::ContactDetect => Domain::PairNodes,
+        Pass::ConstraintPoints | Pass::ConstraintPointsForce => Domain::PointLanes,
         Pass::Probes => Domain::Probes,
         _ => Domain::Particles,
     }
@@ -120,6 +125,9 @@ pub struct Variant {
     /// Contact pairs (CONTACT): [fields, pairs] (`model::contact`); the
     /// nodal buffers hold one copy of the nodes per field.
     pub contact: Option<[u32; 2]>,
+    /// Constraint points (CONSTRAINT_POINTS): their tables' counts
+    /// (`gpu::constraint_points`).
+    pub points: Option<PointCounts>,
 }
 
 impl Variant {
@@ -153,6 +161,7 @@ impl Variant {
                 .contact
                 .as_ref()
                 .map(|c| [c.n_fields as u32, c.pairs.len() as u32]),
+            points: super::constraint_points::tables(model).map(|(c, _)| c),
             bspline_small_grid: match &model.shape {
                 Shape::Bspline(b) => {
                     !(crate::model::shape::bspline::table_fits(model.grid.nx, b.degree)
@@ -174,6 +183,7 @@ impl Variant {
             patch: self.patch,
             walls: self.walls,
             contact: self.contact.is_some(),
+            points: self.points.is_some(),
         })
     }
 
@@ -211,6 +221,7 @@ impl Variant {
                 self.gather || self.patch || self.contact.is_some(),
             )
             .flag("CONTACT", self.contact.is_some())
+            .flag("CONSTRAINT_POINTS", self.points.is_some())
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
@@ -235,6 +246,19 @@ impl Variant {
         d.value("LME_SIDE", self.lme_side);
         if let Some([fields, pairs]) = self.contact {
             d.value("N_FIELDS", fields).value("N_PAIRS", pairs);
+        }
+        if let Some(c) = self.points {
+            d.value("POINT_COUNT", c.n_points)
+                .value("POINT_SLOTS", c.slots)
+                .value("POINT_HELD", c.n_held)
+                .value("POINT_SLOTS_AT", c.slots_at())
+                .value("POINT_WEIGHTS_AT", c.weights_at())
+                .value("POINT_HELD_AT", c.held_at())
+                .value("POINT_LIST_AT", c.list_at())
+                .value("POINT_FREED_AT", c.freed_at())
+                .value("POINT_ENV", c.env)
+                .value("POINT_WORK_STRIDE", c.work_stride())
+                .value("POINT_FIELDS", c.n_fields);
         }
         d.value(
             "BSPLINE_DEGREE",
@@ -282,7 +306,10 @@ pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
     )
     .flag(
         "CORRECT",
-        matches!(pass, Pass::GridCorrect | Pass::ContactExchangeForce),
+        matches!(
+            pass,
+            Pass::GridCorrect | Pass::ContactExchangeForce | Pass::ConstraintPointsForce
+        ),
     )
     .flag(
         "PATCH",
@@ -376,6 +403,8 @@ pub struct Pipelines {
     n_probes: u32,
     n_cells: u32,
     n_gauss: u32,
+    /// Lanes of the constraint points' passes (0 without points).
+    n_point_lanes: u32,
     max_groups: u32,
     pub plan: StepPlan,
 }
@@ -489,6 +518,7 @@ impl Pipelines {
             n_probes: buffers.n_probes as u32,
             n_cells: buffers.n_cells.max(buffers.n_gauss / 4) as u32,
             n_gauss: buffers.n_gauss as u32,
+            n_point_lanes: variant.points.map_or(0, |c| c.lanes()),
             max_groups: ctx.limits.max_compute_workgroups_per_dimension,
             plan,
         })
@@ -507,6 +537,7 @@ impl Pipelines {
             Domain::Cells => grid_2d(self.n_cells, self.max_groups),
             Domain::PairNodes => grid_2d(self.n_pair_nodes, self.max_groups),
             Domain::GaussPoints => grid_2d(self.n_gauss, self.max_groups),
+            Domain::PointLanes => (self.n_point_lanes, 1),
         };
         cpass.set_pipeline(&b.pipeline);
         cpass.set_bind_group(0, &b.bind_group, &[]);
@@ -593,6 +624,7 @@ mod tests {
                                 bspline_small_grid: perturbed,
                                 patch: false,
                                 contact: None,
+                                points: None,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)

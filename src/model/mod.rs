@@ -77,6 +77,10 @@ pub struct Constraints {
     /// Empty unless some group's edge lies inside the grid where nodes
     /// outside its region reach it.
     pub points: Vec<ConstraintPoint>,
+    /// Per group: the region's nodes its points freed (sorted; empty
+    /// without points). The GPU keeps each group as its region's box of
+    /// nodes less these (`gpu::buffers::constraint_boxes`).
+    pub freed: Vec<Vec<u32>>,
 }
 
 impl Constraints {
@@ -97,6 +101,7 @@ impl Constraints {
             }
         }
         self.points = placed.points;
+        self.freed = placed.freed;
     }
 }
 
@@ -656,6 +661,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         fix: vec![0; grid.n_nodes()],
         groups: Vec::new(),
         points: Vec::new(),
+        freed: Vec::new(),
     };
     // Membership is tested on the unperturbed lattice position, so a
     // perturbed grid fixes the same nodes as the regular one.
