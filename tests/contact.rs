@@ -266,12 +266,29 @@ fn frictionless_disks_off_centre_against_one_shared_field() {
     assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
     let sep = |c: &Collision| dot(c.end[1].v, U) - dot(c.end[0].v, U);
     assert!(sep(&c) > 0.5, "{}", sep(&c));
-    // Not asserted yet, because it does not hold: the issue's "neither
-    // spins up". Measured omega R = 0.39 / 0.48 of the impact speed and
-    // v.t = -0.30 / 0.30 (exact -0.5 / 0.5), against 0.24 / 0.38 with one
-    // shared field: the mass-gradient normals tilt across the contact
-    // patch (with the exact line of centres as the normal, omega R is
-    // 0.05). docs/methods.md, "Contact between bodies".
+    // The issue's "neither spins up" is not met in full: with the
+    // logistic-regression normals omega R = 0.025 / 0.187 of the impact
+    // speed and v.t = -0.468 / 0.468 (exact -0.5 / 0.5), against 0.39 /
+    // 0.48 and -0.30 / 0.30 with the larger volume's gradient normal and
+    // 0.24 / 0.38 with one shared field (2026-11-25; with the exact line
+    // of centres as the normal, 0.05). What is asserted: the pair spins
+    // each disk less than the shared field does, and keeps more of the
+    // tangential velocity. docs/methods.md, "Contact between bodies".
+    for i in 0..2 {
+        let (pair, shared) = (c.end[i], one.end[i]);
+        assert!(
+            pair.omega.abs() < shared.omega.abs(),
+            "disk {i}: omega {} against one field's {}",
+            pair.omega,
+            shared.omega
+        );
+        assert!(
+            dot(pair.v, T).abs() > dot(shared.v, T).abs(),
+            "disk {i}: v.t {:?} against one field's {:?}",
+            pair.v,
+            shared.v
+        );
+    }
 }
 
 #[test]

@@ -443,7 +443,11 @@ fn check_detect(
         }
         if on_cpu {
             touching += 1;
-            dn = dn.max((n[0] - cn[0]).abs().max((n[1] - cn[1]).abs()));
+            let d = (n[0] - cn[0]).abs().max((n[1] - cn[1]).abs());
+            if d > normal_tol {
+                println!("  pair node {o}: normal GPU {n:?}, CPU {cn:?}");
+            }
+            dn = dn.max(d);
         }
         // A gap is measured where the pair has a normal (before the gap
         // test), on both twins.
@@ -1386,16 +1390,21 @@ fn stages_match_wall_preload() {
 }
 
 /// Contact normals, |GPU − CPU| of the unit vectors' components: f32
-/// sums of m_p ∇N normalised. Measured (stages_match_contact_pairs) 3.3e-7
-/// linear, 6.3e-7 uGIMP, 1.5e-6 B-spline, 10 times rounded up; LME 2.6e-5,
-/// its f32 Newton leaving Σ∇N ≈ 1e-5/h (as in its stress and forces).
-const CONTACT_NORMAL_TOL: f64 = 2e-5;
-const CONTACT_NORMAL_TOL_LME: f64 = 3e-4;
+/// sums of m_p ∇N normalised, then (where the pair touches) the logistic
+/// regression's ten Newton steps in f32, which carry the sums' rounding
+/// into the direction, most where this scene's random particles of the
+/// two bodies mix at a node and the fit is barely determined (a real
+/// contact separates them). Measured (stages_match_contact_pairs) with
+/// the regression 3.2e-5 linear and LME, 1.9e-4 uGIMP, 1.45e-3 B-spline,
+/// 10 times rounded up (before it: 3.3e-7, 6.3e-7, 1.5e-6; LME 2.6e-5).
+const CONTACT_NORMAL_TOL: f64 = 1.5e-2;
+const CONTACT_NORMAL_TOL_LME: f64 = 1.5e-2;
 /// The exchange's velocities, forces and the pairs' reactions (in
 /// `GridPredict` and `GridCorrect`), relative as the stages' own: they move
-/// along the normals and carry their error. Measured 7.3e-7 (B-spline,
-/// correct: vy change), 10 times rounded up; LME 2.0e-5 (the reactions).
-const CONTACT_EXCHANGE_TOL: f64 = 8e-6;
+/// along the normals and carry their error. Measured 1.35e-5 (linear,
+/// predict: vx) with the logistic-regression normals (7.3e-7 before
+/// them), 10 times rounded up; LME 2.0e-5 (the reactions) on both.
+const CONTACT_EXCHANGE_TOL: f64 = 1.5e-4;
 const CONTACT_EXCHANGE_TOL_LME: f64 = 2e-4;
 /// MUSL's remap with contact pairs: a field node that holds a sliver of
 /// one body (6e-6 kg beside 26 kg of another field at the same node) gets

@@ -18,14 +18,25 @@ struct ContactPair {
 // Keep in sync with `CONTACT_GAP_SLACK` in src/cpu/contact.rs.
 const CONTACT_GAP_SLACK: f32 = 1e-3;
 
+// The logistic-regression normal: ridge, Newton steps, step cap, least scale.
+// Keep in sync with `LR_RIDGE`, `LR_ITERATIONS`, `LR_MAX_STEP`, `LR_MIN_SCALE` in
+// src/cpu/contact.rs (tests/gpu_shaders.rs checks).
+const LR_RIDGE: f32 = 1e-9;
+const LR_ITERATIONS: u32 = 10u;
+const LR_MAX_STEP: f32 = 4.0;
+const LR_MIN_SCALE: f32 = 2.0;
+
 // "No gap measured" (the CPU's infinity; WGSL may assume no infinities).
 const CONTACT_NO_GAP: f32 = 3.4028235e38;
 
-// The normal rule, in one place: at a node where both bodies of a pair have
-// mass, the unit normal from the pair's first body towards its second, from
+// The gradient normal: at a node where both bodies of a pair have mass,
+// the unit normal from the pair's first body towards its second, from
 // their mass gradients and volumes [Σ m_p ∇N, Σ N V_p] there (`ga`, `gb`):
 // the gradient of the body with the larger volume at the node (Nairn's "max
 // volume" choice; ∇m_a points out of a, −∇m_b into b). Zero: no normal.
+// Where the pair touches, `lr_normal` (contact_detect.wgsl) replaces it
+// with the line that separates the two bodies' particles, and keeps it
+// where none does.
 fn contact_normal(ga: vec3<f32>, gb: vec3<f32>) -> vec2<f32> {
     var d = -gb.xy;
     if ga.z >= gb.z {
