@@ -295,7 +295,7 @@ pub fn lr_normal(
         vol += v;
         l += v * half_width(mass[p], rho[p]);
     }
-    if !(vol > 0.0) {
+    if vol.is_nan() || vol <= 0.0 {
         return n0;
     }
     c = [c[0] / vol, c[1] / vol];
