@@ -67,17 +67,20 @@ fn exact_rel(mu: f64, t: f64) -> f64 {
 
 /// The block slides at the Coulomb rate once the ramp is over (t ≥ 0.2 s).
 fn check_sliding(label: &str, h: &[(f64, Vec<[f64; 2]>)]) {
+    let mut checked = 0;
     for (t, v) in h {
         let (t, rel) = (*t, v[0][0] - v[1][0]);
         let exact = exact_rel(0.2, t);
         println!("{label} mu 0.2: t {t:.2} relative {rel:.4} m/s, exact {exact:.4}");
-        if t >= 0.2 {
+        if t >= 0.2 - 1e-9 {
+            checked += 1;
             assert!(
                 (rel / exact - 1.0).abs() < SLIDING_TOL,
                 "{label} t = {t}: relative velocity {rel} against {exact}"
             );
         }
     }
+    assert!(checked > 0, "{label}: no sample after the ramp");
 }
 
 /// The block stays at rest on the slab (μ = 0.7 > tan 30°).
@@ -107,16 +110,18 @@ fn block_rests_on_a_slab_above_the_friction_angle() {
     check_at_rest("cpu", &history(&scene, 0.1));
 }
 
-/// The block on the slab on the GPU, sliding (to 0.3 s: the checks start
-/// at 0.2 s, after the ramp; the CPU test runs to 0.5 s) and at rest (to
-/// 0.2 s), against the same tolerances as the CPU. (llvmpipe steps this
-/// scene at ~15 ms a step, so the runs are kept short.)
+/// The block on the slab on the GPU, sliding (to 0.2 s: the check is at
+/// 0.2 s, after the ramp; the CPU test runs to 0.5 s) and at rest (to
+/// 0.1 s, the ramp's end; the CPU test runs to 0.3 s), against the same
+/// tolerances as the CPU. (llvmpipe steps this scene at ~15 ms a step,
+/// 3300 steps to 0.2 s, so the runs are kept short: to 0.3 and 0.2 s they
+/// made this the suite's slowest test.)
 #[test]
 fn block_on_a_slab_on_gpu() {
     for (sets, sliding) in [
-        (&["solver.t_end=0.3"][..], true),
+        (&["solver.t_end=0.2"][..], true),
         (
-            &["contact.interface.friction=0.7", "solver.t_end=0.2"][..],
+            &["contact.interface.friction=0.7", "solver.t_end=0.1"][..],
             false,
         ),
     ] {

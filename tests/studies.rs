@@ -211,9 +211,10 @@ fn mms_quick_every_method_converges_or_reports_why_not() {
     assert!(md.contains("study-mms-u-e7.png") && md.contains("study-mms-front.png"));
     assert_eq!(
         results.len(),
-        lme_mpm::study::mms::METHODS.len() * lme_mpm::study::mms::CELLS_QUICK.len()
+        lme_mpm::study::mms::methods(true).len() * lme_mpm::study::mms::CELLS_QUICK.len()
     );
-    for (label, _, _) in lme_mpm::study::mms::METHODS {
+    for m in lme_mpm::study::mms::methods(true) {
+        let label = lme_mpm::study::mms::METHODS[m].0;
         let get = |n: &str| {
             results
                 .iter()
