@@ -27,7 +27,8 @@ use crate::error::SceneError;
 use crate::model::material::Material;
 use crate::model::shape::Shape;
 use crate::scene::{
-    Fix, GmmBasis, ImplicitMass, IntegratorKind, MlsScope, NpcPosition, Scene, SolverMethod, seed,
+    Fix, GmmBasis, ImplicitMass, ImplicitStart, IntegratorKind, MlsScope, NpcPosition, Scene,
+    SolverMethod, seed,
 };
 
 /// Nodes lighter than this (kg) count as empty. Relative to the lightest
@@ -135,6 +136,9 @@ pub struct ImplicitSettings {
     pub max_cuts: u32,
     /// Lumped instead of consistent mass.
     pub lumped_mass: bool,
+    /// The first step starts from a₀ = (f_ext − f_int) / m instead of 0
+    /// (`solver.implicit_start = "consistent"`).
+    pub consistent_start: bool,
     /// The Galerkin meshfree method's settings (`solver.method = "gmm"`):
     /// the step solves on a node cloud that moves with the body instead of
     /// the grid. None: implicit MPM.
@@ -276,6 +280,7 @@ impl Model {
                 max_iter: f.solver.newton_max_iter,
                 max_cuts: f.solver.newton_max_cuts,
                 lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
+                consistent_start: f.solver.implicit_start == ImplicitStart::Consistent,
                 gmm: (f.solver.method == SolverMethod::Gmm).then_some(GmmSettings {
                     basis: f.solver.gmm_basis,
                     gamma: f.solver.lme_gamma,

@@ -382,6 +382,17 @@ pub enum ImplicitMass {
     Lumped,
 }
 
+/// The implicit step's initial acceleration (`solver.implicit_start`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ImplicitStart {
+    /// a = 0 at t = 0, the particles' initial data (the paper's).
+    #[default]
+    Rest,
+    /// a₀ = (f_ext − f_int) / m at t = 0, Coulomb at closed wall contacts.
+    Consistent,
+}
+
 /// What the implicit step solves on (`solver.method`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -459,6 +470,12 @@ pub struct SolverSpec {
     /// (docs/methods.md, "Implicit integrator").
     #[serde(default = "default_implicit_mass")]
     pub implicit_mass: ImplicitMass,
+    /// Implicit, dynamic: the nodes' acceleration at the first step.
+    /// Default `rest` (the paper's: the particles' initial a = 0);
+    /// `consistent` solves it from the equations of motion at t = 0
+    /// (docs/methods.md, "Implicit integrator").
+    #[serde(default)]
+    pub implicit_start: ImplicitStart,
     /// Implicit: a static analysis (no inertia): loads grow linearly to
     /// their full value over `load_steps` equal steps of pseudo-time up to
     /// `t_end`. Default false.

@@ -39,7 +39,7 @@ use crate::cpu::{ShapeCache, shape_eval};
 use crate::error::{Error, Result};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::increment::StepState;
-use crate::model::walls::CONTACT_STICK;
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
 use assemble::{Dofs, Incidence, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
 use contact::{ContactPair, ContactState};
@@ -242,6 +242,13 @@ impl ImplicitBackend {
     /// One step, cutting Δt on failure. The time advances only on success.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
         self.initial_phase()?;
+        if self.settings.consistent_start
+            && self.steps == 0
+            && self.t == 0.0
+            && !self.settings.static_analysis
+        {
+            self.initial_acceleration()?;
+        }
         let mut dt = self.planned_dt();
         let mut cuts = 0;
         loop {
@@ -351,6 +358,92 @@ impl ImplicitBackend {
             self.pattern.take(),
         )?);
         self.stats.seconds.symbolic += mapped.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// With `solver.implicit_start = "consistent"`: the nodes'
+    /// acceleration at t = 0 from the equations of motion,
+    /// a₀ = (f_ext − f_int) / m_I (lumped; exact for a body force with
+    /// either mass, since Σ_J M_IJ = m_I), in place of the particles'
+    /// zero: started from a₀ = 0 the trapezoidal rule lags ½ a t² by
+    /// ½ a Δt t for good (docs/methods.md, "Implicit integrator"). Held
+    /// components start at 0; at a closed wall contact (gap ≤ 0) the push
+    /// into the wall is taken out (the wall's reaction at t = 0 is what a
+    /// rigid support would give) and the tangential part by Coulomb's
+    /// law, all of it for `stick`, up to μ |a·n| for `friction`, none for
+    /// `slip`. The particles take a₀ at their place (the trapezoid of
+    /// their velocity update reads it), a GMM cloud's nodes their own.
+    fn initial_acceleration(&mut self) -> std::result::Result<(), Fault> {
+        let m = &self.model;
+        let p = &m.particles;
+        let body =
+            crate::cpu::body_force(m.gravity, &m.manufactured, &m.external, &p.x0, &p.mass, 0.0);
+        let body: Vec<[f64; 2]> = (0..p.len()).map(body).collect();
+        let zero = vec![[0.0; 2]; self.du.len()];
+        let inp = StepInputs {
+            cache: &self.cache,
+            model: m,
+            volume: &self.volume,
+            body: &body,
+            start: &self.start,
+            v: &self.node_v,
+            a: &self.node_a,
+            newmark: Newmark {
+                is_static: true,
+                ..self.newmark(1.0)
+            },
+            dofs: &self.dofs,
+            penalty: self.penalty,
+            pairs: &self.pairs,
+            lumped_mass: true,
+            point_target: &self.point_target,
+            point_penalty: self.point_penalty,
+        };
+        let mut force = vec![[0.0; 2]; self.du.len()];
+        assemble::residual(&inp, &zero, &mut self.iterates, &mut force)?;
+        let mut a0 = vec![[0.0; 2]; force.len()];
+        for (n, (a, f)) in a0.iter_mut().zip(&force).enumerate() {
+            let mass = self.node_mass[n];
+            if self.dofs.id[n] == NO_DOF || mass <= self.mass_eps {
+                continue;
+            }
+            for c in 0..2 {
+                if self.dofs.free(n, c) {
+                    a[c] = f[c] / mass;
+                }
+            }
+        }
+        for pair in self.pairs.iter().filter(|p| p.gap <= 0.0) {
+            let w = &m.walls.list[pair.wall as usize];
+            let a = &mut a0[pair.node as usize];
+            let nrm = w.normal;
+            let an = a[0] * nrm[0] + a[1] * nrm[1];
+            if an >= 0.0 {
+                continue;
+            }
+            let t = [a[0] - an * nrm[0], a[1] - an * nrm[1]];
+            let mag = t[0].hypot(t[1]);
+            let keep = match w.contact {
+                CONTACT_STICK => 0.0,
+                CONTACT_FRICTION if mag > 0.0 => (1.0 - w.mu * an.abs() / mag).max(0.0),
+                _ => 1.0,
+            };
+            *a = [keep * t[0], keep * t[1]];
+        }
+        let p = &mut self.model.particles;
+        for i in 0..p.len() {
+            let (nodes, w) = self.cache.particle(i);
+            let mut ap = [0.0; 2];
+            for (&n, wk) in nodes.iter().zip(w) {
+                ap[0] += wk[0] * a0[n as usize][0];
+                ap[1] += wk[0] * a0[n as usize][1];
+            }
+            p.a[i] = ap;
+        }
+        if let Nodes::Cloud(c) = &mut self.nodes {
+            c.cloud.a.copy_from_slice(&a0);
+        }
+        self.node_a = a0;
         Ok(())
     }
 
