@@ -34,6 +34,15 @@ use rayon::prelude::*;
 /// lattice's disk before the cache grows (it grows on demand anyway).
 const STRIDE_SLACK: f64 = 2.0;
 
+/// The radii, as multiples of the search radius, over which a particle
+/// gathers its cloud, the next tried only when the basis finds no
+/// solution on the last (the paper's variable radius for the column
+/// collapse, §5.3): where the body stretches, the nodes that enclose a
+/// particle can lie beyond the initial radius, and LME then has no λ
+/// (its Hessian turns singular: the particle lies outside the hull of
+/// the nodes it gathered). The cell list is built for the widest.
+const RADIUS_GROWTH: [f64; 3] = [1.0, 1.5, 2.0];
+
 /// The cloud, its basis and each particle's LME multiplier.
 pub struct GmmNodes {
     pub cloud: Cloud,
@@ -95,7 +104,8 @@ impl GmmNodes {
     /// N and ∇N of every particle over its cloud, into `cache` (grown when
     /// a cloud outnumbers its slots).
     pub fn shape_eval(&mut self, x: &[[f64; 2]], cache: &mut ShapeCache) -> Result<(), Fault> {
-        self.cloud.rebuild(self.radius);
+        let widest = RADIUS_GROWTH[RADIUS_GROWTH.len() - 1];
+        self.cloud.rebuild(widest * self.radius);
         let (cloud, basis, radius) = (&self.cloud, &self.basis, self.radius);
         loop {
             let stride = cache.stride;
@@ -108,18 +118,25 @@ impl GmmNodes {
                 .enumerate()
                 .with_min_len(64)
                 .map_init(Vec::new, |list, (p, (((nodes, w), count), lam))| {
-                    cloud.gather(x[p], radius, list);
-                    if list.len() > stride {
-                        return (None, list.len());
-                    }
-                    nodes[..list.len()].copy_from_slice(list);
-                    match basis.eval(x[p], &cloud.x, nodes, list.len(), lam, w) {
-                        Ok(kept) => {
-                            *count = kept as u16;
-                            (None, 0)
+                    let mut fault = None;
+                    for (k, grow) in RADIUS_GROWTH.iter().enumerate() {
+                        cloud.gather(x[p], grow * radius, list);
+                        if list.len() > stride {
+                            return (None, list.len());
                         }
-                        Err(e) => (Some(Fault::at(p, FaultKind::Shape(e))), 0),
+                        nodes[..list.len()].copy_from_slice(list);
+                        if k > 0 {
+                            *lam = [0.0; 2];
+                        }
+                        match basis.eval(x[p], &cloud.x, nodes, list.len(), lam, w) {
+                            Ok(kept) => {
+                                *count = kept as u16;
+                                return (None, 0);
+                            }
+                            Err(e) => fault = Some(Fault::at(p, FaultKind::Shape(e))),
+                        }
                     }
+                    (fault, 0)
                 })
                 .reduce(|| (None, 0), |a, b| (Fault::first(a.0, b.0), a.1.max(b.1)));
             if need > stride {
