@@ -11,8 +11,9 @@
 // With WALL_PRELOAD both velocities count the preloads (`wall_touch`'s
 // `wall_pre_force`). F goes onto the nodes with the particle's weights
 // (`wall_force`, which `correct` adds to f_I), the preload's share of F_n
-// on the wall's line x_p − d n (d: `wall_depth`) with the weights there
-// to first order, N − d n·∇N, and into the wall's reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
+// and the friction (where those weights have no negative part: linear
+// shapes) on the wall's line x_p − d n (d: `wall_depth`) with the weights
+// there to first order, N − d n·∇N, and into the wall's reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
 // that act at the step's start time t (appear_at <= t < remove_at) push.
 // CPU twin: `wall_contact` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
@@ -39,6 +40,7 @@
 // Keep in sync with src/model/walls.rs.
 const WALL_DAMPING: f32 = 0.05;
 const STICK_MU: f32 = 20.0;
+const LINE_WEIGHT_EPS: f32 = 1e-6;
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -118,16 +120,34 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let fw = fnorm * wl.normal + ft;
         reaction_add(2u * (params.n_groups + k), fw.x);
         reaction_add(2u * (params.n_groups + k) + 1u, fw.y);
-        // The preload's share at the face, the rest at the particle.
+        // The preload's share and the friction at the wall's line (the
+        // friction only where the line's weights N − d n·∇N have no
+        // negative part), the rest at the particle.
         let f_pre = min(sp.y, fnorm);
-        let f_at = fw - f_pre * wl.normal;
         let d = wall_depth(x, lp, wl);
+        var positive = true;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
                 let nw = shape_node(c, s);
-                if nw.ok && (nw.n != 0.0 || f_pre != 0.0) {
-                    let o = nw.n * f_at + f_pre * (nw.n - d * dot(wl.normal, nw.dn)) * wl.normal;
+                if nw.ok && nw.n - d * dot(wl.normal, nw.dn) < -LINE_WEIGHT_EPS {
+                    positive = false;
+                }
+            }
+        }
+        var ft_line = vec2<f32>(0.0);
+        if positive {
+            ft_line = ft;
+        }
+        let f_at = fw - f_pre * wl.normal - ft_line;
+        let f_line = f_pre * wl.normal + ft_line;
+        let lined = f_pre != 0.0 || positive;
+        for (var r = 0u; r < SHAPE_ROWS; r++) {
+            let span = shape_span(c, r);
+            for (var s = span.x; s < span.y; s++) {
+                let nw = shape_node(c, s);
+                if nw.ok && (nw.n != 0.0 || lined) {
+                    let o = nw.n * f_at + (nw.n - d * dot(wl.normal, nw.dn)) * f_line;
                     wall_force_add(2u * nw.node, o.x);
                     wall_force_add(2u * nw.node + 1u, o.y);
                 }

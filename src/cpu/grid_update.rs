@@ -9,7 +9,9 @@
 //! contact points, the particles in contact: a penalty normal force with
 //! some damping, and Coulomb friction capped by it that stops the slip of
 //! the body at the point (docs/methods.md, "Walls"); onto the nodes with
-//! the particle's weights, and into the walls' reactions.
+//! the particle's weights (the preload and, for linear shapes, the
+//! friction with the weights at the wall's line), and into the walls'
+//! reactions.
 //! `correct`: the walls' forces added to f_I, reactions on fixed nodes,
 //! their force components zeroed, then v_I += γ Δt f_I / m_I (NPC
 //! corrector; FE is γ = 1: the nodal momentum update p_I += Δt f_I of
@@ -166,6 +168,26 @@ fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
     wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
 }
 
+/// Whether the weights at the wall's line (`face_weight`) of a particle
+/// with weights `wt` ([N, ∇N] per node), at distance `d` (m) from the
+/// line along `n`, are all non-negative (to `LINE_WEIGHT_EPS`): always for linear
+/// shapes while the line is in the particle's cell; LME's and the
+/// B-splines' wider stencils extrapolate to negative weights on the nodes
+/// away from the line. The friction acts on the line only where they are
+/// (docs/methods.md, "Walls": with negative weights the geostatic LME
+/// column moved at 1.1e-2 m/s).
+#[inline]
+fn line_weights_positive(wt: &[[f64; 3]], n: [f64; 2], d: f64) -> bool {
+    wt.iter()
+        .all(|wk| face_weight(wk, n, d) >= -LINE_WEIGHT_EPS)
+}
+
+/// Round-off allowance of `line_weights_positive`: the weights are O(1)
+/// and the GPU twin computes them in f32 (a linear particle's node above
+/// the line gets 0 exactly in exact arithmetic, ±1e-7 in f32), so both
+/// decide alike.
+const LINE_WEIGHT_EPS: f64 = 1e-6;
+
 /// The walls' forces at their contact points: every particle in contact
 /// with a wall gets a normal force F_n = k pen 2 l_p (penalty) plus its
 /// preload (`contact_spring`), less a damping of its approach, and a
@@ -190,7 +212,10 @@ fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
 /// it goes to the nodes with N_I − d n·∇N_I (the weights there, to first
 /// order; exact for linear shapes across the wall's row of cells), so a
 /// geostatic body's boundary nodes get the load their own forces lack,
-/// not a share of it spread a cell into the body.
+/// not a share of it spread a cell into the body. The friction acts
+/// there too, where those weights have no negative part
+/// (`line_weights_positive`: linear shapes), so a rolling body's torque
+/// about its contact is gravity's alone; elsewhere at the particle.
 #[allow(clippy::too_many_arguments)]
 pub fn wall_contact(
     cache: &ShapeCache,
@@ -273,16 +298,28 @@ pub fn wall_contact(
             let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
             wall_r[k][0] += fw[0];
             wall_r[k][1] += fw[1];
-            // The preload's share at the wall's line, the rest at the
-            // particle.
+            // The preload's share and the friction at the wall's line, the
+            // rest (the penalty and the damping) at the particle. The
+            // friction acts at the contact (a rolling body's torque about
+            // its contact is then gravity's alone), where the line's
+            // weights are a partition of unity without negative parts
+            // (`line_weights_positive`), else at the particle.
             let f_pre = pre.min(fnorm);
-            let f_at = [fw[0] - f_pre * nrm[0], fw[1] - f_pre * nrm[1]];
             let d = wall_depth(pt.x[p], lp, wl);
+            let ft_line = if line_weights_positive(wt, nrm, d) {
+                ft
+            } else {
+                [0.0; 2]
+            };
+            let f_at = [
+                fw[0] - f_pre * nrm[0] - ft_line[0],
+                fw[1] - f_pre * nrm[1] - ft_line[1],
+            ];
             for (&n, wk) in nodes.iter().zip(wt) {
-                let face = f_pre * face_weight(wk, nrm, d);
+                let face = face_weight(wk, nrm, d);
                 let o = &mut wall_force[n as usize];
-                o[0] += wk[0] * f_at[0] + face * nrm[0];
-                o[1] += wk[0] * f_at[1] + face * nrm[1];
+                o[0] += wk[0] * f_at[0] + face * (f_pre * nrm[0] + ft_line[0]);
+                o[1] += wk[0] * f_at[1] + face * (f_pre * nrm[1] + ft_line[1]);
             }
         }
     }
