@@ -3,11 +3,12 @@
 // (`shared/wall_spring.wgsl`, as in `wall_touch.wgsl`). Per particle and
 // wall: the body's velocity at the particle, corrected without the walls,
 // v̂ = Σ N (v_I + γΔt f_I / m_I), and w = γΔt Σ N S_I / m_I (S_I: the
-// contact weights of `wall_touch`); the normal force
+// contact weights of `wall_touch`, `wall_touch[2n]`); the normal force
 // F_n = max(0, spring − WALL_DAMPING v̂·n / w), and the tangential
 // force that stops the particle's own slip, v_p' = v_p + sΔt Σ N f_I/m_I
 // (sΔt = (2 − γ)Δt, the time it feels a nodal force in), −v'_t / w',
-// w' = sΔt Σ N S_I / m_I, at most μ F_n (stick: μ = STICK_MU; slip: 0).
+// w' = sΔt Σ N T_I / m_I (T_I: the friction's weights of the contacts,
+// `wall_touch[2n + 1]`), at most μ F_n (stick: μ = STICK_MU; slip: 0).
 // With WALL_PRELOAD both velocities count the preloads (`wall_touch`'s
 // `wall_pre_force`). F goes onto the nodes with the particle's weights
 // (`wall_force`, which `correct` adds to f_I), the preload's share of F_n
@@ -40,7 +41,6 @@
 // Keep in sync with src/model/walls.rs.
 const WALL_DAMPING: f32 = 0.05;
 const STICK_MU: f32 = 20.0;
-const LINE_WEIGHT_EPS: f32 = 1e-6;
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -75,6 +75,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         var v = vec2<f32>(0.0);
         var vp = v_p[p];
         var w = 0.0;
+        var wf = 0.0;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
@@ -91,7 +92,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
                     v += nw.n * (vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f);
                     vp += nw.n * sdt / m * f;
-                    w += nw.n * wall_touch[nw.node] / m;
+                    w += nw.n * wall_touch[2u * nw.node] / m;
+                    wf += nw.n * wall_touch[2u * nw.node + 1u] / m;
                 }
             }
         }
@@ -110,8 +112,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
         // Coulomb: the force that stops the slip, at most μ F_n.
         // Sized over sdt, the step the particle feels it in (over γΔt the
-        // stick loop's gain was (2 − γ)/γ and a slip grew).
-        var ft = -vt / (w / gdt * sdt);
+        // stick loop's gain was (2 − γ)/γ and a slip grew), and with the
+        // friction's own weights T_I (with S_I while it acts on the line,
+        // a stick loop's gain was about 1.28: the held particles kept a
+        // slip against their load); S_I where the nodes carry no T.
+        var ws = w / gdt * sdt;
+        if wf > 0.0 {
+            ws = wf * sdt;
+        }
+        var ft = -vt / ws;
         let mag = length(ft);
         let cap = mu * fnorm;
         if mag > cap {
@@ -125,16 +134,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         // negative part), the rest at the particle.
         let f_pre = min(sp.y, fnorm);
         let d = wall_depth(x, lp, wl);
-        var positive = true;
-        for (var r = 0u; r < SHAPE_ROWS; r++) {
-            let span = shape_span(c, r);
-            for (var s = span.x; s < span.y; s++) {
-                let nw = shape_node(c, s);
-                if nw.ok && nw.n - d * dot(wl.normal, nw.dn) < -LINE_WEIGHT_EPS {
-                    positive = false;
-                }
-            }
-        }
+        let positive = line_weights_positive(c, wl.normal, d);
         var ft_line = vec2<f32>(0.0);
         if positive {
             ft_line = ft;

@@ -184,9 +184,10 @@ const LME_SIGMA_REL: f64 = 0.42;
 const LME_SIGMA_MEASURED: f64 = 0.28;
 
 /// Linear shapes hold the geostatic column exactly (measured 2026-11-25
-/// 1.4e-11 m/s, σ_yy to 4.9e-9 ρgH, with the walls' friction on their
-/// line; 2.8e-14 and 5e-12 with it at the particles' centres; the node
-/// rule before: 1e-16 and 5e-15): the walls carry each flush particle's
+/// 4.8e-14 m/s, σ_yy to 1.0e-11 ρgH, with the walls' friction on their
+/// line sized with its own weights; 1.4e-11 and 4.9e-9 sized with the
+/// particle's; 2.8e-14 and 5e-12 with it at the particles' centres; the
+/// node rule before: 1e-16 and 5e-15): the walls carry each flush particle's
 /// initial traction from
 /// the first step (`Walls::preload`, docs/methods.md "Walls"), onto the
 /// nodes on the wall's line, and the friction sees those loads before it
