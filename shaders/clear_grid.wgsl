@@ -51,7 +51,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         node_acc[n * NODE_STRIDE + k] = 0.0;
     }
 #if WALLS
-    wall_touch[n] = 0.0;
+    wall_touch[2u * n] = 0.0;
+    wall_touch[2u * n + 1u] = 0.0;
     wall_force[2u * n] = 0.0;
     wall_force[2u * n + 1u] = 0.0;
 #if WALL_PRELOAD

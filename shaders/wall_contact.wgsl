@@ -3,16 +3,18 @@
 // (`shared/wall_spring.wgsl`, as in `wall_touch.wgsl`). Per particle and
 // wall: the body's velocity at the particle, corrected without the walls,
 // v̂ = Σ N (v_I + γΔt f_I / m_I), and w = γΔt Σ N S_I / m_I (S_I: the
-// contact weights of `wall_touch`); the normal force
+// contact weights of `wall_touch`, `wall_touch[2n]`); the normal force
 // F_n = max(0, spring − WALL_DAMPING v̂·n / w), and the tangential
 // force that stops the particle's own slip, v_p' = v_p + sΔt Σ N f_I/m_I
 // (sΔt = (2 − γ)Δt, the time it feels a nodal force in), −v'_t / w',
-// w' = sΔt Σ N S_I / m_I, at most μ F_n (stick: μ = STICK_MU; slip: 0).
+// w' = sΔt Σ N T_I / m_I (T_I: the friction's weights of the contacts,
+// `wall_touch[2n + 1]`), at most μ F_n (stick: μ = STICK_MU; slip: 0).
 // With WALL_PRELOAD both velocities count the preloads (`wall_touch`'s
 // `wall_pre_force`). F goes onto the nodes with the particle's weights
 // (`wall_force`, which `correct` adds to f_I), the preload's share of F_n
-// on the wall's line x_p − d n (d: `wall_depth`) with the weights there
-// to first order, N − d n·∇N, and into the wall's reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
+// and the friction (where those weights have no negative part: linear
+// shapes) on the wall's line x_p − d n (d: `wall_depth`) with the weights
+// there to first order, N − d n·∇N, and into the wall's reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
 // that act at the step's start time t (appear_at <= t < remove_at) push.
 // CPU twin: `wall_contact` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
@@ -73,6 +75,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         var v = vec2<f32>(0.0);
         var vp = v_p[p];
         var w = 0.0;
+        var wf = 0.0;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
@@ -89,7 +92,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
                     v += nw.n * (vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) + gdt / m * f);
                     vp += nw.n * sdt / m * f;
-                    w += nw.n * wall_touch[nw.node] / m;
+                    w += nw.n * wall_touch[2u * nw.node] / m;
+                    wf += nw.n * wall_touch[2u * nw.node + 1u] / m;
                 }
             }
         }
@@ -108,8 +112,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
         // Coulomb: the force that stops the slip, at most μ F_n.
         // Sized over sdt, the step the particle feels it in (over γΔt the
-        // stick loop's gain was (2 − γ)/γ and a slip grew).
-        var ft = -vt / (w / gdt * sdt);
+        // stick loop's gain was (2 − γ)/γ and a slip grew), and with the
+        // friction's own weights T_I (with S_I while it acts on the line,
+        // a stick loop's gain was about 1.28: the held particles kept a
+        // slip against their load); S_I where the nodes carry no T.
+        var ws = w / gdt * sdt;
+        if wf > 0.0 {
+            ws = wf * sdt;
+        }
+        var ft = -vt / ws;
         let mag = length(ft);
         let cap = mu * fnorm;
         if mag > cap {
@@ -118,16 +129,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let fw = fnorm * wl.normal + ft;
         reaction_add(2u * (params.n_groups + k), fw.x);
         reaction_add(2u * (params.n_groups + k) + 1u, fw.y);
-        // The preload's share at the face, the rest at the particle.
+        // The preload's share and the friction at the wall's line (the
+        // friction only where the line's weights N − d n·∇N have no
+        // negative part), the rest at the particle.
         let f_pre = min(sp.y, fnorm);
-        let f_at = fw - f_pre * wl.normal;
         let d = wall_depth(x, lp, wl);
+        let positive = line_weights_positive(c, wl.normal, d);
+        var ft_line = vec2<f32>(0.0);
+        if positive {
+            ft_line = ft;
+        }
+        let f_at = fw - f_pre * wl.normal - ft_line;
+        let f_line = f_pre * wl.normal + ft_line;
+        let lined = f_pre != 0.0 || positive;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
                 let nw = shape_node(c, s);
-                if nw.ok && (nw.n != 0.0 || f_pre != 0.0) {
-                    let o = nw.n * f_at + f_pre * (nw.n - d * dot(wl.normal, nw.dn)) * wl.normal;
+                if nw.ok && (nw.n != 0.0 || lined) {
+                    let o = nw.n * f_at + (nw.n - d * dot(wl.normal, nw.dn)) * f_line;
                     wall_force_add(2u * nw.node, o.x);
                     wall_force_add(2u * nw.node + 1u, o.y);
                 }

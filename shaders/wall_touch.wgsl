@@ -3,7 +3,11 @@
 // contact spring is positive (`shared/wall_spring.wgsl`: the domain of
 // half-width l_p = ½ sqrt(m_p / ρ_p) reaches past the wall's contact
 // line, or a preloaded particle has not left it) (a particle in contact
-// with two walls counts twice). With WALL_PRELOAD, each contact's preload
+// with two walls counts twice), at `wall_touch[2n]`, and at
+// `wall_touch[2n + 1]` the friction's weights T_I of the same contacts:
+// at the wall's line, N − d n·∇N, where none of a contact's is negative
+// (linear shapes), else N (`wall_contact` sizes the friction with them).
+// With WALL_PRELOAD, each contact's preload
 // onto the nodes at the wall's line, into `wall_pre_force`. `wall_contact`
 // reads it; `clear_grid` zeroes it. With GATES only the walls that act at
 // the step's start time t (appear_at <= t < remove_at) are in contact.
@@ -57,7 +61,37 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         for (var k = span.x; k < span.y; k++) {
             let w = shape_node(c, k);
             if w.ok && w.n != 0.0 {
-                touch_add(w.node, f32(count) * w.n);
+                touch_add(2u * w.node, f32(count) * w.n);
+            }
+        }
+    }
+    // The friction's weights of each contact: at the wall's line where
+    // none of them is negative, else the particle's.
+    for (var k = 0u; k < arrayLength(&walls); k++) {
+        let wl = walls[k];
+#if GATES
+        if t < wl.appear_at || t >= wl.remove_at {
+            continue;
+        }
+#endif
+        if contact_spring(p, k, wl, x, lp).x <= 0.0 {
+            continue;
+        }
+        let d = wall_depth(x, lp, wl);
+        let positive = line_weights_positive(c, wl.normal, d);
+        for (var r = 0u; r < SHAPE_ROWS; r++) {
+            let span = shape_span(c, r);
+            for (var s = span.x; s < span.y; s++) {
+                let nw = shape_node(c, s);
+                if nw.ok {
+                    var fw = nw.n;
+                    if positive {
+                        fw = nw.n - d * dot(wl.normal, nw.dn);
+                    }
+                    if fw != 0.0 {
+                        touch_add(2u * nw.node + 1u, fw);
+                    }
+                }
             }
         }
     }

@@ -83,8 +83,9 @@ fn sliding_block_matches_exact_on_cpu() {
 /// rings on the wall. It must rest (|v| below `SUDDEN_REST_SPEED`) for
 /// μ = 0.7 and 1.0 (> tan 30°), and slide within `SUDDEN_SLIDE_TOL` of
 /// g (sin θ − μ cos θ) t for μ = 0.5. Measured (2026-11-25, walls at the
-/// contact points): 0.0002 and 0.0019 m/s, and 2.4 % fast; with the
-/// node rule before, 0.24 and 0.11 m/s, and 58 % fast.
+/// contact points, the friction on the wall's line sized with its own
+/// weights): 0.0055 and 0.00017 m/s, and 3.18 % fast; with the node rule
+/// before, 0.24 and 0.11 m/s, and 58 % fast.
 const SUDDEN_BLOCK: &str = r#"
 exact = "sliding_block"
 [grid]
@@ -116,10 +117,13 @@ sample_interval = 0.1
 /// Issue 23's bound on the resting block's speed (m/s).
 const SUDDEN_REST_SPEED: f64 = 0.02;
 /// The sliding block's velocity, relative: issue 23's bound is 3 %;
-/// measured 3.08 % (μ = 0.5, 2026-11-25; 2.4 % before the friction
-/// stopped each particle's own slip, which the block at rest needed:
-/// 0.011 → 0.0001 m/s), so the bound is 3.5 %: the issue's 3 % is just
-/// missed.
+/// measured 3.18 % (μ = 0.5, 2026-11-25, the friction on the wall's line
+/// sized with the weights it acts with), 3.08 % with it at the
+/// particles' centres, 2.87 % on the line sized with the particle's
+/// weights (a stick loop that did not hold a slab: docs/methods.md,
+/// "Walls"), so the bound is 3.5 %: the issue's 3 % is just missed (the
+/// block sticks in the peaks of its bounce on the penalty spring, so the
+/// figure moves by tenths of a percent with any change of the rule).
 const SUDDEN_SLIDE_TOL: f64 = 0.035;
 
 #[test]
@@ -364,20 +368,23 @@ t_end = 0.5
 sample_interval = 0.1
 "#;
 
-/// The disk's centre displacement at 0.5 s within 6.5 % of the exact
-/// rolling distance (a = (2/3) g sin θ). Measured 5.17 % on the friction
-/// wall and 5.68 % on the stick wall (2026-11-25, walls at the contact
-/// points, the friction stopping each particle's own slip); 6.65 % and
-/// 2.21 % when it stopped the nodal velocity's (unstable under NPC), 17.5
-/// % and 18.1 % with the node rule, 49.6 % when every node behind the
-/// wall under the disk was held. Issue 23's 5 % is not met (docs/methods.md,
-/// "Walls").
-const DISK_R10_BOUND: f64 = 0.065;
+/// The disk's centre displacement at 0.5 s within 5.5 % of the exact
+/// rolling distance (a = (2/3) g sin θ; issue 23's bound at R/h = 10 is
+/// 5 %, met on friction, missed by 0.21 points on stick). Measured 4.52 %
+/// on the friction wall and 5.21 % on the stick wall (2026-11-25, walls
+/// at the contact points, the friction on the wall's line sized with the
+/// weights it acts with); 5.17 % and 5.68 % with the friction at the
+/// particles' centres; 4.71 % and 3.95 % on the line sized with the
+/// particle's weights, whose stick loop rang (the disk's mean friction
+/// halved, its centre at 1.99 m/s against the exact 1.64) and crept under
+/// a slab (docs/methods.md, "Walls"); 6.65 % and 2.21 % when it stopped
+/// the nodal velocity's (unstable under NPC), 17.5 % and 18.1 % with the
+/// node rule, 49.6 % when every node behind the wall under the disk was
+/// held.
+const DISK_R10_BOUND: f64 = 0.055;
 /// The stick wall rolls the disk about as far as the friction wall, within
-/// this much (both ought to roll without slip). Measured: stick 0.51
-/// points behind (it stops its contact particles' centres, l_p above the
-/// contact line, which rolling moves at ω l_p; friction lets them slip a
-/// little).
+/// this much (both ought to roll without slip). Measured: stick 0.69
+/// points behind friction.
 const DISK_STICK_SLACK: f64 = 0.01;
 
 #[test]

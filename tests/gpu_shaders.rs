@@ -509,6 +509,10 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("WALL_DAMPING", f(lme_mpm::model::walls::WALL_DAMPING)),
         ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
         (
+            "LINE_WEIGHT_EPS",
+            f(lme_mpm::cpu::grid_update::LINE_WEIGHT_EPS),
+        ),
+        (
             "CONTACT_GAP_SLACK",
             f(lme_mpm::cpu::contact::CONTACT_GAP_SLACK),
         ),

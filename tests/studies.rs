@@ -272,7 +272,9 @@ const DISK_QUICK_ERROR_BOUND: f64 = 8.0;
 /// the disk should roll alike; the node rule had them within 2 points.
 /// NOT YET: with the contact-point walls the stick wall (Coulomb with
 /// μ = 20 at the contact points) lags at the start: measured 12.25 %
-/// against friction's 6.62 % over 0.2 s (2026-11-25), though the full
+/// against friction's 6.62 % over 0.2 s (2026-11-25; 11.89 % against
+/// 6.61 % with the friction on the wall's line sized with the weights it
+/// acts with, 11.44 % sized with the particle's), though the full
 /// study's stick run covers 98.1 % of the exact distance at 0.5 s. These
 /// two constants hold that measured state (a regression of issue 23's
 /// walls merge, open there) so that a further loss fails.

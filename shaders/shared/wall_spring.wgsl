@@ -1,5 +1,7 @@
 // The walls' contact spring, shared by `wall_touch.wgsl` and
-// `wall_contact.wgsl` (which declare `walls` and `mass`): the normal force
+// `wall_contact.wgsl` (which declare `walls` and `mass`, and include the
+// shape functions), and whether a contact's friction acts on the wall's
+// line (`line_weights_positive`): the normal force
 // of particle p on wall k before damping, the penalty k pen 2 l_p (pen:
 // how far its domain reaches past the contact line, negative once clear)
 // plus, with WALL_PRELOAD, the preload of a particle that started flush
@@ -18,6 +20,28 @@
 // clamped to [0, l_p (|n_x| + |n_y|)]: where the wall's traction acts.
 fn wall_depth(x: vec2<f32>, lp: f32, w: Wall) -> f32 {
     return clamp(dot(x - w.point, w.normal), 0.0, lp * (abs(w.normal.x) + abs(w.normal.y)));
+}
+
+// Round-off allowance of `line_weights_positive` (f32 weights of O(1)).
+// Keep in sync with src/cpu/grid_update.rs.
+const LINE_WEIGHT_EPS: f32 = 1e-6;
+
+// Whether the particle's weights at the wall's line, N − d n·∇N (d:
+// `wall_depth`), are all non-negative (linear shapes while the line is in
+// the particle's cell): its friction then acts on the line.
+// CPU twin: `line_weights_positive` in src/cpu/grid_update.rs.
+fn line_weights_positive(c: ShapeCtx, n: vec2<f32>, d: f32) -> bool {
+    var positive = true;
+    for (var r = 0u; r < SHAPE_ROWS; r++) {
+        let span = shape_span(c, r);
+        for (var s = span.x; s < span.y; s++) {
+            let nw = shape_node(c, s);
+            if nw.ok && nw.n - d * dot(n, nw.dn) < -LINE_WEIGHT_EPS {
+                positive = false;
+            }
+        }
+    }
+    return positive;
 }
 
 // (spring force, preload) in N per unit thickness.

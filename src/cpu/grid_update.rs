@@ -1,7 +1,8 @@
 //! Stage `grid_update`, in two passes around the force computation.
 //! `wall_touch` (walls only, before `predict`): per node, the weight S_I of
 //! the particles in contact with a wall (their domain reaches past its
-//! contact line).
+//! contact line), and T_I, the same with the weights their friction acts
+//! with (at the wall's line for linear shapes).
 //! `predict`: nodal velocity from the scattered momentum, v_I = q_I / m_I,
 //! then the Dirichlet conditions (fixed components set to the
 //! constraint's prescribed velocity at the step's end, zero by default).
@@ -9,7 +10,9 @@
 //! contact points, the particles in contact: a penalty normal force with
 //! some damping, and Coulomb friction capped by it that stops the slip of
 //! the body at the point (docs/methods.md, "Walls"); onto the nodes with
-//! the particle's weights, and into the walls' reactions.
+//! the particle's weights (the preload and, for linear shapes, the
+//! friction with the weights at the wall's line), and into the walls'
+//! reactions.
 //! `correct`: the walls' forces added to f_I, reactions on fixed nodes,
 //! their force components zeroed, then v_I += γ Δt f_I / m_I (NPC
 //! corrector; FE is γ = 1: the nodal momentum update p_I += Δt f_I of
@@ -104,9 +107,13 @@ pub struct ContactParticles<'a> {
     pub gravity: [f64; 2],
 }
 
-/// Per node, the contact weight S_I = Σ_p N_Ip over the particles in
-/// contact with a wall (`contact_spring` > 0; a particle in contact
-/// with two walls counts twice). Only the walls that act in the step
+/// Per node, `touch[n] = [S_I, T_I]`: the contact weight S_I = Σ_p N_Ip
+/// over the particles in contact with a wall (`contact_spring` > 0; a
+/// particle in contact with two walls counts twice), and the friction's
+/// T_I = Σ_p F_Ip over the same contacts, F_Ip the weights the contact's
+/// friction goes to the nodes with (`friction_weight`: at the wall's line
+/// for linear shapes, else N_Ip), by which `wall_contact` sizes the
+/// friction. Only the walls that act in the step
 /// starting at `t` (s) count (`Wall::active_at`), so a removed gate, or
 /// one not there yet, is nowhere in contact. With preloads
 /// (`Walls::preload`; `pre_force` is empty without), each contact's
@@ -121,13 +128,14 @@ pub fn wall_touch(
     pt: &ContactParticles,
     walls: &Walls,
     t: f64,
-    touch: &mut [f64],
+    touch: &mut [[f64; 2]],
     pre_force: &mut [[f64; 2]],
 ) {
-    touch.fill(0.0);
+    touch.fill([0.0; 2]);
     pre_force.fill([0.0; 2]);
     for p in 0..pt.x.len() {
         let (nodes, w) = cache.particle(p);
+        let lp = half_width(pt.mass[p], pt.rho[p]);
         let mut count = 0;
         for (k, wl) in walls.list.iter().enumerate() {
             if !wl.active_at(t) {
@@ -138,8 +146,12 @@ pub fn wall_touch(
                 continue;
             }
             count += 1;
+            let d = wall_depth(pt.x[p], lp, wl);
+            let on_line = line_weights_positive(w, wl.normal, d);
+            for (&n, wk) in nodes.iter().zip(w) {
+                touch[n as usize][1] += friction_weight(wk, wl.normal, d, on_line);
+            }
             if pre > 0.0 {
-                let d = wall_depth(pt.x[p], half_width(pt.mass[p], pt.rho[p]), wl);
                 for (&n, wk) in nodes.iter().zip(w) {
                     let f = pre * face_weight(wk, wl.normal, d);
                     pre_force[n as usize][0] += f * wl.normal[0];
@@ -151,7 +163,7 @@ pub fn wall_touch(
             continue;
         }
         for (&n, wk) in nodes.iter().zip(w) {
-            touch[n as usize] += count as f64 * wk[0];
+            touch[n as usize][0] += count as f64 * wk[0];
         }
     }
 }
@@ -166,6 +178,38 @@ fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
     wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
 }
 
+/// Whether the weights at the wall's line (`face_weight`) of a particle
+/// with weights `wt` ([N, ∇N] per node), at distance `d` (m) from the
+/// line along `n`, are all non-negative (to `LINE_WEIGHT_EPS`): always for linear
+/// shapes while the line is in the particle's cell; LME's and the
+/// B-splines' wider stencils extrapolate to negative weights on the nodes
+/// away from the line. The friction acts on the line only where they are
+/// (docs/methods.md, "Walls": with negative weights the geostatic LME
+/// column moved at 1.1e-2 m/s).
+#[inline]
+fn line_weights_positive(wt: &[[f64; 3]], n: [f64; 2], d: f64) -> bool {
+    wt.iter()
+        .all(|wk| face_weight(wk, n, d) >= -LINE_WEIGHT_EPS)
+}
+
+/// The weight of a node in a contact's friction: at the wall's line
+/// (`face_weight`) where the line's weights are all non-negative
+/// (`on_line`, from `line_weights_positive`), else the particle's N.
+#[inline]
+fn friction_weight(wk: &[f64; 3], n: [f64; 2], d: f64, on_line: bool) -> f64 {
+    if on_line {
+        face_weight(wk, n, d)
+    } else {
+        wk[0]
+    }
+}
+
+/// Round-off allowance of `line_weights_positive`: the weights are O(1)
+/// and the GPU twin computes them in f32 (a linear particle's node above
+/// the line gets 0 exactly in exact arithmetic, ±1e-7 in f32), so both
+/// decide alike.
+pub const LINE_WEIGHT_EPS: f64 = 1e-6;
+
 /// The walls' forces at their contact points: every particle in contact
 /// with a wall gets a normal force F_n = k pen 2 l_p (penalty) plus its
 /// preload (`contact_spring`), less a damping of its approach, and a
@@ -177,11 +221,14 @@ fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
 /// particle's next velocity without the walls, v_p + `slip_dt` Σ N f_I /
 /// m_I (its slip, v_t, is what must stop: a particle that the nodes' PIC
 /// velocity holds still can still creep by its own), and the tangential
-/// force that stops it is −v_t / w with
-/// w = `slip_dt` Σ N_I S_I / m_I (S_I from `wall_touch`: the neighbours in
-/// contact pull on the same nodes; `slip_dt` the time over which the
-/// particles feel a nodal force, (2 − γ)Δt for NPC, Δt for FE and MUSL),
-/// and the damping's w is the same with γΔt (`gamma_dt`). With preloads,
+/// force that stops it is −v_t / w_t with
+/// w_t = `slip_dt` Σ N_I T_I / m_I (T_I from `wall_touch`: the friction's
+/// weights of every contact, so w_t is the change of the particle's
+/// velocity per unit friction when its neighbours in contact pull alike,
+/// with the weights the friction really goes to the nodes with; `slip_dt`
+/// the time over which the particles feel a nodal force, (2 − γ)Δt for
+/// NPC, Δt for FE and MUSL). The damping's w = γΔt Σ N_I S_I / m_I
+/// (`gamma_dt`; S_I from `wall_touch`, the normal force goes with N). With preloads,
 /// the body's velocity counts the walls' preloads (`pre_force`, from
 /// `wall_touch`). Only the walls that act in the step
 /// starting at `t` (s) push (`Wall::active_at`). The preload's share of
@@ -190,7 +237,10 @@ fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
 /// it goes to the nodes with N_I − d n·∇N_I (the weights there, to first
 /// order; exact for linear shapes across the wall's row of cells), so a
 /// geostatic body's boundary nodes get the load their own forces lack,
-/// not a share of it spread a cell into the body.
+/// not a share of it spread a cell into the body. The friction acts
+/// there too, where those weights have no negative part
+/// (`line_weights_positive`: linear shapes), so a rolling body's torque
+/// about its contact is gravity's alone; elsewhere at the particle.
 #[allow(clippy::too_many_arguments)]
 pub fn wall_contact(
     cache: &ShapeCache,
@@ -199,7 +249,7 @@ pub fn wall_contact(
     force: &[[f64; 2]],
     walls: &Walls,
     t: f64,
-    touch: &[f64],
+    touch: &[[f64; 2]],
     pre_force: &[[f64; 2]],
     wall_force: &mut [[f64; 2]],
     wall_r: &mut [[f64; 2]],
@@ -226,7 +276,7 @@ pub fn wall_contact(
             // damping); vp: the particle's own next velocity (for the
             // friction); both without the walls' contact forces, with
             // their preloads.
-            let (mut v, mut w) = ([0.0; 2], 0.0);
+            let (mut v, mut w, mut wf) = ([0.0; 2], 0.0, 0.0);
             let mut vp = pt.v[p];
             for (&n, wk) in nodes.iter().zip(wt) {
                 let node = &mv[n as usize];
@@ -239,7 +289,8 @@ pub fn wall_contact(
                     v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
                     vp[0] += wk[0] * slip_dt * f[0] / node[0];
                     vp[1] += wk[0] * slip_dt * f[1] / node[0];
-                    w += wk[0] * touch[n as usize] / node[0];
+                    w += wk[0] * touch[n as usize][0] / node[0];
+                    wf += wk[0] * touch[n as usize][1] / node[0];
                 }
             }
             if w <= 0.0 {
@@ -262,8 +313,14 @@ pub fn wall_contact(
             // step it is sized for. Sized on the corrected nodal velocity
             // over γΔt instead, the stick loop's gain was (2 − γ)/γ = 3 and
             // a slip grew (the geostatic column's bottom row: from 1e-16
-            // to 1 m/s in 100 steps).
-            let ws = w / gamma_dt * slip_dt;
+            // to 1 m/s in 100 steps). And with the weights it acts with
+            // (T_I): sized with the particle's (S_I) while it acts on the
+            // line, a stick loop's gain was about 1.28, which left the
+            // held particles a steady slip against their load and a
+            // stick-held slab crept under a block (docs/methods.md,
+            // "Walls"). A point whose nodes carry no friction weight (T
+            // is never negative beyond round-off) falls back on S.
+            let ws = slip_dt * if wf > 0.0 { wf } else { w / gamma_dt };
             let mut ft = [-vt[0] / ws, -vt[1] / ws];
             let mag = ft[0].hypot(ft[1]);
             let cap = mu * fnorm;
@@ -273,16 +330,28 @@ pub fn wall_contact(
             let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
             wall_r[k][0] += fw[0];
             wall_r[k][1] += fw[1];
-            // The preload's share at the wall's line, the rest at the
-            // particle.
+            // The preload's share and the friction at the wall's line, the
+            // rest (the penalty and the damping) at the particle. The
+            // friction acts at the contact (a rolling body's torque about
+            // its contact is then gravity's alone), where the line's
+            // weights are a partition of unity without negative parts
+            // (`line_weights_positive`), else at the particle.
             let f_pre = pre.min(fnorm);
-            let f_at = [fw[0] - f_pre * nrm[0], fw[1] - f_pre * nrm[1]];
             let d = wall_depth(pt.x[p], lp, wl);
+            let ft_line = if line_weights_positive(wt, nrm, d) {
+                ft
+            } else {
+                [0.0; 2]
+            };
+            let f_at = [
+                fw[0] - f_pre * nrm[0] - ft_line[0],
+                fw[1] - f_pre * nrm[1] - ft_line[1],
+            ];
             for (&n, wk) in nodes.iter().zip(wt) {
-                let face = f_pre * face_weight(wk, nrm, d);
+                let face = face_weight(wk, nrm, d);
                 let o = &mut wall_force[n as usize];
-                o[0] += wk[0] * f_at[0] + face * nrm[0];
-                o[1] += wk[0] * f_at[1] + face * nrm[1];
+                o[0] += wk[0] * f_at[0] + face * (f_pre * nrm[0] + ft_line[0]);
+                o[1] += wk[0] * f_at[1] + face * (f_pre * nrm[1] + ft_line[1]);
             }
         }
     }
@@ -445,7 +514,7 @@ mod tests {
             v: &[v],
             gravity: [0.0; 2],
         };
-        let mut touch = [0.0];
+        let mut touch = [[0.0; 2]];
         wall_touch(&cache, &pt, &walls, t, &mut touch, &mut []);
         let mv = [[2.0, v[0], v[1]]];
         let (mut wf, mut r) = ([[0.0; 2]], [[0.0; 2]]);
@@ -495,6 +564,73 @@ mod tests {
         assert!((f[0] + 200.0).abs() < 1e-9, "{f:?}");
         let f = contact([0.3, 0.04], [1.0, 0.0], CONTACT_SLIP, 0.0);
         assert_eq!(f[0], 0.0);
+    }
+
+    /// A stick wall's friction, acting on the wall's line, stops the
+    /// particle's slip in one step: its step is sized with the weights it
+    /// acts with. One particle at y = 0.04 m over a level wall at y = 0
+    /// between a node on the line (N 0.75) and one 0.16 m above it (N
+    /// 0.25), as a linear shape's column: the line's weights are 1 and 0.
+    /// Sized with the particle's weights instead, the friction overshot
+    /// the slip by Σ N T/m ÷ Σ N S/m = 0.75/m_0 ÷ (0.5625/m_0 + 0.0625/m_1).
+    #[test]
+    fn stick_friction_on_the_line_stops_the_slip_in_one_step() {
+        let wall = Wall {
+            name: "w".into(),
+            point: [0.0, 0.0],
+            normal: [0.0, 1.0],
+            contact: CONTACT_STICK,
+            mu: 0.0,
+            nodes: Vec::new(),
+            stiffness: 1e6,
+            offset: 0.0,
+            appear_at: 0.0,
+            remove_at: f64::INFINITY,
+        };
+        let walls = Walls {
+            list: vec![wall],
+            mask: vec![1],
+            preload: Vec::new(),
+        };
+        let mut cache = ShapeCache::new(1, 2);
+        cache.count[0] = 2;
+        cache.nodes[..2].copy_from_slice(&[0, 1]);
+        cache.w[0] = [0.75, 0.0, -1.0 / 0.16];
+        cache.w[1] = [0.25, 0.0, 1.0 / 0.16];
+        let v = [1.0, 0.0];
+        let pt = ContactParticles {
+            x: &[[0.3, 0.04]],
+            mass: &[10.0],
+            rho: &[1000.0],
+            stress: &[[0.0; 3]],
+            v: &[v],
+            gravity: [0.0; 2],
+        };
+        let mut touch = [[0.0; 2]; 2];
+        wall_touch(&cache, &pt, &walls, 0.0, &mut touch, &mut []);
+        assert!((touch[0][1] - 1.0).abs() < 1e-12 && touch[1][1].abs() < 1e-12);
+        let mv = [[1.5, v[0], v[1]], [4.0, v[0], v[1]]];
+        let (mut wf, mut r) = ([[0.0; 2]; 2], [[0.0; 2]]);
+        let slip_dt = 0.015;
+        wall_contact(
+            &cache,
+            &pt,
+            &mv,
+            &[[0.0; 2]; 2],
+            &walls,
+            0.0,
+            &touch,
+            &[],
+            &mut wf,
+            &mut r,
+            0.01,
+            slip_dt,
+            1e-9,
+        );
+        // All the friction on the line's node, none on the other.
+        assert!(wf[1][0].abs() < 1e-9, "{wf:?}");
+        let next = v[0] + slip_dt * (0.75 * wf[0][0] / 1.5 + 0.25 * wf[1][0] / 4.0);
+        assert!(next.abs() < 1e-12, "slip left {next}");
     }
 
     #[test]

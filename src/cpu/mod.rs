@@ -42,8 +42,9 @@ pub struct CpuBackend {
     /// Per constraint group: reaction (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
     /// Per node: the weight of the particles in contact with a wall this
-    /// step (`grid_update::wall_touch`); empty without walls.
-    pub wall_touch: Vec<f64>,
+    /// step and their friction's weight, [S_I, T_I]
+    /// (`grid_update::wall_touch`); empty without walls.
+    pub wall_touch: Vec<[f64; 2]>,
     /// Per node: the walls' forces this step (`grid_update::wall_contact`);
     /// empty without walls.
     pub wall_force: Vec<[f64; 2]>,
@@ -99,7 +100,7 @@ impl CpuBackend {
             wall_touch: if model.walls.is_empty() {
                 Vec::new()
             } else {
-                vec![0.0; nodes]
+                vec![[0.0; 2]; nodes]
             },
             wall_force: if model.walls.is_empty() {
                 Vec::new()

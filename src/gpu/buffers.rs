@@ -67,7 +67,7 @@ pub enum Buf {
     /// Per node: the walls' forces this step (wall_contact.wgsl).
     WallForce,
     /// Per node: the weight of the particles in contact with a wall this
-    /// step (wall_touch.wgsl).
+    /// step and their friction's weight (2 f32: S_I, T_I; wall_touch.wgsl).
     WallTouch,
     /// Per particle and wall: the preload traction of the particles that
     /// start flush with a wall and compressed (`Walls::preload`); only
@@ -417,7 +417,7 @@ fn grid_and_output_data(
             .collect();
         data.push((Buf::Walls, bytemuck::cast_slice(&walls).to_vec()));
         data.push((Buf::WallForce, vec![0u8; 8 * field_nodes]));
-        data.push((Buf::WallTouch, vec![0u8; 4 * field_nodes]));
+        data.push((Buf::WallTouch, vec![0u8; 8 * field_nodes]));
         if !model.walls.preload.is_empty() {
             let pre: Vec<f32> = model.walls.preload.iter().map(|&t| t as f32).collect();
             data.push((Buf::WallPreload, bytemuck::cast_slice(&pre).to_vec()));
