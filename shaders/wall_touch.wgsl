@@ -41,15 +41,49 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #if GATES
     let t = sim.t + sim.t_lo;
 #endif
+    // Per contact, the friction's weights: at the wall's line where none
+    // of them is negative, else the particle's; with WALL_PRELOAD, its
+    // preload P n onto the nodes at the wall's line (weights N − d n·∇N),
+    // which `wall_contact` counts in the body's velocity before it
+    // decides the rest.
     for (var k = 0u; k < arrayLength(&walls); k++) {
-        let w = walls[k];
+        let wl = walls[k];
 #if GATES
-        if t < w.appear_at || t >= w.remove_at {
+        if t < wl.appear_at || t >= wl.remove_at {
             continue;
         }
 #endif
-        if contact_spring(p, k, w, x, lp).x > 0.0 {
-            count += 1u;
+        let sp = contact_spring(p, k, wl, x, lp);
+        if sp.x <= 0.0 {
+            continue;
+        }
+        count += 1u;
+        let c = shape_ctx(p, x);
+        let d = wall_depth(x, lp, wl);
+        let positive = line_weights_positive(c, wl.normal, d);
+        for (var r = 0u; r < SHAPE_ROWS; r++) {
+            let span = shape_span(c, r);
+            for (var s = span.x; s < span.y; s++) {
+                let nw = shape_node(c, s);
+                if !nw.ok {
+                    continue;
+                }
+                let line = nw.n - d * dot(wl.normal, nw.dn);
+                var fw = nw.n;
+                if positive {
+                    fw = line;
+                }
+                if fw != 0.0 {
+                    touch_add(2u * nw.node + 1u, fw);
+                }
+#if WALL_PRELOAD
+                if sp.y > 0.0 {
+                    let f = sp.y * line * wl.normal;
+                    pre_force_add(2u * nw.node, f.x);
+                    pre_force_add(2u * nw.node + 1u, f.y);
+                }
+#endif
+            }
         }
     }
     if count == 0u {
@@ -65,63 +99,4 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
-    // The friction's weights of each contact: at the wall's line where
-    // none of them is negative, else the particle's.
-    for (var k = 0u; k < arrayLength(&walls); k++) {
-        let wl = walls[k];
-#if GATES
-        if t < wl.appear_at || t >= wl.remove_at {
-            continue;
-        }
-#endif
-        if contact_spring(p, k, wl, x, lp).x <= 0.0 {
-            continue;
-        }
-        let d = wall_depth(x, lp, wl);
-        let positive = line_weights_positive(c, wl.normal, d);
-        for (var r = 0u; r < SHAPE_ROWS; r++) {
-            let span = shape_span(c, r);
-            for (var s = span.x; s < span.y; s++) {
-                let nw = shape_node(c, s);
-                if nw.ok {
-                    var fw = nw.n;
-                    if positive {
-                        fw = nw.n - d * dot(wl.normal, nw.dn);
-                    }
-                    if fw != 0.0 {
-                        touch_add(2u * nw.node + 1u, fw);
-                    }
-                }
-            }
-        }
-    }
-#if WALL_PRELOAD
-    // Each contact's preload P n onto the nodes at the wall's line
-    // (weights N − d n·∇N), which `wall_contact` counts in the body's
-    // velocity before it decides the rest.
-    for (var k = 0u; k < arrayLength(&walls); k++) {
-        let wl = walls[k];
-#if GATES
-        if t < wl.appear_at || t >= wl.remove_at {
-            continue;
-        }
-#endif
-        let sp = contact_spring(p, k, wl, x, lp);
-        if sp.x <= 0.0 || sp.y <= 0.0 {
-            continue;
-        }
-        let d = wall_depth(x, lp, wl);
-        for (var r = 0u; r < SHAPE_ROWS; r++) {
-            let span = shape_span(c, r);
-            for (var s = span.x; s < span.y; s++) {
-                let nw = shape_node(c, s);
-                if nw.ok {
-                    let f = sp.y * (nw.n - d * dot(wl.normal, nw.dn)) * wl.normal;
-                    pre_force_add(2u * nw.node, f.x);
-                    pre_force_add(2u * nw.node + 1u, f.y);
-                }
-            }
-        }
-    }
-#endif
 }
