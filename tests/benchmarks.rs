@@ -2,7 +2,7 @@
 //! Dyka's bar (NPC vs FE), the elastic block (LME vs Q4), and the test that
 //! chose the NPC position update.
 
-mod common;
+use crate::common;
 
 use common::{column, dyka_rms, run};
 use lme_mpm::cpu::CpuBackend;

@@ -6,7 +6,7 @@
 //! surcharge and its weight (σ_yy = −p − ρ0 g (H − Y)), and a disk rolling
 //! on friction and stick walls on a grid line.
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;

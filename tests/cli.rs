@@ -2,7 +2,7 @@
 //! writes nothing; an unstable run exits 3 and keeps its outputs; a good run
 //! exits 0 and writes every output file in its documented shape.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -7,7 +7,7 @@
 //! column on the grid's edge, on the CPU and on the GPU; the held velocity
 //! at the points themselves.
 
-mod common;
+use crate::common;
 
 use lme_mpm::exact::Errors;
 use lme_mpm::exact::cantilever::CantileverErrors;

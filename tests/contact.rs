@@ -4,7 +4,7 @@
 //! and the GPU, the single shared field beside it (the block glued), and
 //! two disks colliding (CPU).
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;

@@ -3,7 +3,7 @@
 //! cloud against a difference of the residual, and the static cantilever
 //! with GMM-LME and GMM-MLS against the paper's nonlinear deflection.
 
-mod common;
+use crate::common;
 
 use lme_mpm::cpu::implicit::{ImplicitBackend, Nodes};
 use lme_mpm::exact::Errors;
@@ -510,7 +510,7 @@ fn gmm_rolling_disk_beats_implicit_mpm_at_a_short_end_time() {
 
 /// GMM's rolling disk as `study implicit` runs it (0.5 s, Δt1 = 2 ms =
 /// 2Δt2 = 4Δt3): a measurement for docs/methods.md, not a check.
-/// `cargo test --release --test gmm -- --ignored --nocapture gmm_disk_`
+/// `cargo test --release --test suite -- --ignored --nocapture gmm::gmm_disk_`
 fn gmm_disk_rows(label: &str, keys: &[&str], dts: &[f64]) {
     for dt in dts {
         let d = format!("solver.dt={dt}");

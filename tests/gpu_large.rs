@@ -5,7 +5,7 @@
 //! scene (Mohr–Coulomb: σzz and plastic strains per particle) stays under
 //! the same bound.
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::bench;

@@ -5,7 +5,7 @@
 //! the f32 state read back, so not bit for bit). The CPU twin is checked
 //! byte for byte through the binary in tests/run_safety.rs.
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::{Backend, Sample, State};
 use lme_mpm::gpu::GpuBackend;

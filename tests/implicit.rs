@@ -5,7 +5,7 @@
 //! then reported unstable (exit 3), and the rolling disk on a frictional
 //! wall against its exact motion.
 
-mod common;
+use crate::common;
 
 use common::disk::DiskRun;
 use lme_mpm::cpu::implicit::ImplicitBackend;

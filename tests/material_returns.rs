@@ -5,7 +5,7 @@
 //! must give the same return on both; every GPU return must land on the
 //! yield surface within f32 round-off.
 
-mod common;
+use crate::common;
 
 use lme_mpm::gpu::buffers::gpu_material;
 use lme_mpm::gpu::layout::GpuMaterial;

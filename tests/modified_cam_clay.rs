@@ -11,7 +11,7 @@
 //! the analytical results and the CPU path.
 //!
 
-mod common;
+use crate::common;
 
 use lme_mpm::gpu::preprocess::{Defines, expand_text};
 use lme_mpm::model::material::modified_cam_clay::{

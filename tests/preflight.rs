@@ -4,7 +4,7 @@
 //! they must agree within 25 % (issue 10), on the four cases, a scene
 //! with contact pairs and a 1M-particle scene.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::Command;

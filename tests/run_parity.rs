@@ -5,7 +5,7 @@
 //! agree within the tolerances below, and the GPU's error against the exact
 //! solution (where there is one) must be within 10% of the CPU's.
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::{Backend, Sample};
 use lme_mpm::cpu::CpuBackend;

@@ -9,7 +9,7 @@
 //! followed; leftover `.tmp` files go; a completed run can be extended; an
 //! implicit run with a wall resumes bit for bit.
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

@@ -5,7 +5,7 @@
 //! integrators and MUSL, regular and perturbed grids, both atomic modes, one and two
 //! materials.
 
-mod common;
+use crate::common;
 
 use lme_mpm::backend::Backend;
 use lme_mpm::cpu::CpuBackend;

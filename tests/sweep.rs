@@ -5,7 +5,7 @@
 //! exits 2 before anything runs. Small scenes (Dyka's bar at h = 1 cm, a
 //! few hundred steps), so the file runs in seconds.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
