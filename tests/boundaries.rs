@@ -121,29 +121,67 @@ const SUDDEN_REST_SPEED: f64 = 0.02;
 /// sized with the weights it acts with), 3.08 % with it at the
 /// particles' centres, 2.87 % on the line sized with the particle's
 /// weights (a stick loop that did not hold a slab: docs/methods.md,
-/// "Walls"), so the bound is 3.5 %: the issue's 3 % is just missed (the
-/// block sticks in the peaks of its bounce on the penalty spring, so the
-/// figure moves by tenths of a percent with any change of the rule).
+/// "Walls"), so the bound is 3.5 %: the issue's 3 % is just missed. The
+/// whole excess is the landing (`SUDDEN_LANDING`): the rigid block's a t
+/// is not the elastic block's answer (`exact::sliding`).
 const SUDDEN_SLIDE_TOL: f64 = 0.035;
+/// The end of the block's landing on its floor (s): by then its bounce
+/// on the wall has died down (mean normal speed 2e-4 m/s at 0.1 s, 0.11
+/// m/s at 0.03 s).
+const SUDDEN_LANDING: f64 = 0.1;
+/// How far the Coulomb invariant v_t + μ v_n may grow from a (relative)
+/// between the landing and 0.5 s: it grows at a exactly while every
+/// contact point slides with friction μ N (`exact::sliding`), and the
+/// step's momentum balance is exact, so the measured −2.1e-15
+/// (2026-11-27) is round-off; 1e-6 fails a contact point that sticks for
+/// one step of the 0.4 s.
+const COULOMB_SLOPE_TOL: f64 = 1e-6;
 
-#[test]
-fn suddenly_loaded_block_rests_or_slides_as_coulomb_says() {
-    for mu in ["0.7", "1.0", "0.5"] {
-        let set = format!("walls.floor.friction={mu}");
-        let scene = scene_of(SUDDEN_BLOCK, &[set.as_str()]);
-        let model = Model::new(&scene).unwrap();
-        let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
-        let e = sliding(&mut sim);
-        println!("sudden block mu = {mu}: {e:?}");
-        if e.velocity_exact > 0.0 {
-            assert!(e.velocity_rel_error < SUDDEN_SLIDE_TOL, "mu {mu}: {e:?}");
-        } else {
-            assert!(e.velocity.abs() < SUDDEN_REST_SPEED, "mu {mu}: {e:?}");
-        }
-    }
+/// The suddenly loaded block at μ = `mu` to `t_end` (s), scored.
+fn sudden_block(mu: &str, t_end: f64) -> SlidingErrors {
+    let sets = [
+        format!("walls.floor.friction={mu}"),
+        format!("solver.t_end={t_end}"),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let scene = scene_of(SUDDEN_BLOCK, &sets);
+    let model = Model::new(&scene).unwrap();
+    let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
+    sliding(&mut sim)
 }
 
-/// The sliding block on the GPU, both geometries, sliding and at rest.
+/// At rest for μ > tan θ; for μ = 0.5 two checks. The friction law: after
+/// the landing, v_t + μ v_n grows at a = g (sin θ − μ cos θ) within
+/// `COULOMB_SLOPE_TOL` (every contact slides with friction μ N). The
+/// issue's figure: v_t at 0.5 s within `SUDDEN_SLIDE_TOL` of a t; what it
+/// misses is the friction the base did not use while it stuck at the
+/// peak of the landing (v_t + μ v_n − a t: 1.0e-2 m/s from 0.08 s on,
+/// 2e-4 at 0.01 s), which a rigid block has no part in and an elastic
+/// one, ringing undamped, makes far larger (`exact::sliding`).
+#[test]
+fn suddenly_loaded_block_rests_or_slides_as_coulomb_says() {
+    for mu in ["0.7", "1.0"] {
+        let e = sudden_block(mu, 0.5);
+        println!("sudden block mu = {mu}: {e:?}");
+        assert!(e.velocity_exact == 0.0);
+        assert!(e.velocity.abs() < SUDDEN_REST_SPEED, "mu {mu}: {e:?}");
+    }
+    let landed = sudden_block("0.5", SUDDEN_LANDING);
+    let e = sudden_block("0.5", 0.5);
+    println!("sudden block mu = 0.5 at {SUDDEN_LANDING} s: {landed:?}");
+    println!("sudden block mu = 0.5: {e:?}");
+    let slope = (e.coulomb_velocity - landed.coulomb_velocity)
+        / ((0.5 - SUDDEN_LANDING) * e.acceleration_exact)
+        - 1.0;
+    println!(
+        "v_t + mu v_n grows at a (1 {slope:+.2e}) after the landing; \
+         it is {:.3e} m/s ahead of a t at 0.5 s",
+        e.coulomb_velocity - e.velocity_exact
+    );
+    assert!(slope.abs() < COULOMB_SLOPE_TOL, "{slope}");
+    assert!(e.velocity_rel_error < SUDDEN_SLIDE_TOL, "{e:?}");
+}
+
 #[test]
 fn sliding_block_matches_exact_on_gpu() {
     for (case, wall) in [

@@ -127,6 +127,7 @@ fn block_exact(mu: f64) -> SlidingBlock {
     let th = 30f64.to_radians();
     SlidingBlock {
         tangent: [1.0, 0.0],
+        normal: [0.0, 1.0],
         g_tangential: 9.81 * th.sin(),
         g_normal: 9.81 * th.cos(),
         mu,
