@@ -601,7 +601,15 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
         ),
         Shape::Ugimp(u) => format!("ugimp (lp = {:.4} h)", u.lp_h),
         Shape::Linear => "linear".to_string(),
-        Shape::Bspline(b) => format!("B-spline of degree {} (open knots)", b.degree),
+        Shape::Bspline(b) => format!(
+            "B-spline of degree {} (open knots, {})",
+            b.degree,
+            if b.cells {
+                "on the grid lines: solver.bspline_knots = \"cells\""
+            } else {
+                "interior ones mid-cell for degree 2, on the nodes for 3"
+            }
+        ),
     };
     let shape = if model.mls {
         format!(

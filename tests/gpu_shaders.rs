@@ -151,6 +151,10 @@ fn variants() -> Vec<Variant> {
                                             && !(multi_material && atomics == AtomicMode::Float),
                                         // The recursion B-splines take on small grids.
                                         bspline_small_grid: multi_material,
+                                        // The knots on the grid lines, with the
+                                        // manufactured solution (the paper's
+                                        // layout for its study).
+                                        bspline_cells: mms,
                                         // Per-bin scatter where it applies and
                                         // the variant does not gather.
                                         // (LME on any grid.)

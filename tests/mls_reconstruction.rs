@@ -186,7 +186,10 @@ fn cosine_fit_error_falls_as_h_squared() {
         // ρ = 2 + cos(kx): positive, so the fit is the paper's density fit.
         let rho: Vec<f64> = x.iter().map(|p| 2.0 + (k * p[0]).cos()).collect();
         let v = vec![[0.0; 2]; x.len()];
-        let shape = Shape::Bspline(Bspline { degree: 2 });
+        let shape = Shape::Bspline(Bspline {
+            degree: 2,
+            cells: false,
+        });
         let mut mls = Mls::new(&shape, &grid, x.len()).unwrap();
         let mut mv = vec![[0.0; 3]; grid.n_nodes()];
         mls.p2g(&grid, &x, &rho, &v, &[], 0.0, &mut mv).unwrap();
@@ -294,7 +297,7 @@ fn projection_at(shape: &str, mls: bool, cells: usize, t: f64, support: f64) -> 
     for i in 3..n - 3 {
         let node = g.index(i, row);
         let a = cpu.force[node][0] / cpu.mv[node][0];
-        let xg = greville(i, n, degree) * g.h;
+        let xg = greville(i, n, degree, 0.0) * g.h;
         let exact = -omega * omega * field.displacement([reference(xg), 0.0], t)[0];
         peak = peak.max(exact.abs());
         sum += (a - exact).powi(2);

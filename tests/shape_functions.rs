@@ -317,10 +317,13 @@ fn bsplines_satisfy_the_identities_inside_and_at_the_open_knot_boundary() {
     // next to it), so reproduction is checked against those.
     use lme_mpm::model::shape::bspline::{Bspline, greville};
     let g = grid(0.0);
-    for degree in [2, 3] {
-        let shape = Shape::Bspline(Bspline { degree });
+    for (degree, cells) in [(2, false), (3, false), (2, true), (3, true)] {
+        let b = Bspline { degree, cells };
+        let e = b.end();
+        let shape = Shape::Bspline(b);
         let mut worst = [0.0f64; 4];
-        for x in points(&g, 0.0, 400, 23) {
+        // The cells layout's bases live e cells inside its nodes.
+        for x in points(&g, e * g.h, 400, 23) {
             let mut nodes = vec![0u32; shape.max_nodes()];
             let mut w = vec![[0.0; 3]; shape.max_nodes()];
             let n = shape
@@ -330,8 +333,8 @@ fn bsplines_satisfy_the_identities_inside_and_at_the_open_knot_boundary() {
             for k in 0..n {
                 let node = nodes[k] as usize;
                 let xa = [
-                    g.min[0] + g.h * greville(node % g.nx, g.nx, degree),
-                    g.min[1] + g.h * greville(node / g.nx, g.ny, degree),
+                    g.min[0] + g.h * greville(node % g.nx, g.nx, degree, e),
+                    g.min[1] + g.h * greville(node / g.nx, g.ny, degree, e),
                 ];
                 assert!(w[k][0] >= -TOL_CLOSED);
                 s += w[k][0];
@@ -363,5 +366,47 @@ fn bsplines_satisfy_the_identities_inside_and_at_the_open_knot_boundary() {
         {
             assert!(w <= TOL_CLOSED, "bspline{degree}: {name} error {w:.3e}");
         }
+    }
+}
+
+/// `solver.bspline_knots` is read with B-splines only; a bad value or the
+/// key beside another shape is refused with exit 2 naming it.
+#[test]
+fn bspline_knots_are_checked_naming_the_key() {
+    use lme_mpm::scene::{Override, Scene};
+    let case = crate::common::case("aligned_vibration.toml");
+    for (set, key) in [
+        (
+            ["solver.shape=lme", "solver.bspline_knots=cells"],
+            "solver.bspline_knots",
+        ),
+        (
+            ["solver.shape=bspline2", "solver.bspline_knots=grid"],
+            "unknown variant `grid`",
+        ),
+    ] {
+        let o: Vec<Override> = set.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let e = Scene::load(&case, &o)
+            .err()
+            .unwrap_or_else(|| panic!("{set:?} was accepted"));
+        let msg = e.to_string();
+        assert!(msg.contains(key), "{set:?}: {msg}");
+        assert_eq!(lme_mpm::Error::from(e).exit_code(), 2);
+    }
+    for shape in ["bspline2", "bspline3"] {
+        let set = [
+            format!("solver.shape={shape}"),
+            "solver.bspline_knots=cells".into(),
+        ];
+        let o: Vec<Override> = set.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let scene = Scene::load(&case, &o).unwrap();
+        let m = lme_mpm::model::Model::new(&scene).unwrap();
+        // 16 cells: 16 + p bases per direction, the nodes shifted out by (p − 1)/2 cells.
+        let p = if shape == "bspline2" { 2 } else { 3 };
+        assert_eq!(m.grid.nx, 16 + p, "{shape}");
+        assert!(
+            (m.grid.min[0] + 0.5 * (p - 1) as f64 * m.grid.h).abs() < 1e-12,
+            "{shape}"
+        );
     }
 }

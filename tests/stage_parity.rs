@@ -280,7 +280,11 @@ fn random_model_of(text: &str, sets: &[&str], seed: u64) -> Model {
     } else {
         0.0
     };
-    let margin = m.shape.edge_margin() + 1e-3 * g.h + lattice;
+    let margin = m.shape.edge_margin(g.h) + 1e-3 * g.h + lattice;
+    let e = match &m.shape {
+        lme_mpm::model::shape::Shape::Bspline(b) => b.end(),
+        _ => 0.0,
+    };
     let (lo, hi) = (g.min, g.max());
     let mut rng = SplitMix64::new(seed);
     let p = &mut m.particles;
@@ -291,9 +295,22 @@ fn random_model_of(text: &str, sets: &[&str], seed: u64) -> Model {
             rng.range(lo[1] + margin, hi[1] - margin),
         ];
         match i % 8 {
-            // On a vertical and on a horizontal grid line.
-            1 => x[0] = lo[0] + g.h * (x[0] / g.h).round().clamp(1.0, (g.nx - 2) as f64),
-            2 => x[1] = lo[1] + g.h * (x[1] / g.h).round().clamp(1.0, (g.ny - 2) as f64),
+            // On a vertical and on a horizontal grid line (knot line: the
+            // cells layout's lie e cells off its shifted nodes).
+            1 => {
+                x[0] = lo[0]
+                    + g.h
+                        * (e + ((x[0] - lo[0]) / g.h - e)
+                            .round()
+                            .clamp(1.0, g.nx as f64 - 2.0 - 2.0 * e))
+            }
+            2 => {
+                x[1] = lo[1]
+                    + g.h
+                        * (e + ((x[1] - lo[1]) / g.h - e)
+                            .round()
+                            .clamp(1.0, g.ny as f64 - 2.0 - 2.0 * e))
+            }
             // Just inside the grid's edge.
             3 => x[0] = lo[0] + margin,
             4 => x[1] = hi[1] - margin,
@@ -946,6 +963,35 @@ fn stages_match_bspline() {
         &["solver.shape=bspline2", "materials.m.model=neo_hookean"],
         false,
     );
+    // The paper's layout: knots on the grid lines, nodes shifted out.
+    cells_parity(
+        "bspline2 npc, knots on the cells",
+        &["solver.shape=bspline2"],
+    );
+    cells_parity(
+        "bspline3 fe, knots on the cells",
+        &["solver.shape=bspline3", "solver.integrator=fe"],
+    );
+}
+
+/// SCENE with `solver.bspline_knots = "cells"`, whose quadratic nodes sit
+/// at the cell midpoints: the pin widened to a box that holds nodes in
+/// either layout.
+fn cells_parity(label: &str, sets: &[&str]) {
+    let text = SCENE.replace(
+        "min = [2.0, 1.0]\nmax = [2.0, 2.0]",
+        "min = [1.75, 1.0]\nmax = [2.25, 2.0]",
+    );
+    assert_ne!(text, SCENE, "SCENE's pin moved");
+    let mut all = sets.to_vec();
+    all.push("solver.bspline_knots=cells");
+    parity_of(
+        label,
+        random_model_of(&text, &all, 42),
+        false,
+        GpuOptions::default(),
+        0.0,
+    );
 }
 
 #[test]
@@ -954,6 +1000,10 @@ fn stages_match_mls() {
         "bspline2 npc mls",
         &["solver.shape=bspline2", "solver.mls=true"],
         false,
+    );
+    cells_parity(
+        "bspline2 npc mls, knots on the cells",
+        &["solver.shape=bspline2", "solver.mls=true"],
     );
     parity(
         "bspline3 fe mls, neo-hookean",

@@ -19,8 +19,13 @@ fn mls_weight(r: f32) -> f32 {
     return 0.0;
 }
 
-// Break k of `spans` integration cells along an axis of n nodes (lattice units).
+// Break k of `spans` integration cells along an axis of n nodes (lattice
+// units): the distinct knots (`model::gauss::breaks`). The cells layout's
+// are e, e + 1, …, n − 1 − e, with e = mls_break_off.
 fn mls_break(k: u32, spans: u32, n: u32) -> f32 {
+#if BSPLINE_CELLS
+    return f32(k) + params.mls_break_off;
+#endif
     if k == 0u {
         return 0.0;
     }

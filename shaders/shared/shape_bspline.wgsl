@@ -1,18 +1,25 @@
 // Tensor-product B-splines of degree BSPLINE_P (2 or 3) by Cox-de Boor, with
 // open knot vectors at the grid's edge, one basis function per node:
-// t_k = 0 for k ≤ p, n − 1 for k ≥ n, k − (p + 1)/2 between (lattice units).
-// CPU twin: src/shape/bspline.rs.
+// t_k = e for k ≤ p, n − 1 − e for k ≥ n, k − (p + 1)/2 between (lattice
+// units), e = BSPLINE_END: 0, or (p − 1)/2 for the `cells` layout (knots on
+// the scene's grid lines, on a node lattice shifted out by e).
+// CPU twin: src/model/shape/bspline.rs.
 
 const BSPLINE_P: i32 = {{BSPLINE_DEGREE}};
+#if BSPLINE_CELLS
+const BSPLINE_END: f32 = 0.5 * f32(BSPLINE_P - 1);
+#else
+const BSPLINE_END: f32 = 0.0;
+#endif
 const STENCIL: u32 = u32((BSPLINE_P + 1) * (BSPLINE_P + 1));
 const SHAPE_WIDTH: u32 = u32(BSPLINE_P + 1);
 
 fn bs_knot(k: i32, n: u32) -> f32 {
     if k <= BSPLINE_P {
-        return 0.0;
+        return BSPLINE_END;
     }
     if k >= i32(n) {
-        return f32(n - 1u);
+        return f32(n - 1u) - BSPLINE_END;
     }
     return f32(k) - 0.5 * f32(BSPLINE_P + 1);
 }
@@ -45,18 +52,33 @@ fn bs_basis(u: f32, n: u32) -> Basis1 {
     var nb: vec4<f32>;
     var dn: vec4<f32>;
     if BSPLINE_P == 2 {
+#if BSPLINE_CELLS
+        // The cells layout: only the first span differs from the interior.
+        let k0 = bs_pick2(row, vec4<f32>(1.0 / 4.0, 5.0 / 8.0, 1.0 / 8.0, 0.0), vec4<f32>(1.0 / 8.0, 3.0 / 4.0, 1.0 / 8.0, 0.0), vec4<f32>(1.0 / 8.0, 3.0 / 4.0, 1.0 / 8.0, 0.0));
+        let k1 = bs_pick2(row, vec4<f32>(-1.0, 1.0 / 2.0, 1.0 / 2.0, 0.0), vec4<f32>(-1.0 / 2.0, 0.0, 1.0 / 2.0, 0.0), vec4<f32>(-1.0 / 2.0, 0.0, 1.0 / 2.0, 0.0));
+        let k2 = bs_pick2(row, vec4<f32>(1.0, -3.0 / 2.0, 1.0 / 2.0, 0.0), vec4<f32>(1.0 / 2.0, -1.0, 1.0 / 2.0, 0.0), vec4<f32>(1.0 / 2.0, -1.0, 1.0 / 2.0, 0.0));
+#else
         let k0 = bs_pick2(row, vec4<f32>(1.0 / 9.0, 28.0 / 45.0, 4.0 / 15.0, 0.0), vec4<f32>(1.0 / 10.0, 31.0 / 40.0, 1.0 / 8.0, 0.0), vec4<f32>(1.0 / 8.0, 3.0 / 4.0, 1.0 / 8.0, 0.0));
         let k1 = bs_pick2(row, vec4<f32>(-4.0 / 9.0, -4.0 / 45.0, 8.0 / 15.0, 0.0), vec4<f32>(-2.0 / 5.0, -1.0 / 10.0, 1.0 / 2.0, 0.0), vec4<f32>(-1.0 / 2.0, 0.0, 1.0 / 2.0, 0.0));
         let k2 = bs_pick2(row, vec4<f32>(4.0 / 9.0, -32.0 / 45.0, 4.0 / 15.0, 0.0), vec4<f32>(2.0 / 5.0, -9.0 / 10.0, 1.0 / 2.0, 0.0), vec4<f32>(1.0 / 2.0, -1.0, 1.0 / 2.0, 0.0));
+#endif
         nb = k0 + c * (k1 + c * k2);
         dn = k1 + 2.0 * c * k2;
         nb = select(nb, nb.zyxw, right);
         dn = select(dn, -dn.zyxw, right);
     } else {
+#if BSPLINE_CELLS
+        // The cells layout: the first two spans differ from the interior.
+        let k0 = bs_pick3(row, vec4<f32>(1.0 / 8.0, 19.0 / 32.0, 25.0 / 96.0, 1.0 / 48.0), vec4<f32>(1.0 / 32.0, 15.0 / 32.0, 23.0 / 48.0, 1.0 / 48.0), vec4<f32>(1.0 / 48.0, 23.0 / 48.0, 23.0 / 48.0, 1.0 / 48.0), vec4<f32>(1.0 / 48.0, 23.0 / 48.0, 23.0 / 48.0, 1.0 / 48.0));
+        let k1 = bs_pick3(row, vec4<f32>(-3.0 / 4.0, -3.0 / 16.0, 13.0 / 16.0, 1.0 / 8.0), vec4<f32>(-3.0 / 16.0, -9.0 / 16.0, 5.0 / 8.0, 1.0 / 8.0), vec4<f32>(-1.0 / 8.0, -5.0 / 8.0, 5.0 / 8.0, 1.0 / 8.0), vec4<f32>(-1.0 / 8.0, -5.0 / 8.0, 5.0 / 8.0, 1.0 / 8.0));
+        let k2 = bs_pick3(row, vec4<f32>(3.0 / 2.0, -15.0 / 8.0, 1.0 / 8.0, 1.0 / 4.0), vec4<f32>(3.0 / 8.0, -3.0 / 8.0, -1.0 / 4.0, 1.0 / 4.0), vec4<f32>(1.0 / 4.0, -1.0 / 4.0, -1.0 / 4.0, 1.0 / 4.0), vec4<f32>(1.0 / 4.0, -1.0 / 4.0, -1.0 / 4.0, 1.0 / 4.0));
+        let k3 = bs_pick3(row, vec4<f32>(-1.0, 7.0 / 4.0, -11.0 / 12.0, 1.0 / 6.0), vec4<f32>(-1.0 / 4.0, 7.0 / 12.0, -1.0 / 2.0, 1.0 / 6.0), vec4<f32>(-1.0 / 6.0, 1.0 / 2.0, -1.0 / 2.0, 1.0 / 6.0), vec4<f32>(-1.0 / 6.0, 1.0 / 2.0, -1.0 / 2.0, 1.0 / 6.0));
+#else
         let k0 = bs_pick3(row, vec4<f32>(1.0 / 64.0, 21.0 / 64.0, 33.0 / 64.0, 9.0 / 64.0), vec4<f32>(1.0 / 72.0, 211.0 / 576.0, 115.0 / 192.0, 1.0 / 48.0), vec4<f32>(1.0 / 64.0, 31.0 / 64.0, 23.0 / 48.0, 1.0 / 48.0), vec4<f32>(1.0 / 48.0, 23.0 / 48.0, 23.0 / 48.0, 1.0 / 48.0));
         let k1 = bs_pick3(row, vec4<f32>(-3.0 / 32.0, -15.0 / 32.0, 9.0 / 32.0, 9.0 / 32.0), vec4<f32>(-1.0 / 12.0, -49.0 / 96.0, 15.0 / 32.0, 1.0 / 8.0), vec4<f32>(-3.0 / 32.0, -21.0 / 32.0, 5.0 / 8.0, 1.0 / 8.0), vec4<f32>(-1.0 / 8.0, -5.0 / 8.0, 5.0 / 8.0, 1.0 / 8.0));
         let k2 = bs_pick3(row, vec4<f32>(3.0 / 16.0, -1.0 / 16.0, -5.0 / 16.0, 3.0 / 16.0), vec4<f32>(1.0 / 6.0, -5.0 / 48.0, -5.0 / 16.0, 1.0 / 4.0), vec4<f32>(3.0 / 16.0, -3.0 / 16.0, -1.0 / 4.0, 1.0 / 4.0), vec4<f32>(1.0 / 4.0, -1.0 / 4.0, -1.0 / 4.0, 1.0 / 4.0));
         let k3 = bs_pick3(row, vec4<f32>(-1.0 / 8.0, 19.0 / 72.0, -13.0 / 72.0, 1.0 / 24.0), vec4<f32>(-1.0 / 9.0, 23.0 / 72.0, -3.0 / 8.0, 1.0 / 6.0), vec4<f32>(-1.0 / 8.0, 11.0 / 24.0, -1.0 / 2.0, 1.0 / 6.0), vec4<f32>(-1.0 / 6.0, 1.0 / 2.0, -1.0 / 2.0, 1.0 / 6.0));
+#endif
         nb = k0 + c * (k1 + c * (k2 + c * k3));
         dn = k1 + c * (2.0 * k2 + 3.0 * c * k3);
         nb = select(nb, nb.wzyx, right);
@@ -140,9 +162,9 @@ struct ShapeCtx {
 fn shape_ctx(p: u32, x: vec2<f32>) -> ShapeCtx {
     let q = x * params.inv_h;
 #if CONTACT
-    return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, 0.0), field_base(p));
+    return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, params.edge_margin), field_base(p));
 #else
-    return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, 0.0));
+    return ShapeCtx(bs_basis(q.x, params.nx), bs_basis(q.y, params.ny), inside_grid(x, params.edge_margin));
 #endif
 }
 

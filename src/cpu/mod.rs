@@ -542,7 +542,7 @@ impl CpuBackend {
                     dt: self.dt,
                     integrator: m.integrator,
                     mass_eps: self.mass_eps,
-                    edge_margin: m.shape.edge_margin(),
+                    edge_margin: m.shape.edge_margin(m.grid.h),
                     pic_fraction: m.pic_fraction,
                 };
                 g2p::g2p(

@@ -393,7 +393,7 @@ pub fn params(model: &Model) -> Params {
         ramp_period,
         npc_gamma: gamma as f32,
         p2g_accel: p2g_accel as f32,
-        edge_margin: model.shape.edge_margin() as f32,
+        edge_margin: model.shape.edge_margin(g.h) as f32,
         grid_w: ((g.nx - 1) as f64 * g.h) as f32,
         grid_hgt: ((g.ny - 1) as f64 * g.h) as f32,
         lme_beta,

@@ -117,6 +117,9 @@ pub struct Variant {
     /// B-splines on a grid too small for the edge tables
     /// (`bspline::table_fits`): the open-knot recursion instead.
     pub bspline_small_grid: bool,
+    /// B-splines with their knots on the grid lines
+    /// (`solver.bspline_knots = "cells"`, BSPLINE_CELLS).
+    pub bspline_cells: bool,
     /// `p2g` and `forces` (and the fused `StressForces`) scatter per bin of
     /// particles that share their stencil's anchor, summing in registers
     /// before the atomics (PATCH): linear and B-splines on a regular grid,
@@ -169,6 +172,7 @@ impl Variant {
                 }
                 _ => false,
             },
+            bspline_cells: matches!(&model.shape, Shape::Bspline(b) if b.cells),
         }
     }
 
@@ -223,6 +227,7 @@ impl Variant {
             .flag("CONTACT", self.contact.is_some())
             .flag("CONSTRAINT_POINTS", self.points.is_some())
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
+            .flag("BSPLINE_CELLS", self.bspline_cells)
             .flag("MUSL", self.integrator == Integrator::Musl);
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
@@ -622,6 +627,7 @@ mod tests {
                                 ext_force: mms,
                                 gather: false,
                                 bspline_small_grid: perturbed,
+                                bspline_cells: mms,
                                 patch: false,
                                 contact: None,
                                 points: None,

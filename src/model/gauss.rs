@@ -11,9 +11,9 @@ use crate::model::shape::Shape;
 pub fn breaks(shape: &Shape, n: usize) -> Vec<f64> {
     match shape {
         Shape::Bspline(b) => {
-            let p = b.degree;
+            let (p, e) = (b.degree, b.end());
             let mut out: Vec<f64> = (0..(n + p + 1) as i64)
-                .map(|k| crate::model::shape::bspline::knot(k, n, p))
+                .map(|k| crate::model::shape::bspline::knot(k, n, p, e))
                 .collect();
             out.dedup();
             out

@@ -257,7 +257,7 @@ impl Model {
 
         let grid = Grid::regular(h, lo, nx, ny).perturbed(f.grid.perturb, f.grid.seed);
 
-        check_inside(&grid, &seeds, &body_names, shape.edge_margin())?;
+        check_inside(&grid, &seeds, &body_names, shape.edge_margin(h))?;
 
         let body_material: Vec<u32> = scene
             .bodies()
@@ -515,6 +515,18 @@ pub fn grid_extent(scene: &Scene, shape: &Shape) -> Result<GridExtent, SceneErro
             "grid.max",
             "the grid must span at least one cell",
         ));
+    }
+    // The B-spline paper's knots on the grid lines: n_c + p bases over n_c
+    // cells, whose Greville points lie e = (p − 1)/2 cells out from the
+    // lines' lattice (`model::shape::bspline`).
+    if let Shape::Bspline(b) = shape {
+        let e = b.end() * h;
+        let extra = b.extra_nodes();
+        return Ok(GridExtent {
+            lo: [lo[0] - e, lo[1] - e],
+            nx: nx + extra,
+            ny: ny + extra,
+        });
     }
     Ok(GridExtent { lo, nx, ny })
 }

@@ -541,6 +541,12 @@ pub struct SolverSpec {
     /// "MLS as a force correction"). Default `all`.
     #[serde(default)]
     pub mls_scope: MlsScope,
+    /// Where the B-splines' knots sit (`bspline2`, `bspline3` only):
+    /// `midpoints` (the default; one basis per grid node) or `cells` (the
+    /// B-spline paper's Fig. 1: knots on the grid lines, n + p bases over
+    /// n cells). None when the scene does not say.
+    #[serde(default)]
+    pub bspline_knots: Option<BsplineKnots>,
     /// Share α of PIC in the particle velocity update, in [0, 1]:
     /// v_p ← (1 − α) v_FLIP + α v_PIC (explicit integrators). Default 0
     /// (pure FLIP).
@@ -551,6 +557,22 @@ pub struct SolverSpec {
     /// integrators). Default 0 (none).
     #[serde(default)]
     pub local_damping: f64,
+}
+
+/// Where the B-splines' knots sit (`solver.bspline_knots`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BsplineKnots {
+    /// Quadratic: interior knots at the cell midpoints, end spans 1.5
+    /// cells; cubic: at the nodes, end spans 2 cells. One basis per grid
+    /// node, its Greville point the node (away from the edge).
+    #[default]
+    Midpoints,
+    /// The paper's: a knot on every grid line, so the knot spans are the
+    /// cells; n + p bases over n cells per direction, their Greville
+    /// points the cell midpoints (quadratic) or the nodes (cubic), and
+    /// the ends.
+    Cells,
 }
 
 /// What the MLS fit reconstructs (`solver.mls_scope`).

@@ -921,6 +921,12 @@ fn check_solver_options(file: &SceneFile) -> Result<(), SceneError> {
             "needs a regular grid (grid.perturb = 0): its Gauss points sit in the grid's rectangular cells",
         ));
     }
+    if s.bspline_knots.is_some() && !matches!(s.shape, ShapeKind::Bspline2 | ShapeKind::Bspline3) {
+        return Err(SceneError::invalid(
+            "solver.bspline_knots",
+            "is only read with shape = \"bspline2\" or \"bspline3\"; drop it or choose a B-spline",
+        ));
+    }
     Ok(())
 }
 

@@ -2,13 +2,24 @@
 //! vectors at the grid's edge, one basis function per grid node.
 //!
 //! Per direction, over n nodes the knot vector (in lattice units) is
-//! t_k = 0 for k ≤ p, t_k = n − 1 for k ≥ n, and t_k = k − (p + 1)/2 in
-//! between: quadratic interior knots at cell midpoints, cubic ones at the
-//! nodes. That is the usual uniform B-spline space, clamped at both ends so
-//! the first and last basis functions interpolate the boundary (a fixed
-//! boundary node fixes the boundary exactly, and no ghost nodes are needed).
-//! The basis "positions" that reproduce linear fields are the Greville
-//! abscissae (`greville`), which equal the nodes away from the edge.
+//! t_k = e for k ≤ p, t_k = n − 1 − e for k ≥ n, and t_k = k − (p + 1)/2
+//! in between: quadratic interior knots at cell midpoints, cubic ones at
+//! the nodes. That is the usual uniform B-spline space, clamped at both
+//! ends so the first and last basis functions interpolate the boundary (a
+//! fixed boundary node fixes the boundary exactly, and no ghost nodes are
+//! needed). The basis "positions" that reproduce linear fields are the
+//! Greville abscissae (`greville`), which equal the nodes away from the
+//! edge.
+//!
+//! The end offset e (`Bspline::end`) sets where the clamped ends sit:
+//! - `midpoints` layout (`solver.bspline_knots`, the default): e = 0, the
+//!   ends on the first and last nodes, end spans of (p + 1)/2 cells;
+//! - `cells` layout (the B-spline paper's Fig. 1): e = (p − 1)/2, on a
+//!   node lattice shifted out by e cells with p − 1 more nodes per
+//!   direction (`Model::new`): then every knot span is one cell of the
+//!   scene's grid (knots on its lines), n_c + p bases over n_c cells, and
+//!   the bases live on the cells' extent, e cells inside the nodes'.
+//!
 //! WGSL twin: `shaders/shared/shape_bspline.wgsl`.
 
 use super::ShapeFault;
@@ -21,15 +32,19 @@ pub const MAX_DEGREE: usize = 3;
 pub struct Bspline {
     /// 2 (quadratic) or 3 (cubic).
     pub degree: usize,
+    /// The knots on the grid lines (`solver.bspline_knots = "cells"`)
+    /// rather than at the midpoints layout.
+    pub cells: bool,
 }
 
-/// Knot t_k in lattice units for `n` basis functions of degree `p`.
+/// Knot t_k in lattice units for `n` basis functions of degree `p`, the
+/// clamped ends `e` lattice units inside the first and last nodes.
 #[inline]
-pub fn knot(k: i64, n: usize, p: usize) -> f64 {
+pub fn knot(k: i64, n: usize, p: usize, e: f64) -> f64 {
     if k <= p as i64 {
-        0.0
+        e
     } else if k >= n as i64 {
-        (n - 1) as f64
+        (n - 1) as f64 - e
     } else {
         k as f64 - 0.5 * (p as f64 + 1.0)
     }
@@ -37,8 +52,8 @@ pub fn knot(k: i64, n: usize, p: usize) -> f64 {
 
 /// Greville abscissa of basis `i` (lattice units): the point whose linear
 /// function value the basis carries (Σ_i g_i N_i(u) = u).
-pub fn greville(i: usize, n: usize, p: usize) -> f64 {
-    (1..=p).map(|k| knot((i + k) as i64, n, p)).sum::<f64>() / p as f64
+pub fn greville(i: usize, n: usize, p: usize, e: f64) -> f64 {
+    (1..=p).map(|k| knot((i + k) as i64, n, p, e)).sum::<f64>() / p as f64
 }
 
 /// The p + 1 nonzero basis functions at `u` (lattice units, in [0, n − 1])
@@ -52,14 +67,19 @@ pub fn greville(i: usize, n: usize, p: usize) -> f64 {
 /// open-knot recursion (`open_basis`). All give the same functions (equal
 /// to round-off, tested below).
 #[inline]
-pub fn basis(u: f64, n: usize, p: usize) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+pub fn basis(
+    u: f64,
+    n: usize,
+    p: usize,
+    e: f64,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
     let s = span(u, n, p);
     if s > 2 * p && s + p + 2 <= n {
         uniform_basis(u, s, p)
     } else if table_fits(n, p) {
-        table_basis(u, s, n, p)
+        table_basis(u, s, n, p, e)
     } else {
-        open_basis(u, s, n, p)
+        open_basis(u, s, n, p, e)
     }
 }
 
@@ -77,7 +97,9 @@ pub fn table_fits(n: usize, p: usize) -> bool {
 /// the clamped knots), row p is every interior span (the cardinal
 /// B-splines); the right edge is the left one mirrored (N_i(u) =
 /// N_{n−1−i}(n − 1 − u)). Derived from the Cox-de Boor recursion in exact
-/// rationals; the WGSL twin (`bs_basis`) holds the same numbers.
+/// rationals; the WGSL twin (`bs_basis`) holds the same numbers. The
+/// `cells` layout (e = (p − 1)/2) has its own edge rows
+/// (`BSPLINE2_CELLS_TABLE`, `BSPLINE3_CELLS_TABLE`).
 const BSPLINE2_TABLE: [[[f64; 3]; 3]; 3] = [
     // s = 2: knots 0, 0, 0, 3/2, 5/2, 7/2
     [
@@ -130,6 +152,40 @@ const BSPLINE3_TABLE: [[[f64; 4]; 4]; 4] = [
     ],
 ];
 
+/// The `cells` layout's rows (knots e, e, e, e + 1, e + 2, … with
+/// e = 1/2): only the first span differs from the interior.
+const BSPLINE2_CELLS_TABLE: [[[f64; 3]; 3]; 3] = [
+    // s = 2: knots 1/2, 1/2, 1/2, 3/2, 5/2, 7/2
+    [
+        [1.0 / 4.0, 5.0 / 8.0, 1.0 / 8.0],
+        [-1.0, 1.0 / 2.0, 1.0 / 2.0],
+        [1.0, -3.0 / 2.0, 1.0 / 2.0],
+    ],
+    BSPLINE2_TABLE[2],
+    BSPLINE2_TABLE[2],
+];
+
+/// The `cells` layout's cubic rows (knots 1, 1, 1, 1, 2, 3, …): the first
+/// two spans differ from the interior.
+const BSPLINE3_CELLS_TABLE: [[[f64; 4]; 4]; 4] = [
+    // s = 3: knots 1, 1, 1, 1, 2, 3, 4, 5
+    [
+        [1.0 / 8.0, 19.0 / 32.0, 25.0 / 96.0, 1.0 / 48.0],
+        [-3.0 / 4.0, -3.0 / 16.0, 13.0 / 16.0, 1.0 / 8.0],
+        [3.0 / 2.0, -15.0 / 8.0, 1.0 / 8.0, 1.0 / 4.0],
+        [-1.0, 7.0 / 4.0, -11.0 / 12.0, 1.0 / 6.0],
+    ],
+    // s = 4: knots 1, 1, 1, 2, 3, 4, 5, 6
+    [
+        [1.0 / 32.0, 15.0 / 32.0, 23.0 / 48.0, 1.0 / 48.0],
+        [-3.0 / 16.0, -9.0 / 16.0, 5.0 / 8.0, 1.0 / 8.0],
+        [3.0 / 8.0, -3.0 / 8.0, -1.0 / 4.0, 1.0 / 4.0],
+        [-1.0 / 4.0, 7.0 / 12.0, -1.0 / 2.0, 1.0 / 6.0],
+    ],
+    BSPLINE3_TABLE[3],
+    BSPLINE3_TABLE[3],
+];
+
 /// Any span `s` (valid where `table_fits`) from the tables above: a span
 /// of the right edge is evaluated as its mirror on the left (reversed
 /// bases, negated derivatives). No recursion and no data-dependent loop:
@@ -140,7 +196,9 @@ pub fn table_basis(
     s: usize,
     n: usize,
     p: usize,
+    e: f64,
 ) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    let cells = e > 0.0;
     let right = s + p >= n;
     let (um, sm) = if right {
         ((n - 1) as f64 - u, n + p - 1 - s)
@@ -153,12 +211,11 @@ pub fn table_basis(
     let mut dn = [0.0; MAX_DEGREE + 1];
     for r in 0..=p {
         // Horner in c for the value and its derivative.
-        let coef = |k: usize| {
-            if p == 2 {
-                BSPLINE2_TABLE[row][k][r]
-            } else {
-                BSPLINE3_TABLE[row][k][r]
-            }
+        let coef = |k: usize| match (p, cells) {
+            (2, false) => BSPLINE2_TABLE[row][k][r],
+            (2, true) => BSPLINE2_CELLS_TABLE[row][k][r],
+            (_, false) => BSPLINE3_TABLE[row][k][r],
+            (_, true) => BSPLINE3_CELLS_TABLE[row][k][r],
         };
         let (mut v, mut d) = (coef(p), 0.0);
         for k in (0..p).rev() {
@@ -223,8 +280,9 @@ fn open_basis(
     s: usize,
     n: usize,
     p: usize,
+    e: f64,
 ) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
-    let t = |k: usize| knot(k as i64, n, p);
+    let t = |k: usize| knot(k as i64, n, p, e);
     // Cox-de Boor triangle (The NURBS Book, A2.2), keeping degree p − 1 for the derivatives.
     let mut nb = [0.0; MAX_DEGREE + 1];
     let mut lower = [0.0; MAX_DEGREE + 1];
@@ -267,6 +325,22 @@ impl Bspline {
         (self.degree + 1) * (self.degree + 1)
     }
 
+    /// The clamped ends' offset e inside the first and last nodes (lattice
+    /// units): 0 for the midpoints layout, (p − 1)/2 for `cells`.
+    pub fn end(&self) -> f64 {
+        if self.cells {
+            0.5 * (self.degree as f64 - 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Nodes per direction beyond the scene's grid lines: p − 1 for
+    /// `cells` (n_c + p bases over n_c cells), none otherwise.
+    pub fn extra_nodes(&self) -> usize {
+        if self.cells { self.degree - 1 } else { 0 }
+    }
+
     #[inline]
     pub fn eval(
         &self,
@@ -275,13 +349,14 @@ impl Bspline {
         nodes: &mut [u32],
         w: &mut [[f64; 3]],
     ) -> Result<usize, ShapeFault> {
-        if !grid.contains(x, 0.0) {
+        let e = self.end();
+        if !grid.contains(x, e * grid.h) {
             return Err(ShapeFault::OutsideGrid);
         }
         let p = self.degree;
         let q = grid.logical(x);
-        let (fx, nx, dnx) = basis(q[0], grid.nx, p);
-        let (fy, ny, dny) = basis(q[1], grid.ny, p);
+        let (fx, nx, dnx) = basis(q[0], grid.nx, p, e);
+        let (fy, ny, dny) = basis(q[1], grid.ny, p, e);
         let inv_h = 1.0 / grid.h;
         let mut k = 0;
         for b in 0..=p {
@@ -303,24 +378,27 @@ impl Bspline {
 mod tests {
     use super::*;
 
+    /// (degree, end offset e) of both layouts: midpoints, then cells.
+    const LAYOUTS: [(usize, f64); 4] = [(2, 0.0), (2, 0.5), (3, 0.0), (3, 1.0)];
+
     #[test]
     fn basis_is_a_partition_of_unity_reproducing_linear_functions() {
-        for p in [2, 3] {
+        for (p, e) in LAYOUTS {
             for n in [p + 1, p + 2, 9] {
-                let mut u = 0.0;
-                while u <= (n - 1) as f64 {
-                    let (first, nb, dn) = basis(u, n, p);
+                let mut u = e;
+                while u <= (n - 1) as f64 - e {
+                    let (first, nb, dn) = basis(u, n, p, e);
                     let s: f64 = nb[..=p].iter().sum();
                     let ds: f64 = dn[..=p].iter().sum();
-                    let g: f64 = (0..=p).map(|r| nb[r] * greville(first + r, n, p)).sum();
-                    let dg: f64 = (0..=p).map(|r| dn[r] * greville(first + r, n, p)).sum();
+                    let g: f64 = (0..=p).map(|r| nb[r] * greville(first + r, n, p, e)).sum();
+                    let dg: f64 = (0..=p).map(|r| dn[r] * greville(first + r, n, p, e)).sum();
                     assert!(
                         (s - 1.0).abs() < 1e-13 && ds.abs() < 1e-12,
-                        "p {p} n {n} u {u}: {s} {ds}"
+                        "p {p} e {e} n {n} u {u}: {s} {ds}"
                     );
                     assert!(
                         (g - u).abs() < 1e-13 && (dg - 1.0).abs() < 1e-12,
-                        "p {p} n {n} u {u}: {g} {dg}"
+                        "p {p} e {e} n {n} u {u}: {g} {dg}"
                     );
                     assert!(nb[..=p].iter().all(|&v| v >= -1e-15));
                     u += 0.0371;
@@ -331,18 +409,18 @@ mod tests {
 
     #[test]
     fn closed_form_interior_matches_the_open_knot_recursion() {
-        for p in [2, 3] {
+        for (p, e) in LAYOUTS {
             let n = 16;
-            let mut u = 0.0;
+            let mut u = e;
             let mut interior = 0;
-            while u <= (n - 1) as f64 {
+            while u <= (n - 1) as f64 - e {
                 let s = span(u, n, p);
-                let (f0, n0, d0) = open_basis(u, s, n, p);
-                let (f1, n1, d1) = basis(u, n, p);
+                let (f0, n0, d0) = open_basis(u, s, n, p, e);
+                let (f1, n1, d1) = basis(u, n, p, e);
                 assert_eq!(f0, f1);
                 for r in 0..=p {
-                    assert!((n0[r] - n1[r]).abs() < 1e-14, "p {p} u {u} r {r}");
-                    assert!((d0[r] - d1[r]).abs() < 1e-13, "p {p} u {u} r {r}");
+                    assert!((n0[r] - n1[r]).abs() < 1e-14, "p {p} e {e} u {u} r {r}");
+                    assert!((d0[r] - d1[r]).abs() < 1e-13, "p {p} e {e} u {u} r {r}");
                 }
                 if s > 2 * p && s + p + 2 <= n {
                     interior += 1;
@@ -358,17 +436,17 @@ mod tests {
 
     #[test]
     fn edge_tables_match_the_open_knot_recursion_on_every_span() {
-        for p in [2, 3] {
+        for (p, e) in LAYOUTS {
             for n in [3 * p + 1, 3 * p + 2, 16, 41] {
                 assert!(table_fits(n, p));
-                let mut u = 0.0;
+                let mut u = e;
                 let mut spans = std::collections::BTreeSet::new();
-                while u <= (n - 1) as f64 {
+                while u <= (n - 1) as f64 - e {
                     let s = span(u, n, p);
                     spans.insert(s);
-                    let (f0, n0, d0) = open_basis(u, s, n, p);
-                    let (f1, n1, d1) = table_basis(u, s, n, p);
-                    let (f2, n2, d2) = basis(u, n, p);
+                    let (f0, n0, d0) = open_basis(u, s, n, p, e);
+                    let (f1, n1, d1) = table_basis(u, s, n, p, e);
+                    let (f2, n2, d2) = basis(u, n, p, e);
                     assert_eq!(f0, f1);
                     assert_eq!(f0, f2);
                     for r in 0..=p {
@@ -378,16 +456,20 @@ mod tests {
                             (n0[r], n2[r]),
                             (d0[r], d2[r]),
                         ] {
-                            assert!((a - b).abs() < 1e-14, "p {p} n {n} u {u} r {r}: {a} vs {b}");
+                            assert!(
+                                (a - b).abs() < 1e-14,
+                                "p {p} e {e} n {n} u {u} r {r}: {a} vs {b}"
+                            );
                         }
                     }
                     u += 0.0137;
                 }
                 // Both ends included, and every span visited.
-                let (_, n1, d1) = table_basis((n - 1) as f64, n - 1, n, p);
+                let end = (n - 1) as f64 - e;
+                let (_, n1, d1) = table_basis(end, n - 1, n, p, e);
                 assert_eq!(n1[p], 1.0);
                 assert!(d1[p] > 0.0);
-                assert_eq!(spans.len(), n - p, "p {p} n {n}");
+                assert_eq!(spans.len(), n - p, "p {p} e {e} n {n}");
             }
             assert!(!table_fits(3 * p, p));
         }
@@ -395,10 +477,10 @@ mod tests {
 
     #[test]
     fn derivatives_match_differences_and_the_boundary_interpolates() {
-        for p in [2, 3] {
+        for (p, e) in LAYOUTS {
             let n = 8;
             let value = |i: usize, u: f64| {
-                let (first, nb, _) = basis(u, n, p);
+                let (first, nb, _) = basis(u, n, p, e);
                 if i >= first && i <= first + p {
                     nb[i - first]
                 } else {
@@ -406,26 +488,47 @@ mod tests {
                 }
             };
             for i in 0..n {
-                let mut u = 0.013;
-                while u < (n - 1) as f64 - 0.013 {
-                    let (first, _, dn) = basis(u, n, p);
+                let mut u = e + 0.013;
+                while u < (n - 1) as f64 - e - 0.013 {
+                    let (first, _, dn) = basis(u, n, p, e);
                     let d = if i >= first && i <= first + p {
                         dn[i - first]
                     } else {
                         0.0
                     };
                     let fd = (value(i, u + 1e-6) - value(i, u - 1e-6)) / 2e-6;
-                    assert!((d - fd).abs() < 1e-5, "p {p} i {i} u {u}: {d} vs {fd}");
+                    assert!(
+                        (d - fd).abs() < 1e-5,
+                        "p {p} e {e} i {i} u {u}: {d} vs {fd}"
+                    );
                     u += 0.049;
                 }
             }
             // Open knots: the end bases are 1 at the ends.
-            assert_eq!(value(0, 0.0), 1.0);
-            assert!((value(n - 1, (n - 1) as f64) - 1.0).abs() < 1e-15);
-            assert_eq!(greville(0, n, p), 0.0);
-            assert_eq!(greville(n - 1, n, p), (n - 1) as f64);
+            assert_eq!(value(0, e), 1.0);
+            assert!((value(n - 1, (n - 1) as f64 - e) - 1.0).abs() < 1e-15);
+            assert_eq!(greville(0, n, p, e), e);
+            assert_eq!(greville(n - 1, n, p, e), (n - 1) as f64 - e);
             // Interior Greville abscissae are the nodes.
-            assert!((greville(n / 2, n, p) - (n / 2) as f64).abs() < 1e-15);
+            assert!((greville(n / 2, n, p, e) - (n / 2) as f64).abs() < 1e-15);
+        }
+    }
+
+    /// The paper's layout puts a knot on every line of the scene's grid: on
+    /// the node lattice shifted out by e, the knot spans are whole cells.
+    #[test]
+    fn the_cells_layout_has_a_knot_on_every_grid_line() {
+        for p in [2, 3] {
+            let b = Bspline {
+                degree: p,
+                cells: true,
+            };
+            let (e, cells) = (b.end(), 10);
+            let n = cells + 1 + b.extra_nodes();
+            let mut knots: Vec<f64> = (0..(n + p + 1) as i64).map(|k| knot(k, n, p, e)).collect();
+            knots.dedup();
+            let want: Vec<f64> = (0..=cells).map(|c| c as f64 + e).collect();
+            assert_eq!(knots, want, "p {p}");
         }
     }
 }

@@ -11,7 +11,7 @@ pub mod ugimp;
 pub use fault::ShapeFault;
 
 use crate::model::Grid;
-use crate::scene::{ShapeKind, SolverSpec};
+use crate::scene::{BsplineKnots, ShapeKind, SolverSpec};
 
 /// A shape function, with its parameters resolved for one scene.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,8 +32,14 @@ impl Shape {
             ShapeKind::Lme => {
                 Shape::Lme(lme::Lme::new(solver.lme_gamma, solver.lme_tol, h, perturb))
             }
-            ShapeKind::Bspline2 => Shape::Bspline(bspline::Bspline { degree: 2 }),
-            ShapeKind::Bspline3 => Shape::Bspline(bspline::Bspline { degree: 3 }),
+            ShapeKind::Bspline2 | ShapeKind::Bspline3 => Shape::Bspline(bspline::Bspline {
+                degree: if solver.shape == ShapeKind::Bspline2 {
+                    2
+                } else {
+                    3
+                },
+                cells: solver.bspline_knots == Some(BsplineKnots::Cells),
+            }),
         }
     }
 
@@ -79,16 +85,18 @@ impl Shape {
         }
     }
 
-    /// Distance (m) a particle must keep from the grid's edge for the shape
-    /// function to be defined; closer is "left the grid".
-    pub fn edge_margin(&self) -> f64 {
+    /// Distance (m) a particle must keep from the edge of a grid of spacing
+    /// `h` for the shape function to be defined; closer is "left the grid".
+    pub fn edge_margin(&self, h: f64) -> f64 {
         match self {
             Shape::Linear => 0.0,
             Shape::Ugimp(u) => u.lp,
             // LME is defined anywhere inside the nodes' convex hull; a particle
             // very close to the hull shows up as a Newton failure instead.
             Shape::Lme(_) => 0.0,
-            Shape::Bspline(_) => 0.0,
+            // The `cells` layout's bases live on the cells, e cells inside
+            // its shifted nodes.
+            Shape::Bspline(b) => b.end() * h,
         }
     }
 
