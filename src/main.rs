@@ -124,6 +124,12 @@ enum Command {
         /// Without it, a study writes only into --out. Ignored with --quick.
         #[arg(long)]
         doc: Option<PathBuf>,
+        /// With --doc: write into the doc's section NAME (between
+        /// `<!-- BEGIN NAME -->` and `<!-- END NAME -->`) instead of
+        /// study-<study>, and its charts as NAME-*.png, so that a restricted
+        /// run (e.g. LME_MPM_MMS_CELLS=64) sits beside the full one.
+        #[arg(long, requires = "doc")]
+        section: Option<String>,
     },
     /// Run a scene over every combination of values of any of its keys, in
     /// parallel, and chart speed against accuracy: sweep.csv, sweep.md and
@@ -265,6 +271,7 @@ fn main() -> ExitCode {
             quick,
             jobs,
             doc,
+            section,
         } => {
             let opts = StudyOptions {
                 backend,
@@ -273,6 +280,7 @@ fn main() -> ExitCode {
                 jobs: jobs
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
                 doc: doc.clone(),
+                section: section.clone(),
                 progress: std::io::stderr().is_terminal(),
                 progress_lines: !std::io::stderr().is_terminal(),
             };

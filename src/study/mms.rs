@@ -11,9 +11,15 @@
 //! period 2L/c. Charts: log-log convergence of displacement, velocity and
 //! stress per reading, and displacement error against wall time.
 //!
-//! The full sweep is 56 runs, many hours on 2 cores (a 64-cell MLS run
-//! alone is one to two hours). `LME_MPM_MMS_CELLS=8,16,32` restricts the full
-//! sweep to those resolutions; the report says which ran.
+//! Every B-spline method runs on both knot layouts (`solver.bspline_knots`:
+//! the default midpoints, and "-cells", the paper's knots on the grid
+//! lines, issue 28).
+//!
+//! The full sweep is 104 runs, many hours on 2 cores (a 64-cell run of the
+//! force correction alone is about an hour and a half). Three variables
+//! restrict it, and the report says which ran: `LME_MPM_MMS_CELLS=8,16,32`
+//! (resolutions), `LME_MPM_MMS_METHODS=bspline2,bspline2-mlsf` (methods,
+//! by label) and `LME_MPM_MMS_E=1e7` (readings).
 
 use super::runner::{Job, JobResult};
 use super::{backend_slug, backends_of, image, sig, table};
@@ -33,6 +39,10 @@ pub const CELLS_FULL: [usize; 4] = [8, 16, 32, 64];
 pub const CELLS_QUICK: [usize; 2] = [8, 16];
 /// Restricts the full sweep's resolutions (comma-separated, from `CELLS_FULL`).
 pub const CELLS_ENV: &str = "LME_MPM_MMS_CELLS";
+/// Restricts the full sweep's methods (comma-separated labels of `METHODS`).
+pub const METHODS_ENV: &str = "LME_MPM_MMS_METHODS";
+/// Restricts the full sweep's readings of E (comma-separated labels of `E_READINGS`).
+pub const E_ENV: &str = "LME_MPM_MMS_E";
 /// The rate the paper reports for B-spline MPM with MLS, and the acceptance
 /// goal for bspline2 + MLS (displacement, between successive resolutions).
 pub const GOAL_RATE: f64 = 1.8;
@@ -41,27 +51,89 @@ pub const INTEGRATOR: &str = "musl";
 /// The two readings of the paper's "E = 10e^7 Pa" (label, Pa).
 pub const E_READINGS: [(&str, f64); 2] = [("1e7", 1e7), ("1e8", 1e8)];
 
-/// (label, shape, `solver.mls_scope` or None without MLS) of each method:
-/// "-mls" is the paper's step (`"all"`), "-mlsf" the fit as a correction
-/// of the internal force's quadrature only (`"force"`).
-pub const METHODS: [(&str, &str, Option<&str>); 7] = [
-    ("linear", "linear", None),
-    ("bspline2", "bspline2", None),
-    ("bspline2-mls", "bspline2", Some("all")),
-    ("bspline2-mlsf", "bspline2", Some("force")),
-    ("bspline3", "bspline3", None),
-    ("bspline3-mls", "bspline3", Some("all")),
-    ("bspline3-mlsf", "bspline3", Some("force")),
+/// One method of the study: its label, shape, `solver.mls_scope` (None
+/// without MLS), and whether its knots sit on the grid lines
+/// (`solver.bspline_knots = "cells"`).
+#[derive(Debug, Clone, Copy)]
+pub struct MmsMethod {
+    pub label: &'static str,
+    pub shape: &'static str,
+    pub scope: Option<&'static str>,
+    pub cells: bool,
+}
+
+const fn method(
+    label: &'static str,
+    shape: &'static str,
+    scope: Option<&'static str>,
+    cells: bool,
+) -> MmsMethod {
+    MmsMethod {
+        label,
+        shape,
+        scope,
+        cells,
+    }
+}
+
+/// The methods: "-mls" is the paper's step (`"all"`), "-mlsf" the fit as a
+/// correction of the internal force's quadrature only (`"force"`), "-cells"
+/// the paper's knot layout.
+pub const METHODS: [MmsMethod; 13] = [
+    method("linear", "linear", None, false),
+    method("bspline2", "bspline2", None, false),
+    method("bspline2-mls", "bspline2", Some("all"), false),
+    method("bspline2-mlsf", "bspline2", Some("force"), false),
+    method("bspline3", "bspline3", None, false),
+    method("bspline3-mls", "bspline3", Some("all"), false),
+    method("bspline3-mlsf", "bspline3", Some("force"), false),
+    method("bspline2-cells", "bspline2", None, true),
+    method("bspline2-cells-mls", "bspline2", Some("all"), true),
+    method("bspline2-cells-mlsf", "bspline2", Some("force"), true),
+    method("bspline3-cells", "bspline3", None, true),
+    method("bspline3-cells-mls", "bspline3", Some("all"), true),
+    method("bspline3-cells-mlsf", "bspline3", Some("force"), true),
 ];
 
 /// The methods a sweep runs, as indices into `METHODS`: all of them, or
-/// for `--quick` all but bspline3's two MLS modes (126 of the quick
-/// sweep's 358 CPU seconds; bspline2's modes, which the acceptance is
-/// about, stay).
-pub fn methods(quick: bool) -> Vec<usize> {
-    (0..METHODS.len())
-        .filter(|&m| !(quick && METHODS[m].1 == "bspline3" && METHODS[m].2.is_some()))
-        .collect()
+/// `LME_MPM_MMS_METHODS`'s; for `--quick` the midpoints layout's but
+/// bspline3's two MLS modes (126 of the quick sweep's 358 CPU seconds;
+/// bspline2's modes, which the acceptance is about, stay), and plain
+/// bspline2 on the cells layout (the other "-cells" methods cost minutes).
+pub fn methods(quick: bool) -> Result<Vec<usize>> {
+    if quick {
+        return Ok((0..METHODS.len())
+            .filter(|&m| {
+                let x = METHODS[m];
+                if x.cells {
+                    x.label == "bspline2-cells"
+                } else {
+                    !(x.shape == "bspline3" && x.scope.is_some())
+                }
+            })
+            .collect());
+    }
+    let all: Vec<&str> = METHODS.iter().map(|m| m.label).collect();
+    Ok(restricted(METHODS_ENV, &all)?
+        .into_iter()
+        .map(|l| METHODS.iter().position(|m| m.label == l).expect("checked"))
+        .collect())
+}
+
+/// The entries of `all` that `env` (a comma-separated list, each one of
+/// `all`) names, in `all`'s order; all of them when it is not set.
+fn restricted<'a>(env: &str, all: &[&'a str]) -> Result<Vec<&'a str>> {
+    let Ok(list) = std::env::var(env) else {
+        return Ok(all.to_vec());
+    };
+    let named: Vec<&str> = list.split(',').map(str::trim).collect();
+    if let Some(bad) = named.iter().find(|n| !all.contains(n)) {
+        return Err(Error::Scene(crate::error::SceneError::Override {
+            arg: format!("{env}={list}"),
+            message: format!("`{bad}` is not one of {all:?}"),
+        }));
+    }
+    Ok(all.iter().copied().filter(|a| named.contains(a)).collect())
 }
 
 /// The method the acceptance figures are for.
@@ -69,9 +141,10 @@ pub const GOAL_METHOD: &str = "bspline2-mlsf";
 /// What it must do at least as well as.
 pub const GOAL_BASE: &str = "bspline2";
 
-/// Chart colour of method `m`: an MLS variant shares its B-spline's colour, dashed.
+/// Chart colour of method `m`: an MLS variant shares its B-spline's colour,
+/// dashed; the cells layout has colours of its own.
 fn color(m: usize) -> usize {
-    [0, 3, 3, 3, 4, 4, 4][m]
+    [0, 3, 3, 3, 4, 4, 4, 1, 1, 1, 2, 2, 2][m]
 }
 
 /// The resolutions of a sweep: `CELLS_QUICK`, or `CELLS_FULL` restricted by
@@ -100,9 +173,17 @@ pub fn cells(quick: bool) -> Result<Vec<usize>> {
     Ok(out)
 }
 
-/// The E readings of a sweep (quick: the first only).
-fn readings(quick: bool) -> &'static [(&'static str, f64)] {
-    if quick { &E_READINGS[..1] } else { &E_READINGS }
+/// The E readings of a sweep (quick: the first only; else all, or
+/// `LME_MPM_MMS_E`'s).
+fn readings(quick: bool) -> Result<Vec<(&'static str, f64)>> {
+    if quick {
+        return Ok(E_READINGS[..1].to_vec());
+    }
+    let all: Vec<&str> = E_READINGS.iter().map(|r| r.0).collect();
+    Ok(restricted(E_ENV, &all)?
+        .into_iter()
+        .map(|l| *E_READINGS.iter().find(|r| r.0 == l).expect("checked"))
+        .collect())
 }
 
 /// One period 2L/c (s) of the case (L = 1 m, ρ0 = 1000 kg/m³) at modulus `e` (Pa).
@@ -110,9 +191,20 @@ pub fn period(e: f64) -> f64 {
     2.0 / (e / 1000.0).sqrt()
 }
 
-pub fn job(backend: BackendChoice, cells: usize, method: usize, e: usize, quick: bool) -> Job {
-    let (label, shape, scope) = METHODS[method];
-    let (e_label, e_pa) = E_READINGS[e];
+pub fn job(
+    backend: BackendChoice,
+    cells: usize,
+    method: usize,
+    reading: (&'static str, f64),
+    quick: bool,
+) -> Job {
+    let MmsMethod {
+        label,
+        shape,
+        scope,
+        cells: on_lines,
+    } = METHODS[method];
+    let (e_label, e_pa) = reading;
     let mut j = Job::new(
         format!("{}-E{e_label}-{label}-n{cells}", backend_slug(backend)),
         ALIGNED_VIBRATION,
@@ -128,6 +220,9 @@ pub fn job(backend: BackendChoice, cells: usize, method: usize, e: usize, quick:
     .tag("E", e_label)
     .tag("method", label)
     .tag("cells", cells);
+    if on_lines {
+        j = j.set("solver.bspline_knots=cells");
+    }
     if quick {
         j = j.set(format!("solver.t_end={}", period(e_pa)));
     } else {
@@ -138,13 +233,13 @@ pub fn job(backend: BackendChoice, cells: usize, method: usize, e: usize, quick:
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-    let cells = cells(quick)?;
+    let (cells, methods, readings) = (cells(quick)?, methods(quick)?, readings(quick)?);
     let mut out = Vec::new();
     for &b in backends {
         // Finest first: the longest runs start early and do not trail.
         for &n in cells.iter().rev() {
-            for e in 0..readings(quick).len() {
-                for m in methods(quick) {
+            for &e in &readings {
+                for &m in &methods {
                     out.push(job(b, n, m, e, quick));
                 }
             }
@@ -246,6 +341,17 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         .collect::<Vec<_>>();
     let backends = backends_of(results);
     let main = backends.first().copied().unwrap_or("cpu");
+    // The methods and readings that ran, in the study's order.
+    let ran = super::tag_values(results, "method");
+    let methods: Vec<usize> = (0..METHODS.len())
+        .filter(|&m| ran.iter().any(|l| *l == METHODS[m].label))
+        .collect();
+    let ran_e = super::tag_values(results, "E");
+    let readings: Vec<(&str, f64)> = E_READINGS
+        .iter()
+        .copied()
+        .filter(|r| ran_e.contains(&r.0))
+        .collect();
     let mut charts = Vec::new();
     let mut md = String::new();
     let s = Section {
@@ -254,10 +360,12 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         quick,
         main,
         cells: &cells,
+        methods: &methods,
+        readings: &readings,
         t_label: if quick { "one period" } else { "T = 0.2 s" },
     };
     s.intro(&mut md, &backends);
-    for &(e_label, e_pa) in readings(quick) {
+    for &(e_label, e_pa) in &readings {
         let exact = exact_of(e_pa)?;
         let _ = writeln!(
             md,
@@ -289,6 +397,9 @@ struct Section<'a> {
     /// The backend the tables show.
     main: &'a str,
     cells: &'a [usize],
+    /// The methods (indices into `METHODS`) and readings that ran.
+    methods: &'a [usize],
+    readings: &'a [(&'static str, f64)],
     /// When the errors are taken, in words.
     t_label: &'static str,
 }
@@ -326,7 +437,7 @@ impl Section<'_> {
             } else {
                 String::new()
             },
-            readings(quick)
+            self.readings
                 .iter()
                 .map(|r| r.0)
                 .collect::<Vec<_>>()
@@ -338,6 +449,22 @@ impl Section<'_> {
                 ""
             }
         );
+        let names: Vec<&str> = self.methods.iter().map(|&m| METHODS[m].label).collect();
+        let _ = writeln!(
+            md,
+            "Methods: {}{}. \"-mls\": the paper's step (`solver.mls_scope = \"all\"`); \"-mlsf\": the fit \
+             as a correction of the internal force only (`\"force\"`); \"-cells\": the paper's knot \
+             layout, a knot on every grid line (`solver.bspline_knots = \"cells\"`), the others the \
+             midpoints layout.\n",
+            names.join(", "),
+            if !quick
+                && (self.methods.len() < METHODS.len() || self.readings.len() < E_READINGS.len())
+            {
+                format!(" (restricted by {METHODS_ENV} / {E_ENV})")
+            } else {
+                String::new()
+            }
+        );
     }
 
     /// One convergence chart per quantity at E = `e_label`.
@@ -347,10 +474,11 @@ impl Section<'_> {
         let mut charts = Vec::new();
         // --- convergence charts, one per quantity -------------------------
         for (name, unit, stem, pick) in QUANTITIES {
-            let curves: Vec<Curve> = METHODS
+            let curves: Vec<Curve> = self
+                .methods
                 .iter()
-                .enumerate()
-                .map(|(m, &(label, _, scope))| Curve {
+                .map(|&m| (m, METHODS[m].label, METHODS[m].scope))
+                .map(|(m, label, scope)| Curve {
                     label: label.to_string(),
                     points: cells
                         .iter()
@@ -380,7 +508,7 @@ impl Section<'_> {
         let (results, main, cells, t_label) = (self.results, self.main, self.cells, self.t_label);
         // --- tables ----------------------------------------------------------
         let mut header = vec!["cells".to_string()];
-        header.extend(METHODS.iter().map(|m| m.0.to_string()));
+        header.extend(self.methods.iter().map(|&m| METHODS[m].label.to_string()));
         let cell_text = |r: Option<&JobResult>, pick: Pick| match r {
             Some(r) if r.completed() => final_errors(r).map_or("-".into(), |e| sig(pick(e))),
             Some(r) => super::failure_text(r),
@@ -391,7 +519,8 @@ impl Section<'_> {
                 .iter()
                 .map(|&n| {
                     let mut row = vec![n.to_string()];
-                    for (label, _, _) in METHODS {
+                    for &m in self.methods {
+                        let label = METHODS[m].label;
                         row.push(cell_text(find(results, main, e_label, label, n), pick));
                     }
                     row
@@ -407,8 +536,8 @@ impl Section<'_> {
             .iter()
             .map(|&n| {
                 let mut row = vec![n.to_string()];
-                for (label, _, _) in METHODS {
-                    let r = find(results, main, e_label, label, n);
+                for &m in self.methods {
+                    let r = find(results, main, e_label, METHODS[m].label, n);
                     row.push(match r.and_then(final_errors) {
                         Some(e) => RELATIVE
                             .iter()
@@ -445,7 +574,7 @@ impl Section<'_> {
             .collect();
         let mut rate_rows = Vec::new();
         let mut goal = None;
-        for (label, _, _) in METHODS {
+        for label in self.methods.iter().map(|&m| METHODS[m].label) {
             for (name, _, _, pick) in QUANTITIES {
                 let at = |f: &dyn Fn(&JobResult) -> Option<f64>| -> Vec<Option<f64>> {
                     cells
@@ -547,14 +676,17 @@ impl Section<'_> {
 
     /// Error against wall time over every backend and reading.
     fn front(&self, md: &mut String, backends: &[&str]) -> Result<Vec<PathBuf>> {
-        let (results, cells, t_label, quick, dir) =
-            (self.results, self.cells, self.t_label, self.quick, self.dir);
+        let (results, cells, t_label, dir) = (self.results, self.cells, self.t_label, self.dir);
         let mut charts = Vec::new();
         // --- error against wall time -----------------------------------------------
         let mut curves = Vec::new();
         for b in backends {
-            for &(e_label, _) in readings(quick) {
-                for (m, &(label, _, scope)) in METHODS.iter().enumerate() {
+            for &(e_label, _) in self.readings {
+                for (m, label, scope) in self
+                    .methods
+                    .iter()
+                    .map(|&m| (m, METHODS[m].label, METHODS[m].scope))
+                {
                     let points: Vec<(f64, f64)> = cells
                         .iter()
                         .filter_map(|&n| {

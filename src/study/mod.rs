@@ -102,6 +102,9 @@ pub struct StudyOptions {
     pub jobs: usize,
     /// Markdown file whose study sections are regenerated (full runs only).
     pub doc: Option<PathBuf>,
+    /// The doc's section to write instead of `study-<slug>` (its charts then
+    /// named `<section>-…` in place of `study-<slug>-…`).
+    pub section: Option<String>,
     /// A progress bar (on a terminal).
     pub progress: bool,
     /// A line on stderr per finished run (off a terminal, for logs).
@@ -206,7 +209,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
         let local = markdown.replace("](charts/", "](");
         crate::output::write_atomic(&dir.join("report.md"), local.as_bytes())?;
         if let (Some(doc), false) = (&opts.doc, opts.quick) {
-            publish(doc, n, &markdown, &charts)?;
+            publish(doc, n, opts.section.as_deref(), &markdown, &charts)?;
         }
         reports.push(Report {
             study: n,
@@ -218,13 +221,31 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
     Ok(reports)
 }
 
-/// Copies the charts next to `doc` (into `charts/`) and replaces the study's section.
-fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Result<()> {
+/// Copies the charts next to `doc` (into `charts/`) and replaces the study's
+/// section, or `section` with its charts renamed to match.
+fn publish(
+    doc: &Path,
+    n: StudyName,
+    section: Option<&str>,
+    markdown: &str,
+    charts: &[PathBuf],
+) -> Result<()> {
+    let own = format!("study-{}", n.slug());
+    let name = section.unwrap_or(&own);
     let dir = doc.parent().unwrap_or(Path::new(".")).join("charts");
     std::fs::create_dir_all(&dir).map_err(|e| Error::io("cannot create", &dir, e))?;
+    let mut markdown = markdown.to_string();
     for c in charts {
-        let name = c.file_name().expect("chart files have names");
-        std::fs::copy(c, dir.join(name)).map_err(|e| Error::io("cannot copy", c, e))?;
+        let file = c
+            .file_name()
+            .expect("chart files have names")
+            .to_string_lossy()
+            .into_owned();
+        let to = file.replacen(&own, name, 1);
+        if to != file {
+            markdown = markdown.replace(&format!("charts/{file}"), &format!("charts/{to}"));
+        }
+        std::fs::copy(c, dir.join(&to)).map_err(|e| Error::io("cannot copy", c, e))?;
     }
     let stamp = format!(
         "Generated {} by `lme-mpm study {}` on {}.\n\n",
@@ -232,5 +253,5 @@ fn publish(doc: &Path, n: StudyName, markdown: &str, charts: &[PathBuf]) -> Resu
         n.slug(),
         crate::bench::machine()
     );
-    crate::docgen::replace_section(doc, &format!("study-{}", n.slug()), &(stamp + markdown))
+    crate::docgen::replace_section(doc, name, &(stamp + &markdown))
 }
