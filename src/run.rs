@@ -292,6 +292,11 @@ fn finish(
         dt: solver.dt,
         mls: solver.mls,
         mls_scope: solver.mls.then_some(solver.mls_scope),
+        bspline_knots: matches!(
+            solver.shape,
+            crate::scene::ShapeKind::Bspline2 | crate::scene::ShapeKind::Bspline3
+        )
+        .then(|| solver.bspline_knots.unwrap_or_default()),
         h: model.grid.h,
         perturb: model.grid.perturb,
         energy: final_sample

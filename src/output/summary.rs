@@ -3,7 +3,9 @@
 //! docs/outputs.md.
 
 use crate::exact::Errors;
-use crate::scene::{ExactKind, IntegratorKind, MlsScope, NpcPosition, SceneFile, ShapeKind};
+use crate::scene::{
+    BsplineKnots, ExactKind, IntegratorKind, MlsScope, NpcPosition, SceneFile, ShapeKind,
+};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -41,6 +43,9 @@ pub struct Summary {
     pub mls: bool,
     /// What the fit did (`solver.mls_scope`); null without MLS.
     pub mls_scope: Option<MlsScope>,
+    /// Where the B-splines' knots sat (`solver.bspline_knots`); null for
+    /// other shapes.
+    pub bspline_knots: Option<BsplineKnots>,
     pub integrator: IntegratorKind,
     pub npc_gamma: Option<f64>,
     pub npc_position: Option<NpcPosition>,
