@@ -522,7 +522,11 @@ fn gmm_disk_rows(label: &str, keys: &[&str], dts: &[f64]) {
             ],
             keys,
         );
-        let r = common::disk::disk_run(&all);
+        let r = if std::env::var_os("LME_MPM_DISK_STICK").is_some() {
+            common::disk::disk_run_text(&lme_mpm::study::disk::stick_variant(), &all)
+        } else {
+            common::disk::disk_run(&all)
+        };
         println!(
             "| {label} | {dt} | {:?} | {:.3} | {:.3} | {:.0} | {:.2} / {} | {} |",
             r.status,
@@ -570,7 +574,7 @@ fn gmm_disk_mls() {
 }
 
 #[test]
-#[ignore = "measurement: one disk run, Δt and keys from LME_MPM_DISK_DT and LME_MPM_DISK_SETS"]
+#[ignore = "measurement: one disk run, Δt and keys from LME_MPM_DISK_DT and LME_MPM_DISK_SETS (LME_MPM_DISK_STICK: on the stick wall)"]
 fn gmm_disk_one() {
     let dt: f64 = std::env::var("LME_MPM_DISK_DT").map_or(2e-3, |v| v.parse().unwrap());
     let keys = std::env::var("LME_MPM_DISK_SETS").unwrap_or_default();
