@@ -84,14 +84,8 @@ fn exact_forces(shape: &Shape, grid: &Grid, sig: impl Fn([f64; 2]) -> [f64; 3]) 
 fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
     for shape in [
         Shape::Linear,
-        Shape::Bspline(Bspline {
-            degree: 2,
-            cells: false,
-        }),
-        Shape::Bspline(Bspline {
-            degree: 3,
-            cells: false,
-        }),
+        Shape::Bspline(Bspline::midpoints(2)),
+        Shape::Bspline(Bspline::midpoints(3)),
     ] {
         let h = 0.125;
         let grid = Grid::regular(h, [0.0, 0.0], 9, 9);
@@ -180,12 +174,7 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
              exact integral; particles only {particles:.2e}, of max |f|"
         );
         assert!(to_gauss < EXACT, "{shape:?}: {to_gauss:e}");
-        if shape
-            != Shape::Bspline(Bspline {
-                degree: 3,
-                cells: false,
-            })
-        {
+        if shape != Shape::Bspline(Bspline::midpoints(3)) {
             assert!(to_exact < EXACT, "{shape:?}: {to_exact:e}");
         }
         assert!(particles > 1e-2, "{shape:?}: {particles:e}");
@@ -203,14 +192,8 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
 fn the_strain_correction_is_the_transpose_of_the_force_bracket() {
     for shape in [
         Shape::Linear,
-        Shape::Bspline(Bspline {
-            degree: 2,
-            cells: false,
-        }),
-        Shape::Bspline(Bspline {
-            degree: 3,
-            cells: false,
-        }),
+        Shape::Bspline(Bspline::midpoints(2)),
+        Shape::Bspline(Bspline::midpoints(3)),
     ] {
         let h = 0.125;
         let grid = Grid::regular(h, [0.0, 0.0], 9, 9);

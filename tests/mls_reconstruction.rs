@@ -186,10 +186,7 @@ fn cosine_fit_error_falls_as_h_squared() {
         // ρ = 2 + cos(kx): positive, so the fit is the paper's density fit.
         let rho: Vec<f64> = x.iter().map(|p| 2.0 + (k * p[0]).cos()).collect();
         let v = vec![[0.0; 2]; x.len()];
-        let shape = Shape::Bspline(Bspline {
-            degree: 2,
-            cells: false,
-        });
+        let shape = Shape::Bspline(Bspline::midpoints(2));
         let mut mls = Mls::new(&shape, &grid, x.len()).unwrap();
         let mut mv = vec![[0.0; 3]; grid.n_nodes()];
         mls.p2g(&grid, &x, &rho, &v, &[], 0.0, &mut mv).unwrap();

@@ -897,14 +897,8 @@ mod tests {
         use crate::model::shape::bspline::Bspline;
         for shape in [
             Shape::Linear,
-            Shape::Bspline(Bspline {
-                degree: 2,
-                cells: false,
-            }),
-            Shape::Bspline(Bspline {
-                degree: 3,
-                cells: false,
-            }),
+            Shape::Bspline(Bspline::midpoints(2)),
+            Shape::Bspline(Bspline::midpoints(3)),
         ] {
             let h = 0.125;
             let grid = Grid::regular(h, [0.0, 0.0], 9, 9);

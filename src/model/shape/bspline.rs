@@ -320,6 +320,14 @@ fn open_basis(
 }
 
 impl Bspline {
+    /// Degree `degree` on the default (midpoints) layout.
+    pub const fn midpoints(degree: usize) -> Bspline {
+        Bspline {
+            degree,
+            cells: false,
+        }
+    }
+
     /// Nodes a particle sees: (p + 1)².
     pub fn max_nodes(&self) -> usize {
         (self.degree + 1) * (self.degree + 1)
