@@ -226,6 +226,36 @@ fn geostatic_column_stays_at_rest() {
     }
 }
 
+/// LME's geostatic column moves because of FLIP's velocity noise at its
+/// floor, not because it is out of balance: the particles of the rows on
+/// either side of the first node line above the stick floor oscillate in
+/// opposite directions (at 1 s, +5.9e-2 m/s at y = 0.039 m against
+/// −1.6e-2 at 0.061 m, their positions within 1 mm of the start), a mode
+/// the grid does not see, fed by the wall's friction, which stops each
+/// contact particle's own velocity; the mean |v| grows from 2e-3 m/s at
+/// 0.2 s to 8.8e-3 at 1 s and 2.0e-2 at 3 s (measured 2026-11-27). A 1 %
+/// PIC blend (`solver.pic_fraction`), which damps that noise and nothing
+/// resolved, holds it within the issue's bound. Measured (2026-11-27):
+/// mean |v| 3.3e-4 m/s over 1 s (largest 4.4e-4), σ_yy within 2.2e-2 ρgH
+/// at worst (the bottom corners: the issue's 1 % is not met there, and
+/// is not asserted; without the blend 0.28). (B-splines are different:
+/// with the blend their bottom corner particles still sink 7 mm in 1 s,
+/// a real imbalance of their stencils behind the walls; uGIMP holds to
+/// 3e-14 m/s with or without it.)
+
+#[test]
+fn a_pic_blend_holds_the_lme_geostatic_column() {
+    let bound = AT_REST * (G * H).sqrt();
+    let (mean, max, m) = run(&["solver.shape=lme", "solver.pic_fraction=0.01"]);
+    let s = worst_sigma_yy(&m);
+    println!(
+        "geostatic lme, 1 % PIC: mean |v| {mean:.3e} m/s over 1 s (largest {max:.3e}; bound \
+         {bound:.3e}); σ_yy off by {s:.2e} ρgH"
+    );
+    assert!(mean < bound, "mean |v| {mean} m/s ≥ {bound}");
+    assert!(max < bound, "largest mean |v| {max} m/s ≥ {bound}");
+}
+
 #[test]
 fn a_stress_free_start_is_not_at_rest() {
     // The same column without the geostatic start: the check above fails
