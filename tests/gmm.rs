@@ -5,6 +5,7 @@
 
 use crate::common;
 
+use lme_mpm::backend::Backend;
 use lme_mpm::cpu::implicit::{ImplicitBackend, Nodes};
 use lme_mpm::exact::Errors;
 use lme_mpm::exact::cantilever::{CantileverErrors, PAPER_NONLINEAR};
@@ -460,6 +461,108 @@ fn a_block_slides_on_a_friction_floor_and_a_stick_floor_holds_it() {
         u[0].abs() / free
     );
     assert!(u[0].abs() < STICK_REL * free, "{u:?}");
+}
+
+/// A cloud node that no particle holds (no unknown) stays at rest, where
+/// Newmark's update with Δu = 0 (the trapezoidal rule, β = 1/4) would flip
+/// its velocity every step and grow its acceleration by 4|v|/Δt a step, a
+/// state that a particle gathering the node again would start Newton
+/// from (before 2026-11-27, a candidate for the column collapse's NaN at
+/// 0.304 s; docs/methods.md, GMM). A node with an unknown and the same
+/// Δu = 0 takes Newmark's update, which the test shows too.
+#[test]
+fn a_cloud_node_that_no_particle_holds_stays_at_rest() {
+    use lme_mpm::cpu::implicit::assemble::{NO_DOF, Newmark};
+    use lme_mpm::cpu::implicit::gmm::GmmNodes;
+    let text = block_scene(
+        "contact = \"friction\"\nfriction = 0.5",
+        [0.0, -9.81],
+        "t_end = 0.1\ndt = 0.01",
+    );
+    let scene = Scene::from_str(&text, "gmm_block", "gmm_block", &[]).unwrap();
+    let model = Model::new(&scene).unwrap();
+    let lme_mpm::model::Integrator::Implicit(settings) = &model.integrator else {
+        panic!("the block scene is implicit");
+    };
+    let mut nodes = GmmNodes::new(&model, settings.gmm.as_ref().unwrap()).unwrap();
+    let n = nodes.cloud.len();
+    let x0 = nodes.cloud.x.clone();
+    for k in 0..n {
+        nodes.cloud.v[k] = [1.0, -0.5];
+        nodes.cloud.a[k] = [3.0, 2.0];
+    }
+    // Node 0 lost its particles; node 1 is an unknown that did not move.
+    let mut dof: Vec<u32> = (0..n as u32).collect();
+    dof[0] = NO_DOF;
+    let nm = Newmark {
+        beta: 0.25,
+        gamma: 0.5,
+        dt: 0.01,
+        is_static: false,
+    };
+    let du = vec![[0.0; 2]; n];
+    for _ in 0..5 {
+        nodes.advance(&du, &dof, &nm);
+    }
+    let c = &nodes.cloud;
+    assert_eq!(c.v[0], [0.0; 2]);
+    assert_eq!(c.a[0], [0.0; 2]);
+    assert_eq!(c.x[0], x0[0]);
+    // Newmark with Δu = 0 five times: v flips to −v, |a| grows.
+    assert!((c.v[1][0] + 1.0).abs() < 1e-12, "{:?}", c.v[1]);
+    assert!(c.a[1][0].abs() > 1500.0, "{:?}", c.a[1]);
+}
+
+/// A block dropped under sudden gravity onto a `stick` floor, dynamic:
+/// the floor's nodes that it holds are at rest at the end (velocity and
+/// acceleration zero, `GmmNodes::hold_on_stick_wall`), and no particle
+/// moves faster than the block's elastic bounce allows. Measured: the
+/// fastest particle 0.0176 m/s at 0.5 s, the floor's nodes 5.7e-7 m/s
+/// at most, leaving the floor (the bounce's scale: the static
+/// squash ρ g H² / (2 M) ≈ 0.9 mm at the block's frequency c / 4H ≈ 50
+/// Hz, about 0.3 m/s). Before the hold, the column collapse's bottom row
+/// (a stick floor, Δt 2 ms) reached 94 to 5170 m/s by 0.30 s while moving
+/// by millimetres (docs/methods.md, GMM).
+const STICK_BOUNCE: f64 = 0.5;
+/// A held node's leaving speed (m/s): the penalty's squash, 1e-9 m deep,
+/// released over a step is of order 1e-7 m/s.
+const STICK_LEAVING: f64 = 1e-5;
+
+#[test]
+fn a_stick_floor_holds_its_nodes_at_rest() {
+    let text = block_scene(
+        "contact = \"stick\"",
+        [0.0, -9.81],
+        "dt = 5e-3\nt_end = 0.5",
+    );
+    let scene = Scene::from_str(&text, "gmm_block", "gmm_block", &[]).unwrap();
+    let mut b = ImplicitBackend::new(Model::new(&scene).unwrap()).unwrap();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    b.advance(0.5, &stop).unwrap();
+    let p = b.particles().unwrap();
+    let fastest = p.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+    let Nodes::Cloud(c) = &b.nodes else {
+        panic!("a GMM run solves on its cloud");
+    };
+    let floor: Vec<usize> = (0..c.cloud.len())
+        .filter(|&n| c.cloud.x[n][1].abs() < 1e-3)
+        .collect();
+    // Held: nothing along the floor, and only a leaving normal part
+    // (the penalty's release of its squash, 1e-7 m/s here).
+    let leaving = floor.iter().map(|&n| c.cloud.v[n][1]).fold(0.0, f64::max);
+    println!(
+        "stick floor: fastest particle {fastest:.3e} m/s; fastest floor node {leaving:.1e} m/s, \
+         leaving the floor, over {} nodes",
+        floor.len()
+    );
+    assert!(!floor.is_empty());
+    for &n in &floor {
+        let (v, a) = (c.cloud.v[n], c.cloud.a[n]);
+        assert!(v[0] == 0.0 && a[0] == 0.0, "node {n}: {v:?} {a:?}");
+        assert!(v[1] >= 0.0 && a[1] >= 0.0, "node {n}: {v:?} {a:?}");
+    }
+    assert!(leaving < STICK_LEAVING, "{leaving}");
+    assert!(fastest < STICK_BOUNCE, "{fastest}");
 }
 
 /// The rolling disk with GMM (issue 27, paper §5.2): GMM-LME γ = 2.8 at

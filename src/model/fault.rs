@@ -19,8 +19,14 @@ pub enum FaultKind {
     MlsSingular { at: [f64; 2] },
     /// Implicit: Newton did not converge within `solver.newton_max_iter`
     /// iterations even after `cuts` halvings of Δt; `ratio` is the last
-    /// residual norm over the step's reference norm.
-    NewtonDiverged { cuts: u32, ratio: f64 },
+    /// residual norm over the step's reference norm, NaN when the last
+    /// attempt stopped at a particle that faulted at an iterate, whose
+    /// fault's code `iterate` then names (`Fault::particle` the particle).
+    NewtonDiverged {
+        cuts: u32,
+        ratio: f64,
+        iterate: Option<&'static str>,
+    },
     /// A fault its material model declares (`Constitutive::FAULTS`), e.g.
     /// modified Cam-clay's stress return that did not converge; `value` is
     /// the figure the model reports with it (NaN when the GPU found it: the
@@ -107,7 +113,20 @@ impl std::fmt::Display for Fault {
                 "MLS reconstruction singular at the Gauss point ({:.4}, {:.4}) m: fewer than 3 non-collinear particles within 3h",
                 at[0], at[1]
             )?,
-            FaultKind::NewtonDiverged { cuts, ratio } => write!(
+            FaultKind::NewtonDiverged {
+                cuts,
+                iterate: Some(code),
+                ..
+            } => write!(
+                f,
+                "Newton did not converge: after {cuts} halvings of the time step an iterate still \
+                 faulted at a particle ({code}): the step deforms it too far at any Δt tried"
+            )?,
+            FaultKind::NewtonDiverged {
+                cuts,
+                ratio,
+                iterate: None,
+            } => write!(
                 f,
                 "Newton did not converge (residual {ratio:.3e} of the step's reference) after {cuts} \
                  halvings of the time step: lower solver.cfl / solver.dt, raise solver.load_steps or \
@@ -127,5 +146,40 @@ impl std::fmt::Display for Fault {
             write!(f, " (particle {p})")?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Newton's failure says whether it stopped at a faulting particle
+    /// (and which, with the fault's code) or on its residual.
+    #[test]
+    fn newton_failures_say_what_stopped_them() {
+        let at = Fault {
+            particle: Some(157),
+            kind: FaultKind::NewtonDiverged {
+                cuts: 6,
+                ratio: f64::NAN,
+                iterate: Some("non_positive_density"),
+            },
+        };
+        let text = at.to_string();
+        assert!(text.contains("non_positive_density"), "{text}");
+        assert!(text.contains("particle 157"), "{text}");
+        assert!(!text.contains("NaN"), "{text}");
+        assert_eq!(at.code(), "newton_diverged");
+        let residual = Fault {
+            particle: None,
+            kind: FaultKind::NewtonDiverged {
+                cuts: 6,
+                ratio: 3.5,
+                iterate: None,
+            },
+        };
+        let text = residual.to_string();
+        assert!(text.contains("residual 3.500e0"), "{text}");
+        assert!(!text.contains("particle"), "{text}");
     }
 }

@@ -258,16 +258,21 @@ impl ImplicitBackend {
                     if cuts >= self.settings.max_cuts {
                         return Err(match fail {
                             AttemptFail::Particle(f) if self.settings.max_cuts == 0 => f,
-                            AttemptFail::Particle(_) => Fault {
-                                particle: None,
+                            AttemptFail::Particle(f) => Fault {
+                                particle: f.particle,
                                 kind: FaultKind::NewtonDiverged {
                                     cuts,
                                     ratio: f64::NAN,
+                                    iterate: Some(f.code()),
                                 },
                             },
                             AttemptFail::Newton(ratio) => Fault {
                                 particle: None,
-                                kind: FaultKind::NewtonDiverged { cuts, ratio },
+                                kind: FaultKind::NewtonDiverged {
+                                    cuts,
+                                    ratio,
+                                    iterate: None,
+                                },
                             },
                         });
                     }
@@ -978,7 +983,12 @@ impl ImplicitBackend {
             };
         }
         if let Nodes::Cloud(c) = &mut self.nodes {
-            c.advance(&self.du, &newmark);
+            c.advance(&self.du, &self.dofs.id, &newmark);
+            let walls = m.walls.list.len();
+            for p in &self.pairs {
+                let state = self.node_states[p.node as usize * walls + p.wall as usize];
+                c.hold_on_stick_wall(p.node as usize, &m.walls.list[p.wall as usize], state);
+            }
         }
     }
 }
