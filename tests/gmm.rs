@@ -568,7 +568,8 @@ fn a_stick_floor_holds_its_nodes_at_rest() {
 /// The rolling disk with GMM (issue 27, paper §5.2): GMM-LME γ = 2.8 at
 /// the study's Δt1 against implicit MPM (Q4, the paper's MPM) at the same
 /// short end time, and on a stick wall. The final displacement's error at
-/// 0.1 s: measured 2.57 % (friction) and 2.98 % (stick) against implicit
+/// 0.1 s: measured 2.57 % (friction) and 3.01 % (stick; 2.98 % before a
+/// stick wall's held nodes were put at rest, 2026-11-27) against implicit
 /// MPM's 4.19 %, of which 2.0 % is the implicit step's start from a = 0
 /// (the trapezoidal rule lags ½ a t² by about ½ a Δt t, Δt / t of it);
 /// the bound is 1.2–1.4 times them. Eq. 67 over so short a history is
