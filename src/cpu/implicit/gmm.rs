@@ -215,9 +215,7 @@ impl GmmNodes {
             c.a[n] = a;
         }
     }
-}
 
-impl GmmNodes {
     /// A node that a `stick` wall holds at the step's end (its contact
     /// closed and stuck) moves with the wall, which is at rest: its
     /// velocity and acceleration are set to zero, except a normal
