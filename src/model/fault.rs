@@ -120,7 +120,7 @@ impl std::fmt::Display for Fault {
             } => write!(
                 f,
                 "Newton did not converge: after {cuts} halvings of the time step an iterate still \
-                 faulted at a particle ({code}): the step deforms it too far at any Δt tried"
+                 faulted at a particle ({code}), at every Δt tried"
             )?,
             FaultKind::NewtonDiverged {
                 cuts,
