@@ -343,6 +343,11 @@ sample_interval = 0.01
     )
 }
 
+/// The model of a block scene's text.
+fn block_model(text: &str) -> Model {
+    Model::new(&Scene::from_str(text, "gmm_block", "gmm_block", &[]).unwrap()).unwrap()
+}
+
 /// Runs a scene's text in memory on the CPU: status, the samples, and the
 /// mass-weighted mean displacement of the particles at the end (m).
 fn run_text(text: &str) -> (RunStatus, Vec<lme_mpm::backend::Sample>, [f64; 2]) {
@@ -479,8 +484,7 @@ fn a_cloud_node_that_no_particle_holds_stays_at_rest() {
         [0.0, -9.81],
         "t_end = 0.1\ndt = 0.01",
     );
-    let scene = Scene::from_str(&text, "gmm_block", "gmm_block", &[]).unwrap();
-    let model = Model::new(&scene).unwrap();
+    let model = block_model(&text);
     let lme_mpm::model::Integrator::Implicit(settings) = &model.integrator else {
         panic!("the block scene is implicit");
     };
@@ -535,8 +539,7 @@ fn a_stick_floor_holds_its_nodes_at_rest() {
         [0.0, -9.81],
         "dt = 5e-3\nt_end = 0.5",
     );
-    let scene = Scene::from_str(&text, "gmm_block", "gmm_block", &[]).unwrap();
-    let mut b = ImplicitBackend::new(Model::new(&scene).unwrap()).unwrap();
+    let mut b = ImplicitBackend::new(block_model(&text)).unwrap();
     let stop = std::sync::atomic::AtomicBool::new(false);
     b.advance(0.5, &stop).unwrap();
     let p = b.particles().unwrap();

@@ -630,7 +630,7 @@ impl ImplicitBackend {
         let tol = self.settings.tol;
         let mut rhs = Mat::<f64>::zeros(dofs.count(), 1);
         let walls = m.walls.list.len();
-        let slot = |p: &ContactPair| p.node as usize * walls + p.wall as usize;
+        let slot = |p: &ContactPair| state_slot(p, walls);
         for iter in 0..=self.settings.max_iter {
             let clock = Instant::now();
             let res = assemble::residual(&inp, &self.du, &mut self.iterates, &mut self.r_body);
@@ -986,11 +986,17 @@ impl ImplicitBackend {
             c.advance(&self.du, &self.dofs.id, &newmark);
             let walls = m.walls.list.len();
             for p in &self.pairs {
-                let state = self.node_states[p.node as usize * walls + p.wall as usize];
+                let state = self.node_states[state_slot(p, walls)];
                 c.hold_on_stick_wall(p.node as usize, &m.walls.list[p.wall as usize], state);
             }
         }
     }
+}
+
+/// Where a contact pair's state is kept in `node_states` (one slot per
+/// node and wall, `walls` walls).
+fn state_slot(p: &ContactPair, walls: usize) -> usize {
+    p.node as usize * walls + p.wall as usize
 }
 
 /// Constraint group `k`'s nodes in the step's node set.
