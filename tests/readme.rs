@@ -26,6 +26,11 @@ const LEFT_OUT: &[(&str, &str)] = &[
         "0.5 s of a disk: minutes on 2 cores",
     ),
     (
+        "lme-mpm run cases/contact_block.toml",
+        "0.5 s of a block sliding on a slab: a minute on 2 cores, and tests/contact.rs's \
+         block_slides_on_a_slab_at_the_coulomb_rate runs the same scene to its end",
+    ),
+    (
         "cases/contact_rolling.toml",
         "0.5 s of a disk on a slab at R/h 20: a minute on 2 cores (tests/studies.rs runs it at R/h 10)",
     ),
