@@ -406,7 +406,9 @@ fn free_energy(cells: usize, sets: &[&str], t_end: f64) -> (f64, f64, bool) {
 const ENERGY_BAND: f64 = 0.005;
 
 /// Checks one mode's free vibration against the band; the two modes are two
-/// tests so that the harness runs them side by side (each takes about 40 s).
+/// tests so that the harness runs them side by side (the force correction's
+/// 20000 steps are the suite's longest test: 150 s on 2 cores shared with
+/// a 2-thread run, plain bspline2's 42 s, 2026-11-27).
 fn keeps_energy(name: &str, sets: &[&str]) {
     let (lo, hi, done) = free_energy(8, sets, 0.2);
     println!("{name}: E/E0 in [{lo:.5}, {hi:.5}], completed {done}");
