@@ -34,24 +34,19 @@ use crate::model::shape::{Shape, ShapeFault};
 use rayon::prelude::*;
 
 /// The quadratic-spline weight of eq. 17, w(r) for r ≥ 0 (support 3/2).
-/// Written without branches (both pieces computed, one selected; the outer
-/// piece clamped at 0 past r = 3/2): the neighbour sums call it for every
-/// particle near a fit, at r spread at random over [0, 2], where branches
-/// mispredicted for about half the force correction's time.
-#[inline(always)]
+#[inline]
 pub fn weight(r: f64) -> f64 {
-    let inner = 0.75 - r * r;
-    let t = if r < 1.5 { 1.5 - r } else { 0.0 };
-    let outer = 0.5 * t * t;
-    if r <= 0.5 { inner } else { outer }
+    if r <= 0.5 {
+        0.75 - r * r
+    } else if r < 1.5 {
+        0.5 * (1.5 - r) * (1.5 - r)
+    } else {
+        0.0
+    }
 }
 
 /// Half-width of the MLS support in cells: w(|Δ|/2) vanishes for |Δ| ≥ 3.
 pub const SUPPORT_CELLS: f64 = 3.0;
-
-/// Points fitted together in one pass over their neighbours (`fit_lanes`,
-/// `strain_correction`).
-const LANES: usize = 4;
 
 /// A moment matrix with det A < this × A₀₀³ is treated as singular.
 const SINGULAR_REL: f64 = 1e-10;
@@ -95,13 +90,11 @@ pub struct Mls {
     pub part_fit: Vec<[f64; 3]>,
     part_ok: Vec<bool>,
     pub cell_ok: Vec<bool>,
-    /// `"force"` only: per particle in binned order, its fit's c = A⁻¹e₀
-    /// (zeros where singular) and σ_h(x_p) (`None` where singular); per
-    /// Gauss point, ω_g L(x_g) (zeros outside `cell_ok`); per particle in
-    /// binned order, V_p L_p (zeros outside `cell_ok`) and the strain-rate
-    /// correction (`strain_correction`).
-    coef_binned: Vec<[f64; 3]>,
-    fit_binned: Vec<Option<[f64; 3]>>,
+    /// `"force"` only: per particle, its fit's c = A⁻¹e₀ (zeros where
+    /// singular); per Gauss point, ω_g L(x_g) (zeros outside `cell_ok`);
+    /// per particle in binned order, V_p L_p (zeros outside `cell_ok`) and
+    /// the strain-rate correction (`strain_correction`).
+    part_coef: Vec<[f64; 3]>,
     gp_l: Vec<[f64; 4]>,
     part_vl: Vec<[f64; 4]>,
     part_dl: Vec<[f64; 4]>,
@@ -153,8 +146,7 @@ impl Mls {
             part_fit: Vec::new(),
             part_ok: Vec::new(),
             cell_ok: Vec::new(),
-            coef_binned: Vec::new(),
-            fit_binned: Vec::new(),
+            part_coef: Vec::new(),
             gp_l: Vec::new(),
             part_vl: Vec::new(),
             part_dl: Vec::new(),
@@ -167,8 +159,7 @@ impl Mls {
         self.part_fit = vec![[0.0; 3]; n];
         self.part_ok = vec![false; n];
         self.cell_ok = vec![false; self.occupied.len()];
-        self.coef_binned = vec![[0.0; 3]; n];
-        self.fit_binned = vec![None; n];
+        self.part_coef = vec![[0.0; 3]; n];
         self.gp_l = vec![[0.0; 4]; self.gp_x.len()];
         self.part_vl = vec![[0.0; 4]; n];
         self.part_dl = vec![[0.0; 4]; n];
@@ -259,7 +250,15 @@ impl Mls {
         mut visit: impl FnMut(&[f64; 8], &[[f64; 2]; 4], &[f64; 4], usize),
     ) {
         let g0 = 4 * ic;
-        let ([i0, i1], [j0, j1]) = self.window(grid, &[self.gp_x[g0], self.gp_x[g0 + 3]]);
+        let lo = grid.logical(self.gp_x[g0]);
+        let hi = grid.logical(self.gp_x[g0 + 3]);
+        let cell_range = |a: f64, b: f64, n: usize| {
+            let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+            let i1 = ((b + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+            (i0.min(n - 1), i1)
+        };
+        let (i0, i1) = cell_range(lo[0], hi[0], self.cells[0]);
+        let (j0, j1) = cell_range(lo[1], hi[1], self.cells[1]);
         let inv_h = 1.0 / grid.h;
         let gx = [self.gp_x[g0][0], self.gp_x[g0 + 1][0]];
         let gy = [self.gp_x[g0][1], self.gp_x[g0 + 2][1]];
@@ -293,110 +292,61 @@ impl Mls {
         }
     }
 
-    /// Per Gauss point of integration cell `ic`, in one pass over its
-    /// neighbours: the moment matrix A (a00 a01 a02 a11 a12 a22) and the
-    /// moments Σ w p f of the first 3 packed fields.
-    #[allow(clippy::type_complexity)]
-    fn moments(&self, grid: &Grid, ic: usize) -> ([[f64; 6]; 4], [[[f64; 3]; 3]; 4]) {
-        let mut am = [[0.0f64; 6]; 4];
-        let mut mom = [[[0.0f64; 3]; 3]; 4];
-        self.neighbours(grid, ic, |q, d, w, _| {
-            for k in 0..4 {
-                let (wk, dx, dy) = (w[k], d[k][0], d[k][1]);
-                let m = &mut am[k];
-                m[0] += wk;
-                m[1] += wk * dx;
-                m[2] += wk * dy;
-                m[3] += wk * dx * dx;
-                m[4] += wk * dx * dy;
-                m[5] += wk * dy * dy;
-                for f in 0..3 {
-                    let wf = wk * q[2 + f];
-                    mom[k][f][0] += wf;
-                    mom[k][f][1] += wf * dx;
-                    mom[k][f][2] += wf * dy;
-                }
-            }
-        });
-        (am, mom)
-    }
-
-    /// The grid cells, [i0, i1] × [j0, j1], holding every particle within
-    /// the weight's reach of any of the points `at` (m).
-    fn window(&self, grid: &Grid, at: &[[f64; 2]]) -> ([usize; 2], [usize; 2]) {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for a in at {
-            let u = grid.logical(*a);
-            for k in 0..2 {
-                lo[k] = lo[k].min(u[k]);
-                hi[k] = hi[k].max(u[k]);
-            }
-        }
-        let range = |a: f64, b: f64, n: usize| {
-            let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
-            let i1 = ((b + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
-            [i0.min(n - 1), i1]
-        };
-        (
-            range(lo[0], hi[0], self.cells[0]),
-            range(lo[1], hi[1], self.cells[1]),
-        )
-    }
-
-    /// The fits of the first 3 packed fields at the points `at`, each with
-    /// its own moment matrix, c = A⁻¹ e₀ (`None` where A is singular), in
-    /// one pass over the points' joint neighbourhood. Lane by lane the sums
-    /// are those of a fit at that point alone, term by term in the same
-    /// order: the joint window adds only particles of zero weight, which
-    /// are summed rather than skipped (a branch there mispredicts; adding
-    /// 0 changes no sum). The lanes are independent, so the compiler
-    /// vectorises across them.
-    #[allow(clippy::needless_range_loop)]
-    fn fit_lanes(
+    /// Visits every particle within the weight's reach of the point `at`
+    /// (m), passing its packed data, Δ = (x_p − at)/h and the weight w.
+    #[inline]
+    fn neighbours_at(
         &self,
         grid: &Grid,
-        at: &[[f64; 2]; LANES],
-    ) -> [Option<([f64; 3], [f64; 3])>; LANES] {
-        let ([i0, i1], [j0, j1]) = self.window(grid, at);
+        at: [f64; 2],
+        mut visit: impl FnMut(&[f64; 8], [f64; 2], f64),
+    ) {
+        let u = grid.logical(at);
+        let range = |a: f64, n: usize| {
+            let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+            let i1 = ((a + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+            (i0.min(n - 1), i1)
+        };
+        let (i0, i1) = range(u[0], self.cells[0]);
+        let (j0, j1) = range(u[1], self.cells[1]);
         let inv_h = 1.0 / grid.h;
         let sc = self.weight_scale;
-        let (ax, ay) = (at.map(|a| a[0]), at.map(|a| a[1]));
-        let mut m = [[0.0f64; LANES]; 6];
-        let mut mom = [[[0.0f64; LANES]; 3]; 3];
         for j in j0..=j1 {
             let row = j * self.cells[0];
             let (s, e) = (self.cell_start[row + i0], self.cell_start[row + i1 + 1]);
             for q in &self.packed[s as usize..e as usize] {
-                let (mut dx, mut dy, mut w) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-                for l in 0..LANES {
-                    dx[l] = (q[0] - ax[l]) * inv_h;
-                    dy[l] = (q[1] - ay[l]) * inv_h;
-                    w[l] = weight(sc * dx[l].abs()) * weight(sc * dy[l].abs());
+                let d = [(q[0] - at[0]) * inv_h, (q[1] - at[1]) * inv_h];
+                let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                if w == 0.0 {
+                    continue;
                 }
-                for l in 0..LANES {
-                    m[0][l] += w[l];
-                    m[1][l] += w[l] * dx[l];
-                    m[2][l] += w[l] * dy[l];
-                    m[3][l] += w[l] * dx[l] * dx[l];
-                    m[4][l] += w[l] * dx[l] * dy[l];
-                    m[5][l] += w[l] * dy[l] * dy[l];
-                }
-                for f in 0..3 {
-                    let v = q[2 + f];
-                    for l in 0..LANES {
-                        let wf = w[l] * v;
-                        mom[f][0][l] += wf;
-                        mom[f][1][l] += wf * dx[l];
-                        mom[f][2][l] += wf * dy[l];
-                    }
-                }
+                visit(q, d, w);
             }
         }
-        std::array::from_fn(|l| {
-            let c = solve_e0(&m.map(|r| r[l]))?;
-            let fit = |f: usize| dot(&c, &mom[f].map(|r| r[l]));
-            Some((c, [fit(0), fit(1), fit(2)]))
-        })
+    }
+
+    /// The fit of the first 3 packed fields at the point `at` with its own
+    /// moment matrix, with c = A⁻¹ e₀; `None` where A is singular.
+    fn fit_at(&self, grid: &Grid, at: [f64; 2]) -> Option<([f64; 3], [f64; 3])> {
+        let mut m = [0.0f64; 6];
+        let mut mom = [[0.0f64; 3]; 3];
+        self.neighbours_at(grid, at, |q, d, w| {
+            let (dx, dy) = (d[0], d[1]);
+            m[0] += w;
+            m[1] += w * dx;
+            m[2] += w * dy;
+            m[3] += w * dx * dx;
+            m[4] += w * dx * dy;
+            m[5] += w * dy * dy;
+            for f in 0..3 {
+                let wf = w * q[2 + f];
+                mom[f][0] += wf;
+                mom[f][1] += wf * dx;
+                mom[f][2] += wf * dy;
+            }
+        });
+        let c = solve_e0(&m)?;
+        Some((c, [dot(&c, &mom[0]), dot(&c, &mom[1]), dot(&c, &mom[2])]))
     }
 
     /// `solver.mls_scope = "force"`, first half of the `forces` stage: bins
@@ -417,9 +367,10 @@ impl Mls {
             std::mem::take(&mut self.gp_f),
             std::mem::take(&mut self.cell_ok),
         );
-        let (mut part_fit, mut part_ok) = (
+        let (mut part_fit, mut part_ok, mut part_coef) = (
             std::mem::take(&mut self.part_fit),
             std::mem::take(&mut self.part_ok),
+            std::mem::take(&mut self.part_coef),
         );
         let this = &*self;
         coef.par_chunks_mut(4)
@@ -433,63 +384,33 @@ impl Mls {
                 if !*ok {
                     return;
                 }
-                // The 4 Gauss points' fits in one pass (what `fit_at` gives
-                // at each, summed in the same order).
-                let (am, mom) = this.moments(grid, ic);
                 for k in 0..4 {
-                    match solve_e0(&am[k]) {
-                        Some(ck) => {
+                    match this.fit_at(grid, this.gp_x[4 * ic + k]) {
+                        Some((ck, f)) => {
                             c[k] = ck;
-                            val[k] = [
-                                dot(&ck, &mom[k][0]),
-                                dot(&ck, &mom[k][1]),
-                                dot(&ck, &mom[k][2]),
-                                0.0,
-                                0.0,
-                            ];
+                            val[k] = [f[0], f[1], f[2], 0.0, 0.0];
                         }
                         None => *ok = false,
                     }
                 }
             });
-        // The particles' fits, LANES neighbours in the binned order at a
-        // time (mostly one grid cell's, which share their neighbourhood),
-        // then each into particle order.
-        let (mut coef_binned, mut fit_binned) = (
-            std::mem::take(&mut self.coef_binned),
-            std::mem::take(&mut self.fit_binned),
-        );
-        let this = &*self;
-        coef_binned
-            .par_chunks_mut(LANES)
-            .zip(fit_binned.par_chunks_mut(LANES))
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(b, (c, f))| {
-                let k0 = b * LANES;
-                let at = std::array::from_fn(|l| {
-                    let q = &this.packed[k0 + l.min(c.len() - 1)];
-                    [q[0], q[1]]
-                });
-                for (l, r) in this
-                    .fit_lanes(grid, &at)
-                    .into_iter()
-                    .take(c.len())
-                    .enumerate()
-                {
-                    (c[l], f[l]) = r.map_or(([0.0; 3], None), |(cl, fl)| (cl, Some(fl)));
-                }
+        part_fit
+            .par_iter_mut()
+            .zip(part_ok.par_iter_mut())
+            .zip(part_coef.par_iter_mut())
+            .zip(x)
+            .with_min_len(1024)
+            .for_each(|(((f, ok), c), &xp)| match this.fit_at(grid, xp) {
+                Some((cp, v)) => (*f, *ok, *c) = (v, true, cp),
+                None => (*f, *ok, *c) = ([0.0; 3], false, [0.0; 3]),
             });
-        for (k, &p) in this.order.iter().enumerate() {
-            let p = p as usize;
-            (part_fit[p], part_ok[p]) = fit_binned[k].map_or(([0.0; 3], false), |f| (f, true));
-            if !part_ok[p] {
+        for (p, ok) in part_ok.iter().enumerate() {
+            if !ok {
                 cell_ok[this.cell_of[p][1] as usize] = false;
             }
         }
         (self.coef, self.gp_f, self.cell_ok) = (coef, vals, cell_ok);
-        (self.part_fit, self.part_ok) = (part_fit, part_ok);
-        (self.coef_binned, self.fit_binned) = (coef_binned, fit_binned);
+        (self.part_fit, self.part_ok, self.part_coef) = (part_fit, part_ok, part_coef);
     }
 
     /// `solver.mls_scope = "force"`, in the `stress` stage, after
@@ -552,40 +473,23 @@ impl Mls {
         let sc = this.weight_scale;
         let reach = 1.5 / sc;
         let nb = [this.breaks[0].len() - 1, this.breaks[1].len() - 1];
-        let span_range = |b: &[f64], lo: f64, hi: f64| {
-            let s0 = b.partition_point(|&t| t <= lo - reach).saturating_sub(1);
-            let s1 = b.partition_point(|&t| t < hi + reach).min(b.len() - 1);
-            s0..s1
+        let span_range = |b: &[f64], a: f64| {
+            let lo = b.partition_point(|&t| t <= a - reach).saturating_sub(1);
+            let hi = b.partition_point(|&t| t < a + reach).min(b.len() - 1);
+            lo..hi
         };
         let (gp_l_ref, part_vl_ref) = (&gp_l, &part_vl);
-        // LANES particles q of the binned order at a time over their joint
-        // neighbourhood, as in `fit_lanes`: lane by lane the same terms in
-        // the same order, the joint window's extra ones exactly 0, and no
-        // branch on a zero weight or a zero V_p L_p (a cell outside
-        // `cell_ok`), which add exactly 0.
         part_dl
-            .par_chunks_mut(LANES)
+            .par_iter_mut()
             .enumerate()
-            .with_min_len(64)
-            .for_each(|(b, o)| {
-                let k0 = b * LANES;
-                let at: [[f64; 2]; LANES] = std::array::from_fn(|l| {
-                    let q = &this.packed[k0 + l.min(o.len() - 1)];
-                    [q[0], q[1]]
-                });
-                let (qx, qy) = (at.map(|a| a[0]), at.map(|a| a[1]));
-                let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-                for a in &at {
-                    let u = grid.logical(*a);
-                    for k in 0..2 {
-                        lo[k] = lo[k].min(u[k]);
-                        hi[k] = hi[k].max(u[k]);
-                    }
-                }
-                let mut acc = [[0.0; LANES]; 4];
+            .with_min_len(256)
+            .for_each(|(k, o)| {
+                let xq = [this.packed[k][0], this.packed[k][1]];
+                let u = grid.logical(xq);
+                let mut acc = [0.0; 4];
                 // Gauss points: φ_q(x_g) with the Gauss point's c.
-                for sy in span_range(&this.breaks[1], lo[1], hi[1]) {
-                    for sx in span_range(&this.breaks[0], lo[0], hi[0]) {
+                for sy in span_range(&this.breaks[1], u[1]) {
+                    for sx in span_range(&this.breaks[0], u[0]) {
                         let ic = sy * nb[0] + sx;
                         if !this.cell_ok[ic] {
                             continue;
@@ -596,27 +500,51 @@ impl Mls {
                             .zip(&this.coef[gs.clone()])
                             .zip(&gp_l_ref[gs])
                         {
-                            lanes_add(&mut acc, qx, qy, *xg, c, lg, inv_h, sc, 1.0);
+                            let d = [(xq[0] - xg[0]) * inv_h, (xq[1] - xg[1]) * inv_h];
+                            let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                            if w == 0.0 {
+                                continue;
+                            }
+                            let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                            for (a, l) in acc.iter_mut().zip(lg) {
+                                *a += phi * l;
+                            }
                         }
                     }
                 }
                 // Particles: −φ_q(x_p) with particle p's c.
-                let ([i0, i1], [j0, j1]) = this.window(grid, &at);
+                let range = |a: f64, n: usize| {
+                    let i0 = (a - SUPPORT_CELLS).floor().max(0.0) as usize;
+                    let i1 = ((a + SUPPORT_CELLS).floor().max(0.0) as usize).min(n - 1);
+                    (i0.min(n - 1), i1)
+                };
+                let (i0, i1) = range(u[0], this.cells[0]);
+                let (j0, j1) = range(u[1], this.cells[1]);
                 for j in j0..=j1 {
                     let row = j * this.cells[0];
                     let (s, e) = (this.cell_start[row + i0], this.cell_start[row + i1 + 1]);
                     let ks = s as usize..e as usize;
-                    for ((vl, q), c) in part_vl_ref[ks.clone()]
+                    for ((vl, q), &p) in part_vl_ref[ks.clone()]
                         .iter()
                         .zip(&this.packed[ks.clone()])
-                        .zip(&this.coef_binned[ks])
+                        .zip(&this.order[ks])
                     {
-                        lanes_add(&mut acc, qx, qy, [q[0], q[1]], c, vl, inv_h, sc, -1.0);
+                        if *vl == [0.0; 4] {
+                            continue;
+                        }
+                        let d = [(xq[0] - q[0]) * inv_h, (xq[1] - q[1]) * inv_h];
+                        let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let c = this.part_coef[p as usize];
+                        let phi = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
+                        for (a, l) in acc.iter_mut().zip(vl) {
+                            *a -= phi * l;
+                        }
                     }
                 }
-                for (l, ol) in o.iter_mut().enumerate() {
-                    *ol = acc.map(|a| a[l]);
-                }
+                *o = acc;
             });
         for (k, &p) in this.order.iter().enumerate() {
             let p = p as usize;
@@ -729,7 +657,27 @@ impl Mls {
                     val.fill([0.0; 3]);
                     return None;
                 }
-                let (am, mom) = this.moments(grid, ic);
+                // Per Gauss point: A (a00 a01 a02 a11 a12 a22) and the moments Σ w p f.
+                let mut am = [[0.0f64; 6]; 4];
+                let mut mom = [[[0.0f64; 3]; 3]; 4];
+                this.neighbours(grid, ic, |q, d, w, _| {
+                    for k in 0..4 {
+                        let (wk, dx, dy) = (w[k], d[k][0], d[k][1]);
+                        let m = &mut am[k];
+                        m[0] += wk;
+                        m[1] += wk * dx;
+                        m[2] += wk * dy;
+                        m[3] += wk * dx * dx;
+                        m[4] += wk * dx * dy;
+                        m[5] += wk * dy * dy;
+                        for f in 0..3 {
+                            let wf = wk * q[2 + f];
+                            mom[k][f][0] += wf;
+                            mom[k][f][1] += wf * dx;
+                            mom[k][f][2] += wf * dy;
+                        }
+                    }
+                });
                 for k in 0..4 {
                     let Some(ck) = solve_e0(&am[k]) else {
                         return Some(Fault {
@@ -899,35 +847,6 @@ impl Mls {
                 o[4] += wk[1] * u[2];
                 o[5] += wk[2] * u[2];
             }
-        }
-    }
-}
-
-/// `strain_correction`'s term for the lanes q at (`qx`, `qy`) (m) of one
-/// fit point at `xp` with coefficients `c` and value `l`: acc[i][q] +=
-/// sign φ_q(xp) l[i], φ_q(x) = w(x_q − x) (c₀ + c · (x_q − x)/h).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn lanes_add(
-    acc: &mut [[f64; LANES]; 4],
-    qx: [f64; LANES],
-    qy: [f64; LANES],
-    xp: [f64; 2],
-    c: &[f64; 3],
-    l: &[f64; 4],
-    inv_h: f64,
-    sc: f64,
-    sign: f64,
-) {
-    let mut phi = [0.0; LANES];
-    for k in 0..LANES {
-        let d = [(qx[k] - xp[0]) * inv_h, (qy[k] - xp[1]) * inv_h];
-        let w = weight(sc * d[0].abs()) * weight(sc * d[1].abs());
-        phi[k] = w * (c[0] + c[1] * d[0] + c[2] * d[1]);
-    }
-    for (a, li) in acc.iter_mut().zip(l) {
-        for k in 0..LANES {
-            a[k] += sign * (phi[k] * li);
         }
     }
 }
