@@ -139,9 +139,31 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if positive {
             ft_line = ft;
         }
+        // B-splines: the preload's share with the basis evaluated at the
+        // line's point itself (as `wall_touch`), the friction as below.
+        var f_pre_line = f_pre;
+#if SHAPE_BSPLINE
+        if f_pre > 0.0 {
+            let cl = shape_ctx(p, x - d * wl.normal);
+            if cl.ok {
+                f_pre_line = 0.0;
+                for (var r = 0u; r < SHAPE_ROWS; r++) {
+                    let span = shape_span(cl, r);
+                    for (var s = span.x; s < span.y; s++) {
+                        let nw = shape_node(cl, s);
+                        if nw.ok && nw.n != 0.0 {
+                            let o = nw.n * f_pre * wl.normal;
+                            wall_force_add(2u * nw.node, o.x);
+                            wall_force_add(2u * nw.node + 1u, o.y);
+                        }
+                    }
+                }
+            }
+        }
+#endif
         let f_at = fw - f_pre * wl.normal - ft_line;
-        let f_line = f_pre * wl.normal + ft_line;
-        let lined = f_pre != 0.0 || positive;
+        let f_line = f_pre_line * wl.normal + ft_line;
+        let lined = f_pre_line != 0.0 || positive;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {

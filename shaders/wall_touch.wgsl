@@ -8,7 +8,8 @@
 // at the wall's line, N − d n·∇N, where none of a contact's is negative
 // (linear shapes), else N (`wall_contact` sizes the friction with them).
 // With WALL_PRELOAD, each contact's preload
-// onto the nodes at the wall's line, into `wall_pre_force`. `wall_contact`
+// onto the nodes at the wall's line (B-splines: their basis evaluated at
+// the line's point; else N − d n·∇N), into `wall_pre_force`. `wall_contact`
 // reads it; `clear_grid` zeroes it. With GATES only the walls that act at
 // the step's start time t (appear_at <= t < remove_at) are in contact.
 // CPU twin: `wall_touch` in src/cpu/grid_update.rs.
@@ -43,7 +44,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
     // Per contact, the friction's weights: at the wall's line where none
     // of them is negative, else the particle's; with WALL_PRELOAD, its
-    // preload P n onto the nodes at the wall's line (weights N − d n·∇N),
+    // preload P n onto the nodes at the wall's line (weights N − d n·∇N, or
+    // B-splines' basis at the line's point),
     // which `wall_contact` counts in the body's velocity before it
     // decides the rest.
     for (var k = 0u; k < arrayLength(&walls); k++) {
@@ -61,6 +63,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let c = shape_ctx(p, x);
         let d = wall_depth(x, lp, wl);
         let positive = line_weights_positive(c, wl.normal, d);
+#if WALL_PRELOAD
+        // B-splines: the preload with the basis evaluated at the line's
+        // point itself (the first-order weights are off by ½ d² ∂²N).
+        var exact = false;
+#if SHAPE_BSPLINE
+        if sp.y > 0.0 {
+            let cl = shape_ctx(p, x - d * wl.normal);
+            exact = cl.ok;
+            for (var r = 0u; exact && r < SHAPE_ROWS; r++) {
+                let span = shape_span(cl, r);
+                for (var s = span.x; s < span.y; s++) {
+                    let nw = shape_node(cl, s);
+                    if nw.ok && nw.n != 0.0 {
+                        let f = sp.y * nw.n * wl.normal;
+                        pre_force_add(2u * nw.node, f.x);
+                        pre_force_add(2u * nw.node + 1u, f.y);
+                    }
+                }
+            }
+        }
+#endif
+#endif
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
@@ -77,7 +101,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                     touch_add(2u * nw.node + 1u, fw);
                 }
 #if WALL_PRELOAD
-                if sp.y > 0.0 {
+                if sp.y > 0.0 && !exact {
                     let f = sp.y * line * wl.normal;
                     pre_force_add(2u * nw.node, f.x);
                     pre_force_add(2u * nw.node + 1u, f.y);

@@ -17,10 +17,15 @@ use lme_mpm::study::column::{GRANULAR_H, run_out};
 /// The experiments' tolerance the issue accepts: within 25 % of 1.2 a.
 const RUN_OUT_REL: f64 = 0.25;
 /// The FLIP deposit's kinetic energy at 2 s over the PIC one's: measured
-/// 650 (5.8 against 8.8e-3 J/m); the check asks for 100.
-const KE_RATIO_MIN: f64 = 100.0;
-/// FLIP's least particle density over PIC's: measured 0.15 (74 against
-/// 491 kg/m³); the check asks for below a half.
+/// 57 (7.7 against 0.13 J/m, 2026-11-27) since the case's B-splines have
+/// their knots on the grid lines (`bspline_knots = "cells"`, so the column
+/// starts in balance behind its gate; 650 before, 5.8 against 8.8e-3,
+/// on the `midpoints` layout). Both PIC figures are below 1e-5 of m g H,
+/// a deposit at rest; the check asks for 20, a deposit still flowing.
+const KE_RATIO_MIN: f64 = 20.0;
+/// FLIP's least particle density over PIC's: measured 0.15 (135 against
+/// 916 kg/m³; 74 against 491 on `midpoints`); the check asks for below a
+/// half.
 const DENSITY_RATIO_MAX: f64 = 0.5;
 
 struct End {

@@ -29,11 +29,12 @@
 //! `CORRECT`), `shaders/wall_touch.wgsl` and `shaders/wall_contact.wgsl`.
 
 use super::stage_inputs::ShapeCache;
+use crate::model::shape::Shape;
 use crate::model::walls::{
     CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, preload_force, wall_depth,
     wall_penetration,
 };
-use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Walls};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Grid, Walls};
 use rayon::prelude::*;
 
 pub use crate::model::MASS_EPS_REL;
@@ -105,6 +106,66 @@ pub struct ContactParticles<'a> {
     pub stress: &'a [[f64; 3]],
     pub v: &'a [[f64; 2]],
     pub gravity: [f64; 2],
+    /// The shape and grid by which the preload's weights at the wall's
+    /// line are evaluated exactly (`LineWeights`), for B-splines; `None`
+    /// keeps the first-order `face_weight`.
+    pub line: Option<(&'a Shape, &'a Grid)>,
+}
+
+/// The nodes and weights N_I(x_p − d n) of a contact's point on the wall's
+/// line, evaluated by the shape itself (B-splines; `ContactParticles::line`).
+struct LineWeights {
+    nodes: Vec<u32>,
+    w: Vec<[f64; 3]>,
+    len: usize,
+}
+
+impl LineWeights {
+    fn new(line: Option<(&Shape, &Grid)>) -> Self {
+        let n = line.map_or(0, |(s, _)| s.max_nodes());
+        LineWeights {
+            nodes: vec![0; n],
+            w: vec![[0.0; 3]; n],
+            len: 0,
+        }
+    }
+
+    /// Evaluates the weights at the point `d` (m) behind `x` along `n`,
+    /// in the field of the particle whose first node is `first` (contact
+    /// pairs stack a field per body: `cpu::contact::offset_nodes`); false
+    /// when there is no shape to evaluate (or it fails there).
+    fn at(
+        &mut self,
+        line: Option<(&Shape, &Grid)>,
+        first: u32,
+        x: [f64; 2],
+        n: [f64; 2],
+        d: f64,
+    ) -> bool {
+        let Some((shape, grid)) = line else {
+            return false;
+        };
+        let xl = [x[0] - d * n[0], x[1] - d * n[1]];
+        match shape.eval(grid, xl, &mut [0.0; 2], &mut self.nodes, &mut self.w) {
+            Ok(k) => {
+                let per_field = grid.n_nodes() as u32;
+                let off = first / per_field * per_field;
+                for node in &mut self.nodes[..k] {
+                    *node += off;
+                }
+                self.len = k;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.nodes[..self.len]
+            .iter()
+            .zip(&self.w[..self.len])
+            .map(|(&n, w)| (n as usize, w[0]))
+    }
 }
 
 /// Per node, `touch[n] = [S_I, T_I]`: the contact weight S_I = Σ_p N_Ip
@@ -133,6 +194,7 @@ pub fn wall_touch(
 ) {
     touch.fill([0.0; 2]);
     pre_force.fill([0.0; 2]);
+    let mut lw = LineWeights::new(pt.line);
     for p in 0..pt.x.len() {
         let (nodes, w) = cache.particle(p);
         let lp = half_width(pt.mass[p], pt.rho[p]);
@@ -151,7 +213,20 @@ pub fn wall_touch(
             for (&n, wk) in nodes.iter().zip(w) {
                 touch[n as usize][1] += friction_weight(wk, wl.normal, d, on_line);
             }
-            if pre > 0.0 {
+            if pre > 0.0
+                && lw.at(
+                    pt.line,
+                    nodes.first().copied().unwrap_or(0),
+                    pt.x[p],
+                    wl.normal,
+                    d,
+                )
+            {
+                for (n, wn) in lw.iter() {
+                    pre_force[n][0] += pre * wn * wl.normal[0];
+                    pre_force[n][1] += pre * wn * wl.normal[1];
+                }
+            } else if pre > 0.0 {
                 for (&n, wk) in nodes.iter().zip(w) {
                     let f = pre * face_weight(wk, wl.normal, d);
                     pre_force[n as usize][0] += f * wl.normal[0];
@@ -261,6 +336,7 @@ pub fn wall_contact(
     for r in wall_r.iter_mut() {
         *r = [0.0; 2];
     }
+    let mut lw = LineWeights::new(pt.line);
     for p in 0..pt.x.len() {
         let lp = half_width(pt.mass[p], pt.rho[p]);
         for (k, wl) in walls.list.iter().enumerate() {
@@ -343,10 +419,25 @@ pub fn wall_contact(
             } else {
                 [0.0; 2]
             };
+            let exact = f_pre > 0.0
+                && lw.at(
+                    pt.line,
+                    nodes.first().copied().unwrap_or(0),
+                    pt.x[p],
+                    nrm,
+                    d,
+                );
+            if exact {
+                for (n, wn) in lw.iter() {
+                    wall_force[n][0] += wn * f_pre * nrm[0];
+                    wall_force[n][1] += wn * f_pre * nrm[1];
+                }
+            }
             let f_at = [
                 fw[0] - f_pre * nrm[0] - ft_line[0],
                 fw[1] - f_pre * nrm[1] - ft_line[1],
             ];
+            let f_pre = if exact { 0.0 } else { f_pre };
             for (&n, wk) in nodes.iter().zip(wt) {
                 let face = face_weight(wk, nrm, d);
                 let o = &mut wall_force[n as usize];
@@ -513,6 +604,7 @@ mod tests {
             stress: &[[0.0; 3]],
             v: &[v],
             gravity: [0.0; 2],
+            line: None,
         };
         let mut touch = [[0.0; 2]];
         wall_touch(&cache, &pt, &walls, t, &mut touch, &mut []);
@@ -605,6 +697,7 @@ mod tests {
             stress: &[[0.0; 3]],
             v: &[v],
             gravity: [0.0; 2],
+            line: None,
         };
         let mut touch = [[0.0; 2]; 2];
         wall_touch(&cache, &pt, &walls, 0.0, &mut touch, &mut []);

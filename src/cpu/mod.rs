@@ -74,14 +74,31 @@ pub struct CpuBackend {
 fn contact_particles<'a>(
     p: &'a Particles,
     gravity: Option<&crate::model::Gravity>,
+    line: Option<(&'a crate::model::shape::Shape, &'a crate::model::Grid)>,
 ) -> grid_update::ContactParticles<'a> {
     grid_update::ContactParticles {
+        line,
         x: &p.x,
         mass: &p.mass,
         rho: &p.rho,
         stress: &p.stress,
         v: &p.v,
         gravity: gravity.map_or([0.0; 2], |g| g.g),
+    }
+}
+
+/// The shape by which the walls' preloads are put on their lines
+/// exactly: B-splines (whose first-order extrapolation to the line is off
+/// by ½ d² ∂²N, enough to unbalance a geostatic column); the others keep
+/// `face_weight` (exact for linear shapes; uGIMP holds as it is; LME
+/// would need a Newton solve per point).
+fn line_shape<'a>(
+    shape: &'a crate::model::shape::Shape,
+    grid: &'a crate::model::Grid,
+) -> Option<(&'a crate::model::shape::Shape, &'a crate::model::Grid)> {
+    match shape {
+        crate::model::shape::Shape::Bspline(_) => Some((shape, grid)),
+        _ => None,
     }
 }
 
@@ -381,7 +398,7 @@ impl CpuBackend {
                 if !m.walls.is_empty() {
                     grid_update::wall_touch(
                         &self.cache,
-                        &contact_particles(p, m.gravity.as_ref()),
+                        &contact_particles(p, m.gravity.as_ref(), line_shape(&m.shape, &m.grid)),
                         &m.walls,
                         self.t,
                         &mut self.wall_touch,
@@ -484,7 +501,7 @@ impl CpuBackend {
                 if !m.walls.is_empty() {
                     grid_update::wall_contact(
                         &self.cache,
-                        &contact_particles(p, m.gravity.as_ref()),
+                        &contact_particles(p, m.gravity.as_ref(), line_shape(&m.shape, &m.grid)),
                         &self.mv,
                         &self.force,
                         &m.walls,
