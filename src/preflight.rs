@@ -475,14 +475,11 @@ fn duration(hours: f64) -> String {
     }
 }
 
-/// Estimates `scene`, clamps output intervals below the first time step to
-/// one per step, and refuses (exit 2, naming the keys) what `limits` do not
-/// allow: memory, unaddressable counts, step count, hours, snapshots.
 /// A geostatic body with B-splines on the `midpoints` knot layout and a
 /// wall: its particles at Gauss points do not integrate the wall's cell
 /// exactly (the quadratic knot mid-cell splits it), so the start is not in
 /// discrete equilibrium there and the body settles (the geostatic column
-/// of tests/initial_states.rs: 1.2e-2 m/s over 1 s against 3.5e-6 on the
+/// of tests/initial_states.rs: 6.9e-2 m/s over 1 s against 1.6e-7 on the
 /// `cells` layout, docs/methods.md "Walls").
 fn geostatic_knots_warning(scene: &Scene) -> Option<String> {
     use crate::scene::{BsplineKnots, InitialStress, ShapeKind};
@@ -502,6 +499,9 @@ fn geostatic_knots_warning(scene: &Scene) -> Option<String> {
     })
 }
 
+/// Estimates `scene`, clamps output intervals below the first time step to
+/// one per step, and refuses (exit 2, naming the keys) what `limits` do not
+/// allow: memory, unaddressable counts, step count, hours, snapshots.
 pub fn plan(scene: &Scene, limits: &Limits, threads: usize) -> Result<Plan, SceneError> {
     let mut est = estimate(scene, threads)?;
     let mut scene = scene.clone();
