@@ -1439,6 +1439,51 @@ fn stages_match_wall_preload() {
     }
 }
 
+/// The walls' preloads where bodies are in a contact pair (each on its
+/// own field): tests/scenes/gate_release.toml's column cut into two
+/// geostatic bodies, the upper one's weight on the lower, held together
+/// by a stick pair, both flush against the back wall and the gate;
+/// bspline2 NPC, whose preload goes to the nodes by the basis at the
+/// wall's line, offset into each body's field on both paths.
+#[test]
+fn stages_match_wall_preload_in_contact_fields() {
+    let text = include_str!("scenes/gate_release.toml").replace(
+        "rects = [[0.0, 0.0, 0.4, 0.8]]\ninitial_stress = \"geostatic\"",
+        "rects = [[0.0, 0.0, 0.4, 0.4]]\ninitial_stress = \"geostatic\"\n\n\
+         [bodies.upper]\nmaterial = \"sand\"\nppc = 2\nrects = [[0.0, 0.4, 0.4, 0.8]]\n\
+         initial_stress = \"geostatic\"\n\n[contact.cut]\nbodies = [\"column\", \"upper\"]\n\
+         law = \"stick\"",
+    );
+    assert!(text.contains("[contact.cut]"), "the scene changed");
+    let all = [
+        "walls.gate.remove_at=1e9",
+        "solver.shape=bspline2",
+        "solver.bspline_knots=cells",
+    ];
+    let o: Vec<Override> = all.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let scene = Scene::from_str(&text, "parity scene", "parity", &o).unwrap();
+    let mut m = Model::new(&scene).unwrap();
+    assert!(m.contact.is_some(), "no contact pair");
+    // Both bodies carry preloads (the upper one against the back wall and
+    // the gate).
+    let upper = m.particles.body.iter().filter(|&&b| b == 1).count();
+    assert!(upper > 0);
+    assert!(!m.walls.preload.is_empty(), "no preload");
+    let mut rng = SplitMix64::new(19);
+    for i in 0..m.particles.len() {
+        m.particles.v[i] = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+        let s = rng.range(0.5, 1.5);
+        m.particles.stress[i] = m.particles.stress[i].map(|c| s * c);
+    }
+    parity_of(
+        "preload in contact fields, bspline2 npc",
+        m,
+        false,
+        GpuOptions::default(),
+        0.0,
+    );
+}
+
 /// Contact normals, |GPU − CPU| of the unit vectors' components: f32
 /// sums of m_p ∇N normalised, then (where the pair touches) the logistic
 /// regression's ten Newton steps in f32, which carry the sums' rounding
