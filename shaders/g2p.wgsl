@@ -7,6 +7,7 @@
 // PIC: v = (1 − α) v_FLIP + α Σ N v_I, α = params.pic_fraction.
 // CPU twin: src/cpu/g2p.rs.
 #include "shared/common.wgsl"
+#include "shared/kahan.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
 
@@ -59,9 +60,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
     a[p] = acc;
 #endif
-    let y = du - u_lo[p];
-    let up = u[p] + y;
-    u_lo[p] = (up - u[p]) - y;
+    let k = kahan_add2(u[p], u_lo[p], du, params.opaque_zero);
+    let up = k.sum;
+    u_lo[p] = k.lo;
     v[p] = vp;
     u[p] = up;
     if !(is_finite(up.x) && is_finite(up.y) && is_finite(vp.x) && is_finite(vp.y)) {

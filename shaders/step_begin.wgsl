@@ -2,6 +2,7 @@
 // and whether the step runs at all. Twin of the Δt and stop logic of
 // CpuBackend (src/cpu/mod.rs, Stage::Cfl and `advance`).
 #include "shared/common.wgsl"
+#include "shared/clock.wgsl"
 
 // A step that would reach within this fraction of the time left of t_end
 // lands on it exactly (src/cpu/cfl.rs LAST_STEP_REL).
@@ -13,10 +14,12 @@ fn main() {
     let cmax = bitcast<f32>(atomicLoad(&sim.cmax_bits));
     // The next `cfl` pass accumulates from zero.
     atomicStore(&sim.cmax_bits, 0u);
-    let rem_stop = (sim.t_stop_hi - sim.t) + (sim.t_stop_lo - sim.t_lo);
-    let rem_end = (params.t_end_hi - sim.t) + (params.t_end_lo - sim.t_lo);
     sim.final_step = 0u;
-    if fault != FAULT_NONE || rem_stop <= 0.0 || rem_end <= 0.0 {
+    // A stop within LAST_STEP_REL of the last step's Δt below counts as
+    // reached (model::time_step::stop_reached; GpuBackend::stop_reached).
+    let slack = ticks_of(LAST_STEP_REL * sim.dt);
+    if fault != FAULT_NONE || ticks_le(sim.t_stop_ticks, ticks_add(sim.ticks, slack))
+        || ticks_le(params.t_end_ticks, sim.ticks) {
         sim.running = 0u;
         sim.dt = 0.0;
         return;
@@ -25,6 +28,7 @@ fn main() {
     if params.fixed_dt > 0.0 {
         dt = params.fixed_dt;
     }
+    let rem_end = ticks_seconds(ticks_sub(params.t_end_ticks, sim.ticks));
     if dt >= rem_end * (1.0 - LAST_STEP_REL) {
         dt = rem_end;
         sim.final_step = 1u;

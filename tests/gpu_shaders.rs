@@ -400,13 +400,13 @@ fn shared_structs_match_rust_layouts() {
     let v = variants()[0];
     let src = pipelines::expand(Pass::Cfl, &v.defines()).unwrap();
     let module = pipelines::validate(&src, "cfl.wgsl", v.atomics).unwrap();
-    let params = rust_fields!(Params; n_particles, n_nodes, nx, ny, h, inv_h, cfl_h, mass_eps, t_end_hi, t_end_lo,
+    let params = rust_fields!(Params; n_particles, n_nodes, nx, ny, h, inv_h, cfl_h, mass_eps, t_end_ticks,
         gravity, ramp_period, npc_gamma, p2g_accel, edge_margin, grid_w, grid_hgt, lme_beta, lme_r2, lme_tol,
         lme_reach, lme_side, lme_max_iter, ugimp_lp, n_groups, n_probes, n_materials, fixed_dt, mms_amp, mms_origin,
         mms_k, mms_omega, mms_lame, mms_shear, mms_c2, mls_spans_x, mls_spans_y, mls_break_off,
-        mls_weight_scale, pic_fraction, local_damping);
+        mls_weight_scale, pic_fraction, local_damping, tick_exp, fixed_dt_ticks, opaque_zero);
     assert_eq!(wgsl_struct(&module, "Params"), params);
-    let sim = rust_fields!(Sim; t, t_lo, dt, t_stop_hi, t_stop_lo, steps, running, final_step, cmax_bits, fault);
+    let sim = rust_fields!(Sim; t, t_lo, ticks, t_stop_ticks, dt, steps, running, final_step, cmax_bits, fault);
     assert_eq!(wgsl_struct(&module, "Sim"), sim);
     let mat = rust_fields!(GpuMaterial; lame, shear, p_modulus, youngs, nu, model, bulk, p);
     assert_eq!(wgsl_struct(&module, "Material"), mat);
@@ -643,4 +643,95 @@ fn constraint_groups_must_be_boxes_of_nodes() {
     let first = grp.nodes[0];
     grp.nodes.insert(mid, first);
     assert!(constraint_boxes(&model).is_err());
+}
+
+/// The GPU's compensated sums (`shared/kahan.wgsl`, the displacement in
+/// g2p) on the adapter the suite runs on: 10 000 steps of 1e-7 onto 1.0.
+/// A plain f32 sum rounds each step to an ulp of 1 (1.19e-7) and ends
+/// 1.2e-3 too far; a working compensation ends within a few ulp. Written as
+/// `lo = ((s + y) − s) − y`, llvmpipe folds the compensation away (in a
+/// kernel of that sum alone it ended exactly where the plain sum does; in
+/// this one, which runs both and prints both, 1.9e-4 off).
+#[test]
+fn compensated_sums_survive_the_driver() {
+    use lme_mpm::gpu::preprocess::{Defines, expand_text};
+    const KERNEL: &str = r#"
+#include "shared/kahan.wgsl"
+@group(0) @binding(0) var<storage, read_write> buf: array<f32>;
+@group(0) @binding(1) var<storage, read> zero: array<u32>;
+@compute @workgroup_size(1)
+fn main() {
+    let du = vec2<f32>(buf[2]);
+    var naive = vec2<f32>(buf[0]);
+    var naive_lo = vec2<f32>(0.0);
+    var s = vec2<f32>(buf[0]);
+    var lo = vec2<f32>(0.0);
+    for (var k = 0u; k < 10000u; k++) {
+        let y = du - naive_lo;
+        let t = naive + y;
+        naive_lo = (t - naive) - y;
+        naive = t;
+        let r = kahan_add2(s, lo, du, zero[0]);
+        s = r.sum;
+        lo = r.lo;
+    }
+    buf[0] = s.x;
+    buf[1] = lo.x;
+    buf[3] = naive.x;
+    buf[4] = naive_lo.x;
+}
+"#;
+    let Some(ctx) = crate::common::gpu::open("compensated sums", false) else {
+        return;
+    };
+    let src = expand_text(KERNEL, "kahan_test", &Defines::default()).unwrap();
+    let dev = &ctx.device;
+    let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("kahan_test"),
+        source: wgpu::ShaderSource::Wgsl(src.into()),
+    });
+    let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("kahan_test"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let make = |bytes: &[u8], usage| {
+        let b = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: bytes.len() as u64,
+            usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&b, 0, bytes);
+        b
+    };
+    let data: [f32; 8] = [1.0, 0.0, 1e-7, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let buf = make(bytemuck::cast_slice(&data), wgpu::BufferUsages::COPY_SRC);
+    let zero = make(
+        bytemuck::cast_slice(&[0u32; 4]),
+        wgpu::BufferUsages::empty(),
+    );
+    let v = crate::common::gpu::dispatch_and_read(
+        &ctx,
+        &pipeline,
+        &[(0, &buf), (1, &zero)],
+        1,
+        &buf,
+        32,
+    );
+    let exact = 1.0 + 10_000.0 * 1e-7f32 as f64;
+    let kahan = v[0] as f64 - v[1] as f64;
+    let naive = v[3] as f64 - v[4] as f64;
+    println!(
+        "10 000 × 1e-7 onto 1: kahan_add2 off by {:.2e}; the plain-written compensation off by {:.2e}",
+        kahan - exact,
+        naive - exact
+    );
+    assert!(
+        (kahan - exact).abs() < 1e-6,
+        "the compensation was lost: {kahan} against {exact}"
+    );
 }

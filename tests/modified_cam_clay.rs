@@ -403,43 +403,14 @@ fn gpu_run(ctx: &Ctx, pipeline: &wgpu::ComputePipeline, cases: &[Case]) -> Vec<O
         &vec![0u8; out_bytes as usize],
         storage | wgpu::BufferUsages::COPY_SRC,
     );
-    let staging = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("staging"),
-        size: out_bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let group = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: par_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: in_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 4,
-                resource: out_buf.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = dev.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&out_buf, 0, &staging, 0, out_bytes);
-    ctx.queue.submit([enc.finish()]);
-    staging.map_async(wgpu::MapMode::Read, .., |r| r.unwrap());
-    dev.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let view = staging.get_mapped_range(..).unwrap();
-    let raw: Vec<f32> = bytemuck::cast_slice(&view[..]).to_vec();
+    let raw = crate::common::gpu::dispatch_and_read(
+        ctx,
+        pipeline,
+        &[(2, &par_buf), (3, &in_buf), (4, &out_buf)],
+        (cases.len() as u32).div_ceil(64),
+        &out_buf,
+        out_bytes,
+    );
     raw.chunks_exact(12)
         .map(|c| {
             (

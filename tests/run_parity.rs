@@ -131,12 +131,32 @@ fn check_energy(label: &str, cpu: &Outcome, gpu: &Outcome, tol: f64) {
 /// RMS over all samples of the difference of a probe quantity, and the
 /// largest |value| on the CPU, aligning samples by index (both backends
 /// sample at the first step end past each multiple of the interval).
+/// RMS of f(GPU sample) − f(CPU sample) over the samples both paths took
+/// at the same step, and the largest |f| on the CPU. A sample is taken at
+/// the first step end at or after its stop time; with CFL steps the GPU's
+/// f32 Δt drifts its time from the CPU's (3e-6 s after 2300 steps of the
+/// elastic block), so a stop that falls inside that drift is sampled one
+/// step apart (twice in the block's 400 samples on llvmpipe). Such pairs
+/// (times differing by more than 1 % of the sample interval; a step is
+/// 4–14 % of it in these scenes, the drift at most 0.2 %, in the gate's
+/// granular flow) say nothing about parity and are left out; at most one
+/// in 20 may be.
 fn history_rms(cpu: &[Sample], gpu: &[Sample], f: impl Fn(&Sample) -> f64) -> (f64, f64) {
     let n = cpu.len().min(gpu.len());
-    let rms = ((0..n)
-        .map(|k| (f(&cpu[k]) - f(&gpu[k])).powi(2))
+    let gap = |k: usize| if k == 0 { 0.0 } else { cpu[k].t - cpu[k - 1].t };
+    let same: Vec<usize> = (0..n)
+        .filter(|&k| (cpu[k].t - gpu[k].t).abs() <= 0.01 * gap(k) + 1e-12)
+        .collect();
+    assert!(
+        (n - same.len()) * 20 <= n,
+        "{} of {n} samples taken a step apart",
+        n - same.len()
+    );
+    let rms = (same
+        .iter()
+        .map(|&k| (f(&cpu[k]) - f(&gpu[k])).powi(2))
         .sum::<f64>()
-        / n as f64)
+        / same.len() as f64)
         .sqrt();
     let scale = cpu.iter().map(|s| f(s).abs()).fold(0.0, f64::max);
     (rms, scale)
@@ -260,8 +280,11 @@ fn elastic_block_gpu_matches_cpu() {
             s_rms < BLOCK_STRESS_TOL,
             "final sigma_yy differs: {s_rms:.3e}"
         );
-        // The GPU's error against the exact column within 10% of the CPU's.
-        let close = |g: f64, c: f64| (g - c).abs() <= 0.1 * c;
+        // The GPU's error against the exact column within 10% of the CPU's,
+        // or within 1e-4 of it: errors of a few 1e-4 are at f32's reach
+        // (the settlement histories differ by 3e-5 of the settlement), and
+        // on an NVIDIA H100 the LME run's 3.4e-4 came out 3.9e-4.
+        let close = |g: f64, c: f64| (g - c).abs() <= 0.1 * c + 1e-4;
         assert!(
             close(eg.settlement_rel_error, ec.settlement_rel_error),
             "settlement error gpu {} cpu {}",
@@ -859,4 +882,47 @@ fn constraint_points_gpu_matches_cpu() {
         assert!(s_rms < POINTS_TOL, "{shape}: final sigma_yy");
         check_energy(shape, &cpu, &gpu, POINTS_ENERGY_TOL);
     }
+}
+
+/// The device's clock against the CPU's over a long fixed-Δt run: 20 000
+/// steps of 5e-5 s, stopped every 0.05 s as samples stop it. At each stop
+/// both paths have taken the same number of steps and reached the same
+/// time. A compensated f32 sum of the time cannot promise this on every
+/// driver (llvmpipe reassociated it into a plain f32 sum, which drifts by
+/// 3e-8 s a step near t = 1 s, 6e-4 of Δt; on an NVIDIA H100 the
+/// manufactured vibration took 251 steps where the CPU took 250); the
+/// integer clock (`gpu::layout::Clock`) does.
+#[test]
+fn long_fixed_step_runs_keep_the_cpus_clock() {
+    let scene = common::scene(
+        "elastic_block.toml",
+        &["solver.dt=5e-5", "solver.t_end=1.0"],
+    );
+    let Some(ctx) = common::gpu::open("long fixed-step clock", false) else {
+        return;
+    };
+    let model = Model::new(&scene).unwrap();
+    let mut cpu = CpuBackend::new(model.clone());
+    let mut gpu = GpuBackend::new(ctx, model).unwrap();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut worst_t = 0.0f64;
+    for k in 1..=20 {
+        let target = 0.05 * k as f64;
+        cpu.advance(target, &stop).unwrap();
+        gpu.advance(target, &stop).unwrap();
+        assert_eq!(
+            cpu.steps(),
+            gpu.steps(),
+            "steps to t = {target}: cpu {} gpu {}",
+            cpu.steps(),
+            gpu.steps()
+        );
+        worst_t = worst_t.max((cpu.time() - gpu.time()).abs());
+    }
+    println!(
+        "20 stops, {} steps on both paths; largest time difference {worst_t:.2e} s",
+        cpu.steps()
+    );
+    assert_eq!(cpu.steps(), 20_000);
+    assert!(worst_t < 1e-12, "time differs by {worst_t:.3e} s");
 }

@@ -33,9 +33,8 @@ struct Params {
     cfl_h: f32,
     // Nodes lighter than this (kg) are empty.
     mass_eps: f32,
-    // t_end as a two-float sum (s).
-    t_end_hi: f32,
-    t_end_lo: f32,
+    // t_end in clock ticks (shared/clock.wgsl), low word first.
+    t_end_ticks: vec2<u32>,
     // Full gravity (m/s^2).
     gravity: vec2<f32>,
     // T of the sine ramp (eq. 45); 0 = constant gravity.
@@ -85,19 +84,26 @@ struct Params {
     pic_fraction: f32,
     // Cundall's local damping α (flag LOCAL_DAMPING), in [0, 1).
     local_damping: f32,
-    _pad_p2: u32,
+    // A clock tick is 2^-tick_exp s (shared/clock.wgsl).
+    tick_exp: i32,
+    // The fixed Δt (as the CPU path's f64) in ticks; 0 with CFL steps.
+    fixed_dt_ticks: vec2<u32>,
+    // Always 0, unknown to the shader compiler (shared/kahan.wgsl).
+    opaque_zero: u32,
+    _pad_p3: u32,
 }
 
 // Run state on the device (storage, read_write), read back at sample times.
 struct Sim {
-    // Time reached (s) as a compensated (Kahan) sum t + t_lo.
+    // Time reached (s) as a two-float sum t + t_lo, derived from `ticks`.
     t: f32,
     t_lo: f32,
+    // Time reached in clock ticks (shared/clock.wgsl): the device's clock.
+    ticks: vec2<u32>,
+    // Steps stop once `ticks` reaches this.
+    t_stop_ticks: vec2<u32>,
     // This step's Δt (s).
     dt: f32,
-    // Steps stop once the time reaches t_stop_hi + t_stop_lo (s).
-    t_stop_hi: f32,
-    t_stop_lo: f32,
     steps: u32,
     // 1 while the current step runs; every pass returns early on 0.
     running: u32,
@@ -107,8 +113,6 @@ struct Sim {
     cmax_bits: atomic<u32>,
     // (particle << 4) | code of the first fault, FAULT_NONE if none.
     fault: atomic<u32>,
-    _pad0: u32,
-    _pad1: u32,
 }
 
 struct Material {

@@ -540,16 +540,14 @@ pub fn initial_sim() -> Sim {
     Sim {
         t: 0.0,
         t_lo: 0.0,
+        ticks: [0; 2],
+        t_stop_ticks: [0; 2],
         dt: 0.0,
-        t_stop_hi: 0.0,
-        t_stop_lo: 0.0,
         steps: 0,
         running: 0,
         final_step: 0,
         cmax_bits: 0,
         fault: super::layout::FAULT_NONE,
-        _pad0: 0,
-        _pad1: 0,
     }
 }
 

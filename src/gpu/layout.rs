@@ -16,8 +16,8 @@ pub struct Params {
     pub inv_h: f32,
     pub cfl_h: f32,
     pub mass_eps: f32,
-    pub t_end_hi: f32,
-    pub t_end_lo: f32,
+    /// t_end in clock ticks (`Clock`), low word first.
+    pub t_end_ticks: [u32; 2],
     pub gravity: [f32; 2],
     pub ramp_period: f32,
     pub npc_gamma: f32,
@@ -49,26 +49,34 @@ pub struct Params {
     pub mls_weight_scale: f32,
     pub pic_fraction: f32,
     pub local_damping: f32,
-    pub _pad_p2: u32,
+    /// A clock tick is 2^-tick_exp s (`Clock`).
+    pub tick_exp: i32,
+    /// The fixed Δt (f64, as the CPU path steps it) in ticks; 0 with CFL steps.
+    pub fixed_dt_ticks: [u32; 2],
+    /// Always 0: an operand the shader compiler cannot fold
+    /// (`shaders/shared/kahan.wgsl`).
+    pub opaque_zero: u32,
+    pub _pad_p3: u32,
 }
-const _: () = assert!(std::mem::size_of::<Params>() == 176);
+const _: () = assert!(std::mem::size_of::<Params>() == 192);
 
 /// Run state on the device. Atomic fields of the WGSL struct are plain u32 here.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct Sim {
+    /// The time as a two-float sum t + t_lo (s), derived from `ticks`.
     pub t: f32,
     pub t_lo: f32,
+    /// The time in clock ticks (`Clock`), low word first: the device's clock.
+    pub ticks: [u32; 2],
+    /// Steps stop once `ticks` reaches this.
+    pub t_stop_ticks: [u32; 2],
     pub dt: f32,
-    pub t_stop_hi: f32,
-    pub t_stop_lo: f32,
     pub steps: u32,
     pub running: u32,
     pub final_step: u32,
     pub cmax_bits: u32,
     pub fault: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
 }
 const _: () = assert!(std::mem::size_of::<Sim>() == 48);
 
@@ -173,4 +181,67 @@ pub const FAULT_MATERIAL: u32 = crate::model::material::registry::GPU_FAULT_BASE
 pub fn split_f64(v: f64) -> (f32, f32) {
     let hi = v as f32;
     (hi, (v - hi as f64) as f32)
+}
+
+/// The device's clock: time as an unsigned 64-bit count of ticks of
+/// 2^-exp s, advanced in integers by `step_end.wgsl`. A compensated float
+/// sum (Kahan) is not safe on GPUs: a driver may reassociate
+/// `(t + y − t) − y` to 0 (llvmpipe's time followed a plain f32 sum), and
+/// a plain f32 sum of 1e5 steps of 1e-5 s drifts by whole steps. Integer
+/// sums cannot be rewritten. `exp` is chosen so that t_end is below 2^61
+/// ticks: at t_end = 1 s a tick is 2^-61 s; any Δt above 2^23 ticks
+/// (1e-11 s at t_end = 1 s) converts to ticks exactly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clock {
+    pub exp: i32,
+}
+
+impl Clock {
+    /// The finest clock whose range holds `t_end` (with a factor 2 spare).
+    pub fn for_end(t_end: f64) -> Clock {
+        let e = t_end.max(f64::MIN_POSITIVE).log2().ceil() as i32;
+        Clock {
+            exp: (61 - e).clamp(-60, 120),
+        }
+    }
+
+    /// `t` (s, ≥ 0) in ticks, rounded to the nearest.
+    pub fn ticks(self, t: f64) -> [u32; 2] {
+        let v = (t.max(0.0) * 2f64.powi(self.exp)).round();
+        let v = if v >= 1.8e19 { u64::MAX } else { v as u64 };
+        [v as u32, (v >> 32) as u32]
+    }
+
+    /// Ticks in seconds.
+    pub fn seconds(self, ticks: [u32; 2]) -> f64 {
+        let v = ((ticks[1] as u64) << 32) | ticks[0] as u64;
+        v as f64 * 2f64.powi(-self.exp)
+    }
+}
+
+#[cfg(test)]
+mod clock_tests {
+    use super::Clock;
+
+    #[test]
+    fn the_clock_holds_t_end_and_resolves_small_steps() {
+        for t_end in [1e-3, 0.0025, 1.0, 20.0, 3600.0, 1e6] {
+            let c = Clock::for_end(t_end);
+            let ticks = c.ticks(t_end);
+            let v = ((ticks[1] as u64) << 32) | ticks[0] as u64;
+            assert!(v <= 1 << 61 && v > 1 << 59, "t_end {t_end}: {v} ticks");
+            // One tick is below 1e-17 of t_end: the clock adds no error a
+            // run could see.
+            assert!((c.seconds(ticks) - t_end).abs() <= 2f64.powi(-c.exp));
+            assert!(2f64.powi(-c.exp) < 1e-17 * t_end);
+            // 1e5 steps of t_end / 1e5, each an f32, sum exactly in ticks.
+            let dt = (t_end / 1e5) as f32 as f64;
+            let step = c.ticks(dt);
+            assert_eq!(
+                c.seconds(step),
+                dt,
+                "t_end {t_end}: Δt {dt} not exact in ticks"
+            );
+        }
+    }
 }

@@ -234,17 +234,29 @@ impl GpuBackend {
             .collect())
     }
 
-    /// Sets the device's stop time (`Sim::t_stop_hi`, `t_stop_lo`: adjacent
-    /// fields, written together) and leaves the rest of `Sim` as it is.
-    fn write_stop(&self, hi: f32, lo: f32) {
-        const _: () = assert!(
-            std::mem::offset_of!(Sim, t_stop_lo) == std::mem::offset_of!(Sim, t_stop_hi) + 4
-        );
+    /// Sets the device's stop time (`Sim::t_stop_ticks`) and leaves the
+    /// rest of `Sim` as it is.
+    fn write_stop(&self, ticks: [u32; 2]) {
         self.ctx.queue.write_buffer(
             self.buffers.get(Buf::Sim),
-            std::mem::offset_of!(Sim, t_stop_hi) as u64,
-            bytemuck::cast_slice(&[hi, lo]),
+            std::mem::offset_of!(Sim, t_stop_ticks) as u64,
+            bytemuck::cast_slice(&ticks),
         );
+    }
+
+    /// Whether the device has reached `stop` as `step_begin.wgsl` decides
+    /// it: its ticks plus LAST_STEP_REL of the last Δt, that product
+    /// rounded to f32 and then to ticks as the shader does.
+    fn stop_reached(&self, stop: [u32; 2]) -> bool {
+        let clock = self.clock();
+        let slack = crate::model::time_step::LAST_STEP_REL as f32 * self.sim.dt;
+        let u = |t: [u32; 2]| ((t[1] as u64) << 32) | t[0] as u64;
+        u(self.sim.ticks).saturating_add(u(clock.ticks(slack as f64))) >= u(stop)
+    }
+
+    /// The device's clock for this model's t_end.
+    fn clock(&self) -> Clock {
+        Clock::for_end(self.model.t_end)
     }
 
     fn write_sim(&self, sim: &Sim) {
@@ -315,14 +327,15 @@ impl GpuBackend {
             0,
             bytemuck::cast_slice(&nodes),
         );
-        let (t, t_lo) = split_f64(state.t);
-        let (sh, sl) = split_f64(self.model.t_end);
+        let clock = self.clock();
+        let ticks = clock.ticks(state.t);
+        let (t, t_lo) = split_f64(clock.seconds(ticks));
         let sim = Sim {
             t,
             t_lo,
+            ticks,
+            t_stop_ticks: clock.ticks(self.model.t_end),
             dt: state.dt as f32,
-            t_stop_hi: sh,
-            t_stop_lo: sl,
             running: 1,
             steps,
             ..buffers::initial_sim()
@@ -341,7 +354,7 @@ impl GpuBackend {
     }
 
     fn t(&self) -> f64 {
-        (self.sim.t as f64 + self.sim.t_lo as f64).max(self.t_floor)
+        self.clock().seconds(self.sim.ticks).max(self.t_floor)
     }
 }
 
@@ -349,7 +362,7 @@ impl GpuBackend {
 pub fn params(model: &Model) -> Params {
     let g = &model.grid;
     let min_mass = model.particles.min_mass();
-    let (t_end_hi, t_end_lo) = split_f64(model.t_end);
+    let clock = Clock::for_end(model.t_end);
     let (gamma, p2g_accel) = match model.integrator {
         // `with_options` refuses implicit models before this is read.
         Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => (1.0, 0.0),
@@ -387,8 +400,7 @@ pub fn params(model: &Model) -> Params {
         inv_h: (1.0 / g.h) as f32,
         cfl_h: (model.cfl * g.min_spacing()) as f32,
         mass_eps: (crate::model::MASS_EPS_REL * min_mass) as f32,
-        t_end_hi,
-        t_end_lo,
+        t_end_ticks: clock.ticks(model.t_end),
         gravity,
         ramp_period,
         npc_gamma: gamma as f32,
@@ -428,7 +440,10 @@ pub fn params(model: &Model) -> Params {
         mls_weight_scale: (1.5 / model.mls_support) as f32,
         pic_fraction: model.pic_fraction as f32,
         local_damping: model.local_damping as f32,
-        _pad_p2: 0,
+        tick_exp: clock.exp,
+        fixed_dt_ticks: model.fixed_dt.map_or([0; 2], |dt| clock.ticks(dt)),
+        opaque_zero: 0,
+        _pad_p3: 0,
     }
 }
 
@@ -451,14 +466,14 @@ impl Backend for GpuBackend {
 
     fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt> {
         let t_end = self.model.t_end;
-        let (hi, lo) = split_f64(t_stop.min(t_end));
-        // The device compares with the two-float target, which can sit an
-        // f32 rounding of `lo` below the f64 one.
-        let target = hi as f64 + lo as f64;
-        self.write_stop(hi, lo);
+        let clock = self.clock();
+        let stop_ticks = clock.ticks(t_stop.min(t_end));
+        // The device compares in ticks, a rounding of the f64 stop time.
+        let target = clock.seconds(stop_ticks);
+        self.write_stop(stop_ticks);
         loop {
             let t = self.t();
-            if t >= target {
+            if t >= target || self.stop_reached(stop_ticks) {
                 // Reached as the device counts: report the stop time itself.
                 self.t_floor = self.t_floor.max(t_stop.min(t_end));
                 return Ok(());
@@ -479,7 +494,7 @@ impl Backend for GpuBackend {
             if let Some(f) = self.fault() {
                 return Err(f.into());
             }
-            if self.sim.steps == before && self.t() < target {
+            if self.sim.steps == before && self.t() < target && !self.stop_reached(stop_ticks) {
                 // No step ran although time remains: Δt must have become 0 or NaN.
                 return Err(Fault {
                     particle: None,
@@ -491,8 +506,7 @@ impl Backend for GpuBackend {
     }
 
     fn advance_steps(&mut self, n: u64) -> std::result::Result<(), Halt> {
-        let (hi, lo) = split_f64(self.model.t_end);
-        self.write_stop(hi, lo);
+        self.write_stop(self.clock().ticks(self.model.t_end));
         let mut left = n;
         while left > 0 {
             let k = left.min(MAX_BATCH);

@@ -13,6 +13,16 @@ use rayon::prelude::*;
 /// tests/gpu_shaders.rs).
 pub const LAST_STEP_REL: f64 = 1e-6;
 
+/// Whether a stop time (a sample, snapshot or checkpoint time) is reached
+/// at `t`, the last step having been `dt_last`: within LAST_STEP_REL of
+/// that step below it counts. Fixed steps meant to land on the stop can
+/// fall short of it by round-off (2000 steps of 5e-5 s sum to 0.1 − 3e-15
+/// in f64), and the step that follows would take the sample a whole Δt
+/// late. Mirrored on the device in `shaders/step_begin.wgsl`.
+pub fn stop_reached(t: f64, t_stop: f64, dt_last: f64) -> bool {
+    t >= t_stop - LAST_STEP_REL * dt_last
+}
+
 /// Δt of a step starting at `t` (s), and whether it is the last.
 pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
     step_of(model, max_speed(model), t)

@@ -56,3 +56,48 @@ pub fn open(label: &str, force_cas: bool) -> Option<GpuContext> {
         Err(e) => panic!("{}: {e}", test_name(label)),
     }
 }
+
+/// Runs a test's own small compute kernel once: binds `buffers` (binding
+/// number, buffer) to group 0 of `pipeline`, dispatches `groups`
+/// workgroups, and returns `read`'s first `bytes` bytes as f32s.
+pub fn dispatch_and_read(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    buffers: &[(u32, &wgpu::Buffer)],
+    groups: u32,
+    read: &wgpu::Buffer,
+    bytes: u64,
+) -> Vec<f32> {
+    let dev = &ctx.device;
+    let staging = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("staging"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry {
+            binding,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let group = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let mut enc = dev.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(groups, 1, 1);
+    }
+    enc.copy_buffer_to_buffer(read, 0, &staging, 0, bytes);
+    ctx.queue.submit([enc.finish()]);
+    staging.map_async(wgpu::MapMode::Read, .., |r| r.unwrap());
+    dev.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let view = staging.get_mapped_range(..).unwrap();
+    bytemuck::cast_slice(&view[..]).to_vec()
+}

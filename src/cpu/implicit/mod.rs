@@ -1041,8 +1041,16 @@ impl Backend for ImplicitBackend {
     }
 
     fn advance(&mut self, t_stop: f64, stop: &AtomicBool) -> std::result::Result<(), Halt> {
-        while self.t < t_stop && self.t < self.model.t_end && !stop_requested(stop) {
+        while !crate::model::time_step::stop_reached(self.t, t_stop, self.dt)
+            && self.t < self.model.t_end
+            && !stop_requested(stop)
+        {
             self.step()?;
+        }
+        if self.t < t_stop && crate::model::time_step::stop_reached(self.t, t_stop, self.dt) {
+            // Within round-off of the stop the steps were meant to land on:
+            // report the stop time itself, as the GPU does.
+            self.t = t_stop.min(self.model.t_end);
         }
         Ok(())
     }
