@@ -20,8 +20,9 @@ fn main() {
     let slack = ticks_of(LAST_STEP_REL * sim.dt);
     if fault != FAULT_NONE || ticks_le(sim.t_stop_ticks, ticks_add(sim.ticks, slack))
         || ticks_le(params.t_end_ticks, sim.ticks) {
+        // sim.dt keeps the last step's Δt: the next stop's slack (here and
+        // on the host) is taken from it.
         sim.running = 0u;
-        sim.dt = 0.0;
         return;
     }
     var dt = params.cfl_h / cmax;
