@@ -128,9 +128,6 @@ fn check_energy(label: &str, cpu: &Outcome, gpu: &Outcome, tol: f64) {
     }
 }
 
-/// RMS over all samples of the difference of a probe quantity, and the
-/// largest |value| on the CPU, aligning samples by index (both backends
-/// sample at the first step end past each multiple of the interval).
 /// RMS of f(GPU sample) − f(CPU sample) over the samples both paths took
 /// at the same step, and the largest |f| on the CPU. A sample is taken at
 /// the first step end at or after its stop time; with CFL steps the GPU's

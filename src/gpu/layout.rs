@@ -188,16 +188,17 @@ pub fn split_f64(v: f64) -> (f32, f32) {
 /// sum (Kahan) is not safe on GPUs: a driver may reassociate
 /// `(t + y − t) − y` to 0 (llvmpipe's time followed a plain f32 sum), and
 /// a plain f32 sum of 1e5 steps of 1e-5 s drifts by whole steps. Integer
-/// sums cannot be rewritten. `exp` is chosen so that t_end is below 2^61
-/// ticks: at t_end = 1 s a tick is 2^-61 s; any Δt above 2^23 ticks
-/// (1e-11 s at t_end = 1 s) converts to ticks exactly.
+/// sums cannot be rewritten. `exp` is chosen so that t_end is at most
+/// 2^61 ticks, an eighth of the range: at t_end = 1 s a tick is 2^-61 s;
+/// any f32 Δt above 2^23 ticks (4e-12 s at t_end = 1 s) converts to ticks
+/// exactly.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clock {
     pub exp: i32,
 }
 
 impl Clock {
-    /// The finest clock whose range holds `t_end` (with a factor 2 spare).
+    /// The finest clock that holds `t_end` in 2^61 ticks.
     pub fn for_end(t_end: f64) -> Clock {
         let e = t_end.max(f64::MIN_POSITIVE).log2().ceil() as i32;
         Clock {
