@@ -70,6 +70,9 @@ fn allocations(threads: usize) -> Vec<(String, usize)> {
                 ],
             ),
             ("aligned_vibration.toml", &["grid.h=0.125"]),
+            // B-splines on walls with a geostatic preload: the preload's
+            // weights at the wall's line (`grid_update::LineWeights`).
+            ("granular_collapse.toml", &["grid.h=0.1"]),
         ] {
             let scene = common::scene(case, sets);
             let mut b = CpuBackend::new(Model::new(&scene).unwrap());

@@ -112,20 +112,27 @@ pub struct ContactParticles<'a> {
     pub line: Option<(&'a Shape, &'a Grid)>,
 }
 
+/// Most nodes of a B-spline's support (cubic: 4 × 4).
+const LINE_NODES: usize = 16;
+
 /// The nodes and weights N_I(x_p − d n) of a contact's point on the wall's
 /// line, evaluated by the shape itself (B-splines; `ContactParticles::line`).
+/// Fixed-size, so that a step allocates nothing (tests/no_alloc.rs).
 struct LineWeights {
-    nodes: Vec<u32>,
-    w: Vec<[f64; 3]>,
+    nodes: [u32; LINE_NODES],
+    w: [[f64; 3]; LINE_NODES],
     len: usize,
 }
 
 impl LineWeights {
     fn new(line: Option<(&Shape, &Grid)>) -> Self {
-        let n = line.map_or(0, |(s, _)| s.max_nodes());
+        assert!(
+            line.is_none_or(|(s, _)| s.max_nodes() <= LINE_NODES),
+            "line weights hold B-spline supports of at most {LINE_NODES} nodes"
+        );
         LineWeights {
-            nodes: vec![0; n],
-            w: vec![[0.0; 3]; n],
+            nodes: [0; LINE_NODES],
+            w: [[0.0; 3]; LINE_NODES],
             len: 0,
         }
     }
