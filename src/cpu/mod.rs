@@ -620,11 +620,7 @@ impl Backend for CpuBackend {
         {
             self.step()?;
         }
-        if self.t < t_stop && crate::model::time_step::stop_reached(self.t, t_stop, self.dt) {
-            // Within round-off of the stop the steps were meant to land on:
-            // report the stop time itself, as the GPU does.
-            self.t = t_stop.min(self.model.t_end);
-        }
+        self.t = crate::model::time_step::settle_on_stop(self.t, t_stop, self.model.t_end, self.dt);
         Ok(())
     }
 

@@ -23,6 +23,17 @@ pub fn stop_reached(t: f64, t_stop: f64, dt_last: f64) -> bool {
     t >= t_stop - LAST_STEP_REL * dt_last
 }
 
+/// The time a CPU backend reports once `advance` has stopped at `t`: the
+/// stop time itself when `t` is within round-off below it (as the GPU
+/// reports it), else `t`.
+pub fn settle_on_stop(t: f64, t_stop: f64, t_end: f64, dt_last: f64) -> f64 {
+    if t < t_stop && stop_reached(t, t_stop, dt_last) {
+        t_stop.min(t_end)
+    } else {
+        t
+    }
+}
+
 /// Δt of a step starting at `t` (s), and whether it is the last.
 pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
     step_of(model, max_speed(model), t)
