@@ -653,15 +653,13 @@ mod tests {
         use crate::scene::Override;
         let warned = |sets: &[&str]| {
             let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-            let text = crate::cases::GRANULAR_COLLAPSE;
-            let text: String = if sets.iter().any(|s| s.contains("linear")) {
-                text.lines()
-                    .filter(|l| !l.starts_with("bspline_knots"))
-                    .collect::<Vec<_>>()
-                    .join("\n")
+            // The case as `study column` runs it for the shape set here.
+            let shape = if sets.iter().any(|s| s.contains("linear")) {
+                "linear"
             } else {
-                text.to_string()
+                "bspline2"
             };
+            let text = crate::study::column::granular_case(shape);
             let scene = Scene::from_str(&text, "g", "g", &o).unwrap();
             geostatic_knots_warning(&scene)
         };

@@ -149,7 +149,7 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
 
 /// The cohesionless case for shape `shape`: its `bspline_knots` line
 /// (which only B-splines accept) dropped for the other shapes.
-fn granular_case(shape: &str) -> std::borrow::Cow<'static, str> {
+pub(crate) fn granular_case(shape: &str) -> std::borrow::Cow<'static, str> {
     if shape.starts_with("bspline") {
         GRANULAR_COLLAPSE.into()
     } else {
