@@ -14,5 +14,20 @@ pub const CONTACT_BLOCK: &str = include_str!("../cases/contact_block.toml");
 pub const CONTACT_DISKS: &str = include_str!("../cases/contact_disks.toml");
 pub const CONTACT_ROLLING: &str = include_str!("../cases/contact_rolling.toml");
 
+/// The cohesionless case for shape `shape`: its `bspline_knots` line
+/// (which only B-splines accept) dropped for the other shapes.
+pub fn granular_case(shape: &str) -> std::borrow::Cow<'static, str> {
+    if shape.starts_with("bspline") {
+        GRANULAR_COLLAPSE.into()
+    } else {
+        GRANULAR_COLLAPSE
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("bspline_knots"))
+            .collect::<Vec<_>>()
+            .join("\n")
+            .into()
+    }
+}
+
 /// Dyka's bar length (m), as in `cases/dyka_bar.toml`.
 pub const DYKA_L: f64 = 0.1333;

@@ -659,7 +659,7 @@ mod tests {
             } else {
                 "bspline2"
             };
-            let text = crate::study::column::granular_case(shape);
+            let text = crate::cases::granular_case(shape);
             let scene = Scene::from_str(&text, "g", "g", &o).unwrap();
             geostatic_knots_warning(&scene)
         };

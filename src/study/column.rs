@@ -10,7 +10,7 @@
 
 use super::runner::{Job, JobResult};
 use super::{Method, backend_slug, image, sig, table};
-use crate::cases::{COLUMN_COLLAPSE, GRANULAR_COLLAPSE};
+use crate::cases::{COLUMN_COLLAPSE, granular_case};
 use crate::chart::{LineChart, Panel, ParticleImage, Series};
 use crate::error::Result;
 use crate::model::Particles;
@@ -145,21 +145,6 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
         }
     }
     out
-}
-
-/// The cohesionless case for shape `shape`: its `bspline_knots` line
-/// (which only B-splines accept) dropped for the other shapes.
-pub(crate) fn granular_case(shape: &str) -> std::borrow::Cow<'static, str> {
-    if shape.starts_with("bspline") {
-        GRANULAR_COLLAPSE.into()
-    } else {
-        GRANULAR_COLLAPSE
-            .lines()
-            .filter(|l| !l.trim_start().starts_with("bspline_knots"))
-            .collect::<Vec<_>>()
-            .join("\n")
-            .into()
-    }
 }
 
 /// Half the particle spacing at cell size `h`: a particle's extent beyond
