@@ -249,12 +249,13 @@ fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
 
 /// The B-spline paper's method as printed (bspline2 + MLS with its MUSL
 /// update and weight), asserted as measured on 2026-11-23, not as the paper
-/// claims. Over one period it converges at second order (0.1047 and
-/// 0.0211 m at 8 and 16 cells, order 2.3) but errs 8 times more than plain
-/// bspline2 with the same update (0.00252 m at 16 cells); over the ten
-/// periods it stops with `energy_runaway` at 0.024 s on 8 cells, where
-/// plain bspline2 completes. The cause is the fit (docs/methods.md, "Why
-/// MLS is less accurate"); `tests/mls_reconstruction.rs` measures it.
+/// claims: over the ten periods it stops with `energy_runaway` at 0.024 s
+/// on 8 cells, where plain bspline2 completes. Over one period it
+/// converges at second order but errs 8 times more than plain bspline2;
+/// those figures are asserted by `studies::mms_quick_…`, whose quick sweep
+/// runs exactly those runs (the same scene, E, MUSL and end time), so they
+/// are not run twice. The cause is the fit (docs/methods.md, "Why MLS is
+/// less accurate"); `tests/mls_reconstruction.rs` measures it.
 #[test]
 fn aligned_vibration_paper_method_figures_as_measured() {
     let disp = |sets: &[&str]| -> (RunStatus, f64) {
@@ -275,21 +276,6 @@ fn aligned_vibration_paper_method_figures_as_measured() {
     let with = |base: &[&'static str], more: &[&'static str]| -> Vec<&'static str> {
         base.iter().chain(more).copied().collect()
     };
-    let one = "solver.t_end=0.02";
-    let (s8, e8) = disp(&with(&paper, &["grid.h=0.125", one]));
-    let (s16, e16) = disp(&with(&paper, &["grid.h=0.0625", one]));
-    let (p16s, p16) = disp(&with(&plain, &["grid.h=0.0625", one]));
-    println!(
-        "paper's method, one period: {e8} m (8 cells), {e16} m (16); plain bspline2 {p16} m (16)"
-    );
-    for s in [&s8, &s16, &p16s] {
-        assert_eq!(*s, RunStatus::Completed);
-    }
-    // ±5% of the measured figures.
-    assert!((e8 / 0.1047 - 1.0).abs() < 0.05, "{e8}");
-    assert!((e16 / 0.0211 - 1.0).abs() < 0.05, "{e16}");
-    assert!((e8 / e16).log2() >= 1.8, "order {}", (e8 / e16).log2());
-    assert!(e16 > 5.0 * p16, "MLS {e16} against plain {p16}");
     // Ten periods at 8 cells.
     let (s, _) = disp(&with(&paper, &["grid.h=0.125"]));
     match s {
