@@ -297,6 +297,10 @@ pub struct PlanInputs {
     /// points' projection after every `GridPredict` and `GridCorrect`
     /// pass (the CPU's `grid_update` stages call it themselves).
     pub points: bool,
+    /// `solver.volumetric_strain = "cell_average"` (CPU only): `stress`
+    /// averages the volumetric strain rate over each cell first, so it
+    /// does not fuse with `forces`.
+    pub cell_average: bool,
 }
 
 /// The step of one scene, for both backends.
@@ -331,6 +335,7 @@ impl StepPlan {
             walls: !model.walls.is_empty(),
             contact: model.contact.is_some(),
             points: !model.constraints.points.is_empty(),
+            cell_average: model.cell_average_volumetric,
         })
     }
 
@@ -341,10 +346,11 @@ impl StepPlan {
             musl,
             gather,
             contact,
+            cell_average,
             ..
         } = inputs;
         let stages = if musl { STEP_MUSL } else { STEP };
-        let fuse_stress = !mls && !mls_force && !musl;
+        let fuse_stress = !mls && !mls_force && !musl && !cell_average;
         let fuse_p2g = !mls && !contact;
         let cpu = stages
             .iter()
@@ -411,6 +417,7 @@ impl StepPlan {
             walls,
             contact,
             points: _,
+            cell_average: _,
         } = self.inputs;
         let binned = gather || patch || contact;
         match stage {
@@ -526,6 +533,7 @@ mod tests {
             walls: lme,
             contact: false,
             points: false,
+            cell_average: false,
         })
     }
 
@@ -548,6 +556,13 @@ mod tests {
         let p = plan(true, false, false, false, true);
         assert!(p.gpu_step.contains(&Pass::StressForcesPatch));
         assert!(p.gpu_uses(Pass::ForcesPatch) && !p.gpu_uses(Pass::Forces));
+        // The cell average of the volumetric strain rate needs every
+        // particle's L before any stress: the CPU runs the stages apart.
+        let mut inputs = plan(false, false, false, false, false).inputs;
+        inputs.cell_average = true;
+        let p = StepPlan::new(inputs);
+        assert!(!p.cpu.contains(&CpuWork::StressForces));
+        assert!(p.cpu.contains(&CpuWork::Stage(Stage::Stress)));
     }
 
     /// `solver.mls_scope = "force"` changes `forces` alone: p2g, the remap
@@ -565,6 +580,7 @@ mod tests {
                 walls: false,
                 contact: false,
                 points: false,
+                cell_average: false,
             });
             assert_eq!(p.cpu[2], CpuWork::ShapeEvalP2g);
             assert!(!p.cpu.contains(&CpuWork::StressForces));
@@ -639,6 +655,7 @@ mod tests {
                     walls,
                     contact: false,
                     points: false,
+                    cell_average: false,
                 };
                 let without = StepPlan::new(base);
                 let with = StepPlan::new(PlanInputs {
@@ -688,6 +705,7 @@ mod tests {
                 walls: b(2),
                 contact: b(3),
                 points: false,
+                cell_average: false,
             };
             let without = StepPlan::new(base);
             let with = StepPlan::new(PlanInputs {

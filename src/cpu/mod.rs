@@ -2,6 +2,7 @@
 //! mirroring the WGSL twin of the same name. Buffers are allocated once in
 //! `CpuBackend::new`; a step allocates nothing.
 
+pub mod antilock;
 pub mod cfl;
 pub mod clear_grid;
 pub mod constraint_points;
@@ -60,6 +61,9 @@ pub struct CpuBackend {
     /// `solver.mls_scope = "force"`: per particle, the strain-rate
     /// correction `Mls::strain_correction` (empty otherwise).
     mls_dl: Vec<[f64; 4]>,
+    /// `solver.volumetric_strain = "cell_average"`: the cells' mean
+    /// volumetric strain rate (`antilock`); None otherwise.
+    cell_average: Option<antilock::CellAverage>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -149,6 +153,9 @@ impl CpuBackend {
             } else {
                 Vec::new()
             },
+            cell_average: model
+                .cell_average_volumetric
+                .then(|| antilock::CellAverage::new(&model.grid, model.body_names.len(), n)),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -201,6 +208,11 @@ impl CpuBackend {
         }
         // Shape cache: a count, then per slot a node index and 3 f64.
         per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
+        // The cell average: tr L and its slot, the correction; per cell
+        // and body two sums.
+        if model.cell_average_volumetric {
+            per += 16.0 + 32.0 + 16.0 * (model.grid.n_nodes() * model.body_names.len()) as f64 / n;
+        }
         // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask,
         // contact weights, forces and node lists.
         let walls = if model.walls.is_empty() {
@@ -443,6 +455,20 @@ impl CpuBackend {
                         &mut self.mls_dl,
                     );
                 }
+                let dl = if let Some(ca) = &mut self.cell_average {
+                    ca.update(
+                        &m.grid,
+                        &self.cache,
+                        &self.mv,
+                        &p.x,
+                        &p.mass,
+                        &p.rho,
+                        &p.body,
+                    );
+                    &ca.dl
+                } else {
+                    &self.mls_dl
+                };
                 stress::stress(
                     &self.cache,
                     &self.mv,
@@ -454,7 +480,7 @@ impl CpuBackend {
                     &mut p.rho,
                     &mut p.f,
                     &mut p.plastic,
-                    &self.mls_dl,
+                    dl,
                 )?
             }
             Stage::Forces => {

@@ -188,6 +188,8 @@ impl Variant {
             walls: self.walls,
             contact: self.contact.is_some(),
             points: self.points.is_some(),
+            // The GPU refuses the cell average (`GpuBackend::with_options`).
+            cell_average: false,
         })
     }
 

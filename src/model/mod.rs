@@ -226,6 +226,10 @@ pub struct Model {
     /// Cundall's local damping α (`solver.local_damping`, 0 = none;
     /// explicit integrators, `grid_update::correct`).
     pub local_damping: f64,
+    /// `solver.volumetric_strain = "cell_average"`: each particle's
+    /// volumetric strain rate is its cell's mean over its body
+    /// (`cpu::antilock`).
+    pub cell_average_volumetric: bool,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
@@ -369,6 +373,8 @@ impl Model {
             mls_scope: f.solver.mls_scope,
             pic_fraction: f.solver.pic_fraction,
             local_damping: f.solver.local_damping,
+            cell_average_volumetric: f.solver.volumetric_strain
+                == crate::scene::VolumetricStrain::CellAverage,
             probes,
             manufactured,
             outline: if f.solver.method == SolverMethod::Gmm {

@@ -557,6 +557,31 @@ pub struct SolverSpec {
     /// integrators). Default 0 (none).
     #[serde(default)]
     pub local_damping: f64,
+    /// The volumetric part of each particle's strain rate: its own
+    /// (`particle`, the default) or the volume-weighted mean of tr L over
+    /// the particles of its body in its grid cell (`cell_average`: a B-bar
+    /// against volumetric locking under nearly incompressible plastic
+    /// flow, Coombs et al. 2018). Explicit integrators, CPU path.
+    #[serde(default)]
+    pub volumetric_strain: VolumetricStrain,
+}
+
+/// The volumetric strain rate a particle's stress update takes
+/// (`solver.volumetric_strain`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumetricStrain {
+    /// tr L_p, the particle's own.
+    #[default]
+    Particle,
+    /// The cell's volume-weighted mean over the particles of the same body.
+    CellAverage,
+}
+
+impl VolumetricStrain {
+    /// Why the GPU path refuses `cell_average`.
+    pub const CPU_ONLY: &str = "= \"cell_average\" runs on the CPU path only: use --backend cpu \
+                                or auto (its GPU pass is not built yet)";
 }
 
 /// Where the B-splines' knots sit (`solver.bspline_knots`).

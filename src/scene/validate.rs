@@ -179,6 +179,22 @@ fn check_dissipation(s: &SolverSpec) -> Result<(), SceneError> {
             }
         }
     }
+    if s.volumetric_strain == VolumetricStrain::CellAverage {
+        if s.integrator == IntegratorKind::Implicit {
+            return Err(SceneError::invalid(
+                "solver.volumetric_strain",
+                "= \"cell_average\" is read by the explicit integrators only (fe, npc, musl); \
+                 drop it with integrator = \"implicit\"",
+            ));
+        }
+        if s.mls {
+            return Err(SceneError::invalid(
+                "solver.volumetric_strain",
+                "= \"cell_average\" does not combine with mls = true (the fit has its own strain \
+                 rate): drop one of them",
+            ));
+        }
+    }
     Ok(())
 }
 

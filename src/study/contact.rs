@@ -12,13 +12,17 @@
 //! - A disk rolling on an elastic slab (`cases/contact_rolling.toml`) at
 //!   R/h = 10, 20 (and 40 in the full study): the centre's displacement
 //!   against ½ (2/3) g sin θ t².
+//! - A rigid strip footing pressed into a Tresca soil (`cases/footing.toml`,
+//!   full study, CPU), smooth and rough, h = 0.1, 0.05 and 0.025 m: the
+//!   peak pressure against Prandtl's (2 + π) c, and the load–settlement
+//!   curves.
 //!
 //! Everything is measured from particle snapshots (`BodyMotion`), so the
 //! figures do not depend on the run's own score.
 
 use super::runner::{Job, JobResult};
 use super::{backend_slug, image, sig, table};
-use crate::cases::{CONTACT_BLOCK, CONTACT_DISKS, CONTACT_ROLLING};
+use crate::cases::{CONTACT_BLOCK, CONTACT_DISKS, CONTACT_ROLLING, FOOTING};
 use crate::chart::{LineChart, Series};
 use crate::error::Result;
 use crate::exact::sliding::SlidingBlock;
@@ -244,7 +248,63 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
             }
         }
     }
+    if !quick {
+        out.extend(footing_jobs());
+    }
     out
+}
+
+/// The footing's grids (m): 10, 20 and 40 cells under its 1 m width.
+pub const FOOTING_H: [f64; 3] = [0.1, 0.05, 0.025];
+/// The footing's speed (m/s), as in `cases/footing.toml`: settlement = v t.
+const FOOTING_V: f64 = 0.02;
+/// The soil's cohesion (Pa) and the footing's width (m), as in the case.
+const FOOTING_C: f64 = 1e4;
+const FOOTING_B: f64 = 1.0;
+/// Prandtl's limit pressure over c, (2 + π).
+pub const PRANDTL: f64 = 2.0 + std::f64::consts::PI;
+
+/// The footing's runs (full study, CPU: the cell average has no GPU pass):
+/// smooth and rough on every grid with the cell-averaged volumetric strain
+/// rate (the case's), and smooth with each particle's own on the two
+/// coarser grids, to show the locking it removes.
+fn footing_jobs() -> Vec<Job> {
+    let mut out = Vec::new();
+    for law in ["slip", "stick"] {
+        for &h in &FOOTING_H {
+            for vol in ["cell_average", "particle"] {
+                if vol == "particle" && (law != "slip" || h < 0.05) {
+                    continue;
+                }
+                out.push(
+                    Job::new(format!("cpu-footing-{law}-{vol}-h{h}"), FOOTING, "footing")
+                        .set(format!("grid.h={h}"))
+                        .set(format!("contact.interface.law={law}"))
+                        .set(format!("solver.volumetric_strain={vol}"))
+                        .on(BackendChoice::Cpu)
+                        .tag("case", "footing")
+                        .tag("law", law)
+                        .tag("volumetric", vol)
+                        .tag("h", h),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// A footing run's (settlement in mm, q/c) at its samples: the pair's
+/// vertical reaction (the last reaction of a sample) over B c.
+pub fn footing_curve(r: &JobResult) -> Vec<(f64, f64)> {
+    r.data().map_or(Vec::new(), |d| {
+        d.samples
+            .iter()
+            .filter_map(|s| {
+                let q = s.reactions.last()?[1] / (FOOTING_B * FOOTING_C);
+                Some((1e3 * FOOTING_V * s.t, q))
+            })
+            .collect()
+    })
 }
 
 /// (t, motion of each body) at a job's snapshots.
@@ -276,7 +336,102 @@ pub fn report(results: &[JobResult], dir: &Path, _quick: bool) -> Result<(String
     charts.extend(block_section(&mine, dir, &mut md)?);
     charts.extend(disks_section(&mine, dir, &mut md)?);
     charts.extend(rolling_section(&mine, dir, &mut md)?);
+    let footing: Vec<&JobResult> = results
+        .iter()
+        .filter(|r| r.job.tag_value("case") == Some("footing"))
+        .collect();
+    if !footing.is_empty() {
+        charts.extend(footing_section(&footing, dir, &mut md)?);
+    }
     Ok((md, charts))
+}
+
+/// The footing: peak q/c against Prandtl's, and the load–settlement chart.
+fn footing_section(runs: &[&JobResult], dir: &Path, md: &mut String) -> Result<Vec<PathBuf>> {
+    let _ = writeln!(
+        md,
+        "**Strip footing on a Tresca soil** (`cases/footing.toml`, CPU): a rigid footing 1 m wide \
+         pressed at {FOOTING_V} m/s into a weightless soil 5 m × 2 m (E = 10 MPa, ν = 0.3, c = 10 kPa, \
+         φ = ψ = 0), rollers on the sides, fixed base, linear shapes, NPC, 2 × 2 particles per cell; the \
+         pair `interface` smooth (`slip`) or rough (`stick`). q is the pair's vertical reaction over the \
+         width, settlement = {FOOTING_V} m/s × t. Prandtl's limit for both: (2 + π) c = {} c. \
+         `volumetric`: the strain rate's volumetric part, the particle's own or its cell's mean \
+         (`solver.volumetric_strain`, [methods](methods.md#cell-averaged-volumetric-strain-rate)).\n",
+        sig(PRANDTL)
+    );
+    let header: Vec<String> = [
+        "interface",
+        "volumetric",
+        "h (m)",
+        "cells under the footing",
+        "status",
+        "peak q/c",
+        "at settlement (mm)",
+        "error against 5.14",
+    ]
+    .map(String::from)
+    .to_vec();
+    let mut rows = Vec::new();
+    let mut c = LineChart::new(
+        "Strip footing on a Tresca soil: load against settlement",
+        "settlement (mm)",
+        "q / c",
+    );
+    let mut top = 0.0f64;
+    for (k, r) in runs.iter().enumerate() {
+        let law = r.job.tag_value("law").unwrap_or("");
+        let vol = r.job.tag_value("volumetric").unwrap_or("");
+        let h: f64 = r
+            .job
+            .tag_value("h")
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0.0);
+        let curve = footing_curve(r);
+        let peak = curve
+            .iter()
+            .copied()
+            .fold(None, |m: Option<(f64, f64)>, x| match m {
+                Some(m) if m.1 >= x.1 => Some(m),
+                _ => Some(x),
+            });
+        let interface = if law == "slip" { "smooth" } else { "rough" };
+        rows.push(vec![
+            interface.to_string(),
+            vol.replace('_', " "),
+            format!("{h}"),
+            format!("{:.0}", FOOTING_B / h),
+            if r.completed() {
+                "completed".to_string()
+            } else {
+                super::failure_text(r)
+            },
+            peak.map_or("-".into(), |p| sig(p.1)),
+            peak.map_or("-".into(), |p| sig(p.0)),
+            peak.map_or("-".into(), |p| {
+                format!("{:+.1} %", 100.0 * (p.1 / PRANDTL - 1.0))
+            }),
+        ]);
+        top = curve.iter().map(|p| p.0).fold(top, f64::max);
+        let mut series = Series::line(
+            format!("{interface}, {}, h = {h}", vol.replace('_', " ")),
+            curve,
+            k,
+        );
+        if vol == "particle" {
+            series = series.dashed();
+        }
+        c.series.push(series);
+    }
+    c.series
+        .push(Series::line("Prandtl (2 + π) c", vec![(0.0, PRANDTL), (top, PRANDTL)], 7).dashed());
+    md.push_str(&table(&header, &rows));
+    md.push('\n');
+    md.push_str(&image(
+        "footing load against settlement",
+        "study-contact-footing.png",
+    ));
+    md.push('\n');
+    save(&mut c, dir, "study-contact-footing")
 }
 
 fn save(c: &mut LineChart, dir: &Path, stem: &str) -> Result<Vec<PathBuf>> {
@@ -617,4 +772,74 @@ fn rolling_section(mine: &[&JobResult], dir: &Path, md: &mut String) -> Result<V
     ));
     md.push('\n');
     save(&mut c, dir, "study-contact-rolling")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The footing's runs: smooth and rough on the three grids with the
+    /// cell average, smooth with the particles' own rate on the two
+    /// coarser ones; every scene valid, on the CPU, only in the full study.
+    #[test]
+    fn the_footing_runs_are_valid_cpu_scenes_of_the_full_study() {
+        let runs = footing_jobs();
+        assert_eq!(runs.len(), 8);
+        for j in &runs {
+            let scene = j.scene().unwrap();
+            assert_eq!(j.backend, BackendChoice::Cpu);
+            let h = j.tag_value("h").unwrap().parse::<f64>().unwrap();
+            assert_eq!(scene.file.grid.h, h);
+        }
+        let footing = |quick| {
+            super::jobs(quick, &[BackendChoice::Cpu])
+                .iter()
+                .filter(|j| j.tag_value("case") == Some("footing"))
+                .count()
+        };
+        assert_eq!((footing(true), footing(false)), (0, 8));
+    }
+
+    /// The footing's section from two short runs (h = 0.1 m, 0.2 s: the
+    /// load still rising): a row per run with its peak, and the chart.
+    #[test]
+    fn the_footing_section_reports_each_runs_peak() {
+        let runs: Vec<Job> = footing_jobs()
+            .into_iter()
+            .filter(|j| j.tag_value("h") == Some("0.1") && j.tag_value("law") == Some("slip"))
+            .map(|j| j.set("solver.t_end=0.2"))
+            .collect();
+        assert_eq!(runs.len(), 2);
+        let results = super::super::runner::run_jobs(runs, 2, false, None);
+        let dir = std::env::temp_dir().join(format!("lme-footing-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let refs: Vec<&JobResult> = results.iter().collect();
+        let mut md = String::new();
+        let charts = footing_section(&refs, &dir, &mut md).unwrap();
+        for r in &results {
+            let curve = footing_curve(r);
+            assert!(
+                curve.len() >= 10,
+                "{}: {} samples",
+                r.job.label,
+                curve.len()
+            );
+            // Loading: the pressure grows with settlement (4 mm at 0.2 s).
+            let (s, q) = *curve.last().unwrap();
+            assert!(
+                (s - 4.0).abs() < 0.1 && q > 1.0 && q < PRANDTL,
+                "{s} mm, q/c {q}"
+            );
+        }
+        assert!(
+            md.contains("| smooth | cell average | 0.1 | 10 | completed |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| smooth | particle | 0.1 | 10 | completed |"),
+            "{md}"
+        );
+        assert!(charts.iter().all(|c| c.exists()));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
