@@ -267,23 +267,25 @@ fn column_top_gpu(shape: &str, y0: f64) -> Option<f64> {
 }
 
 /// The same acceptance through the GPU backend (f32, the points'
-/// projection in `constraint_points.wgsl`), against the same bound.
+/// projection in `constraint_points.wgsl`), against the same bound, with
+/// bspline3 only: the widest stencil reaches furthest past the base, the
+/// projection's shader is the same for every shape, and the CPU test runs
+/// both (bspline2 on llvmpipe added 25 s to CI; measured +0.210 %).
 /// Measured on llvmpipe: see the test's output.
 #[test]
 fn explicit_base_inside_the_grid_holds_like_the_grid_edge_on_the_gpu() {
-    for shape in ["bspline2", "bspline3"] {
-        let Some(edge) = column_top_gpu(shape, 0.0) else {
-            return;
-        };
-        let beyond = column_top_gpu(shape, -2.0).expect("the adapter opened once");
-        let rel = (beyond - edge) / edge;
-        println!(
-            "{shape:>8} (GPU): top settlement {edge:.6} m (grid edge on the base), {beyond:.6} m \
-             (two cells beyond), {:+.3} %",
-            100.0 * rel
-        );
-        assert!(rel.abs() < BASE_REL, "{shape} (GPU): {:+.3} %", 100.0 * rel);
-    }
+    let shape = "bspline3";
+    let Some(edge) = column_top_gpu(shape, 0.0) else {
+        return;
+    };
+    let beyond = column_top_gpu(shape, -2.0).expect("the adapter opened once");
+    let rel = (beyond - edge) / edge;
+    println!(
+        "{shape:>8} (GPU): top settlement {edge:.6} m (grid edge on the base), {beyond:.6} m \
+         (two cells beyond), {:+.3} %",
+        100.0 * rel
+    );
+    assert!(rel.abs() < BASE_REL, "{shape} (GPU): {:+.3} %", 100.0 * rel);
 }
 
 /// On the GPU a constraint group is its region's box of nodes less the
