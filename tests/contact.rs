@@ -11,7 +11,7 @@ use lme_mpm::cpu::CpuBackend;
 use lme_mpm::gpu::GpuBackend;
 use lme_mpm::model::Model;
 use lme_mpm::scene::Scene;
-use lme_mpm::study::contact::{BodyMotion, body_motion, one_field, overlap};
+use lme_mpm::study::contact::{BodyMotion, PRANDTL, body_motion, one_field, overlap};
 
 /// Mass-weighted mean velocity of each body (scene order).
 fn body_velocities(b: &mut dyn Backend) -> Vec<[f64; 2]> {
@@ -374,9 +374,6 @@ fn footing_q(sets: &[&str]) -> Vec<(f64, f64)> {
         .map(|s| (s.t, s.reactions.last().unwrap()[1] / 1e4))
         .collect()
 }
-
-/// Prandtl's (2 + π) c, as q/c.
-const PRANDTL: f64 = 2.0 + std::f64::consts::PI;
 
 /// The cell-averaged volumetric strain rate (B-bar) against locking: the
 /// smooth footing on the Tresca soil at h = 0.1 m (the case's h = 0.05 m
