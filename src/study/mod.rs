@@ -55,7 +55,7 @@ pub enum StudyName {
     /// colliding head-on and off-centre, a disk rolling on an elastic slab
     /// (R/h = 10–40), each beside the single shared field; a strip footing
     /// on a Tresca soil against Prandtl's 5.14 c, smooth and rough, three
-    /// grids (full run only) (CPU; about 40 minutes, --quick about 1).
+    /// grids (full run only) (CPU; about 15 minutes, --quick about 1).
     Contact,
     /// The Galerkin meshfree method on the static cantilever: GMM-LME and
     /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson (the
