@@ -29,6 +29,13 @@
 // solver.mls_scope = "force": the strain-rate correction (mls_strain.wgsl).
 @group(0) @binding({{B_MLS_DL}}) var<storage, read> mls_dl: array<vec4<f32>>;
 #endif
+#if CELL_AVERAGE
+// solver.volumetric_strain = "cell_average": the (cell, body) sums of
+// cell_average.wgsl.
+@group(0) @binding({{B_BODY}}) var<storage, read> body: array<u32>;
+@group(0) @binding({{B_CELL_AVG}}) var<storage, read> cell_avg: array<f32>;
+#include "shared/cell_average.wgsl"
+#endif
 @group(0) @binding({{B_RHO}}) var<storage, read_write> rho: array<f32>;
 @group(0) @binding({{B_STRESS}}) var<storage, read_write> stress: array<f32>;
 #if FORCES
@@ -82,6 +89,13 @@ fn update_particle(p: u32, c: ShapeCtx) -> Updated {
     }
 #if MLS_FORCE
     l += mls_dl[p];
+#endif
+#if CELL_AVERAGE
+    // The volumetric part of L becomes its (cell, body) mean:
+    // L + ½ (⟨tr L⟩ − tr L) I (CPU: `CellAverage::update`'s `dl`).
+    let slot = cell_slot(x0[p] + u[p], body[p]);
+    let half = 0.5 * (cell_avg[slot] / cell_avg[slot + 1u] - (l.x + l.w));
+    l += vec4<f32>(half, 0.0, 0.0, half);
 #endif
     let dt = sim.dt;
 #if DEF_GRAD

@@ -92,25 +92,6 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         };
     }
-    if model.cell_average_volumetric {
-        return match spec.choice() {
-            BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
-                "solver.volumetric_strain",
-                crate::scene::VolumetricStrain::CPU_ONLY,
-            )
-            .into()),
-            BackendChoice::Cpu | BackendChoice::Auto => {
-                let b = CpuBackend::new(model);
-                if spec.verbose && spec.choice() == BackendChoice::Auto {
-                    crate::say!(
-                        "backend: {} (auto: solver.volumetric_strain = \"cell_average\" runs on the CPU only)",
-                        b.name()
-                    );
-                }
-                Ok(Box::new(b))
-            }
-        };
-    }
     match spec.choice() {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
         BackendChoice::Gpu => {

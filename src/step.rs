@@ -152,6 +152,13 @@ pub enum Pass {
     MlsGradGauss,
     MlsGradParticles,
     MlsStrain,
+    /// `solver.volumetric_strain = "cell_average"`, stage `stress`: zero
+    /// the (cell, body) sums (cell_average.wgsl built with CLEAR, one
+    /// invocation per cell), add each particle's V tr L and V to its
+    /// slot (`CellAverage`), then `Stress` (built with CELL_AVERAGE)
+    /// replaces tr L by its slot's mean.
+    CellAverageClear,
+    CellAverage,
     /// Walls only: the walls' forces at the contact points
     /// (wall_contact.wgsl), before `GridCorrect`.
     WallContact,
@@ -188,7 +195,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 40] = [
+    pub const ALL: [Pass; 42] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -214,6 +221,8 @@ impl Pass {
         Pass::MlsGradGauss,
         Pass::MlsGradParticles,
         Pass::MlsStrain,
+        Pass::CellAverageClear,
+        Pass::CellAverage,
         Pass::WallContact,
         Pass::GridCorrect,
         Pass::ContactGrad,
@@ -262,6 +271,7 @@ impl Pass {
             Pass::MlsForceGauss => "mls_force_gauss.wgsl",
             Pass::MlsGradGauss | Pass::MlsGradParticles => "mls_grad.wgsl",
             Pass::MlsStrain => "mls_strain.wgsl",
+            Pass::CellAverageClear | Pass::CellAverage => "cell_average.wgsl",
             Pass::RemapClear | Pass::Remap => "remap.wgsl",
             Pass::MlsRemap => "mls_remap.wgsl",
         }
@@ -297,9 +307,10 @@ pub struct PlanInputs {
     /// points' projection after every `GridPredict` and `GridCorrect`
     /// pass (the CPU's `grid_update` stages call it themselves).
     pub points: bool,
-    /// `solver.volumetric_strain = "cell_average"` (CPU only): `stress`
-    /// averages the volumetric strain rate over each cell first, so it
-    /// does not fuse with `forces`.
+    /// `solver.volumetric_strain = "cell_average"`: `stress` averages the
+    /// volumetric strain rate over each cell first (on the GPU, the
+    /// `CellAverageClear` and `CellAverage` passes), so it does not fuse
+    /// with `forces`.
     pub cell_average: bool,
 }
 
@@ -417,7 +428,7 @@ impl StepPlan {
             walls,
             contact,
             points: _,
-            cell_average: _,
+            cell_average,
         } = self.inputs;
         let binned = gather || patch || contact;
         match stage {
@@ -482,6 +493,9 @@ impl StepPlan {
                 Pass::MlsStrain,
                 Pass::Stress,
             ],
+            Stage::Stress if cell_average => {
+                &[Pass::CellAverageClear, Pass::CellAverage, Pass::Stress]
+            }
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect if walls && contact => &[

@@ -401,7 +401,9 @@ fn the_cell_average_unlocks_a_footing_on_a_tresca_soil() {
 }
 
 /// `solver.volumetric_strain = "cell_average"`: refused with the implicit
-/// integrator and with MLS (exit 2 naming the key), and by the GPU path.
+/// integrator and with MLS (exit 2 naming the key). The GPU path runs it
+/// (`stage_parity::stages_match_cell_average`,
+/// `run_parity::footing_gpu_matches_cpu`).
 #[test]
 fn the_cell_average_is_refused_where_it_does_not_apply() {
     // A case without contact pairs, so that nothing else is refused first.
@@ -429,12 +431,4 @@ fn the_cell_average_is_refused_where_it_does_not_apply() {
             "{sets:?}: {e}"
         );
     }
-    let Some(ctx) = common::gpu::open("cell average refused on gpu", false) else {
-        return;
-    };
-    let model = Model::new(&common::scene("footing.toml", &[])).unwrap();
-    let e = GpuBackend::new(ctx, model)
-        .err()
-        .expect("the GPU path refuses it");
-    assert!(e.to_string().contains("solver.volumetric_strain"), "{e}");
 }

@@ -172,6 +172,7 @@ fn variants() -> Vec<Variant> {
                                                     )),
                                         contact: None,
                                         points: None,
+                                        cell_average_bodies: 0,
                                     });
                                 }
                             }
@@ -194,6 +195,18 @@ fn variants() -> Vec<Variant> {
         })
         .collect();
     out.extend(contact);
+    // The cell-averaged volumetric strain rate (three bodies) on every
+    // variant it allows (no MLS), with several materials, with and
+    // without contact pairs.
+    let cell_average: Vec<Variant> = out
+        .iter()
+        .filter(|v| !v.mls && v.multi_material && !v.lme_stored)
+        .map(|v| Variant {
+            cell_average_bodies: 3,
+            ..*v
+        })
+        .collect();
+    out.extend(cell_average);
     // Constraint points on every shape, integrator and grid without MLS
     // (linear elastic, one atomic mode), and with contact pairs (two lanes
     // per field).
@@ -309,6 +322,15 @@ fn every_pass_validates_in_every_variant() {
             if v.contact.is_some() && pass_uses_shape(pass) && pass != Pass::LmeNewton {
                 assert!(has(Buf::Field), "{pass:?} {v:?}: nodes not offset by field");
             }
+            assert_eq!(
+                has(Buf::Body) || has(Buf::CellAvg),
+                v.cell_average_bodies > 0
+                    && matches!(
+                        pass,
+                        Pass::CellAverageClear | Pass::CellAverage | Pass::Stress
+                    ),
+                "{pass:?} {v:?}: the cell average's buffers where it is read"
+            );
             assert!(
                 !(has(Buf::Walls) || has(Buf::WallForce) || has(Buf::WallTouch)) || v.walls,
                 "{pass:?} {v:?}: wall buffers without walls"
@@ -367,6 +389,7 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::WallContact
             | Pass::ContactGrad
             | Pass::ContactDetect
+            | Pass::CellAverage
     )
 }
 

@@ -838,6 +838,58 @@ fn contact_pairs_gpu_matches_cpu() {
     }
 }
 
+/// The strip footing on a Tresca soil (`cases/footing.toml`, the smooth
+/// pair, the cell-averaged volumetric strain rate) at h = 0.1 m to 0.3 s
+/// (865 steps; 582 particles yield under the footing): the pair's
+/// vertical reaction history (the load-settlement curve) over its
+/// largest, measured 7.5e-7 on llvmpipe (2026-11-28), 10 times rounded up.
+const FOOTING_REACTION_TOL: f64 = 1e-5;
+/// Its final stress field over its largest: measured 5.4e-3, where the
+/// same run with each particle's own strain rate differs by 3.9e-3 (f32
+/// against f64 returns to the Tresca surface beside the footing's corners,
+/// whose stress singularity puts the largest values there); 10 times,
+/// rounded up.
+const FOOTING_STRESS_TOL: f64 = 6e-2;
+
+#[test]
+fn footing_gpu_matches_cpu() {
+    let Some((cpu, gpu)) = both(
+        "footing.toml",
+        &[
+            "grid.h=0.1",
+            "solver.t_end=0.3",
+            "output.sample_interval=0.01",
+        ],
+        false,
+    ) else {
+        return;
+    };
+    // The pair's reaction: the last one (after the constraints').
+    let k = cpu.samples[0].reactions.len() - 1;
+    let r_max = cpu
+        .samples
+        .iter()
+        .map(|s| s.reactions[k][1].abs())
+        .fold(0.0, f64::max);
+    assert!(r_max > 0.0, "the footing never pressed");
+    let r_rms = history_rms(&cpu.samples, &gpu.samples, |s| s.reactions[k][1]).0 / r_max;
+    let sc: Vec<f64> = cpu.particles.stress.iter().flatten().copied().collect();
+    let sg: Vec<f64> = gpu.particles.stress.iter().flatten().copied().collect();
+    let s_rms = field_rms(&sc, &sg) / sc.iter().map(|x| x.abs()).fold(0.0, f64::max);
+    let plastic = cpu.particles.plastic.iter().filter(|q| q[1] > 0.0).count();
+    println!(
+        "footing: steps cpu {} gpu {}; reaction history RMS diff / max {r_rms:.2e} (max {r_max:.0} \
+         N/m), final stress {s_rms:.2e}; {plastic} particles yielded on the CPU",
+        cpu.steps, gpu.steps
+    );
+    assert!(plastic > 0, "no particle yielded: the run is elastic");
+    assert!(
+        r_rms < FOOTING_REACTION_TOL,
+        "reaction histories differ: {r_rms}"
+    );
+    assert!(s_rms < FOOTING_STRESS_TOL, "final stresses differ: {s_rms}");
+}
+
 /// Constraint points (issue 23): the elastic block (h = 1 m) on a base
 /// two cells inside the grid, so bspline2 and bspline3 hold it at its
 /// edge by points (the projection after each grid update), NPC over the

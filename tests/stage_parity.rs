@@ -1600,6 +1600,43 @@ fn stages_match_contact_pairs() {
     }
 }
 
+/// `solver.volumetric_strain = "cell_average"` (the B-bar of
+/// `cpu::antilock`): the stress stage with each particle's volumetric
+/// strain rate replaced by its (cell, body) mean, summed by
+/// cell_average.wgsl with float atomics (CAS in one case) and read by
+/// stress.wgsl; one body on its own field, and the four bodies of
+/// `CONTACT_SCENE` on theirs (bodies average apart; d shares field 0 with
+/// none of the others' cells' sums), NPC and MUSL (whose weights are the
+/// step's start's and whose cells are the moved particles').
+#[test]
+fn stages_match_cell_average() {
+    let avg = "solver.volumetric_strain=cell_average";
+    for (label, m, cas) in [
+        (
+            "cell average, linear npc",
+            random_model(&["solver.shape=linear", avg], 5),
+            false,
+        ),
+        (
+            "cell average, contact, linear npc",
+            random_model_of(CONTACT_SCENE, &["solver.shape=linear", avg], 5),
+            false,
+        ),
+        (
+            "cell average, contact, bspline2 musl, CAS atomics",
+            random_model_of(
+                CONTACT_SCENE,
+                &["solver.shape=bspline2", "solver.integrator=musl", avg],
+                5,
+            ),
+            true,
+        ),
+    ] {
+        assert!(m.cell_average_volumetric, "{label}");
+        parity_of(label, m, cas, GpuOptions::default(), 0.0);
+    }
+}
+
 /// The constraint points' projection (`constraint_points.wgsl`) against
 /// the CPU's, relative to the largest velocity (or its change, force and
 /// reaction in `correct`): an f32 solve of C M⁻¹ Cᵀ λ = v̄ − C v, whose

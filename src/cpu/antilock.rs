@@ -10,8 +10,8 @@
 //! q over the particles of p's body in p's cell; the deviatoric part stays
 //! the particle's own. Bodies average apart, so a contact pair's two fields
 //! do not mix. Applied as the additive correction `dl` the stress stage
-//! already reads (`stress::stress`). No GPU twin yet (the GPU path
-//! refuses the key).
+//! already reads (`stress::stress`). GPU twin: shaders/cell_average.wgsl
+//! with stress.wgsl built with CELL_AVERAGE.
 
 use super::stage_inputs::ShapeCache;
 use crate::model::Grid;

@@ -101,10 +101,16 @@ pub enum Buf {
     /// Constraint points only: per field and component, the projection's
     /// scratch (f32; `PointCounts::work_stride` each).
     PointWork,
+    /// `solver.volumetric_strain = "cell_average"` only: per particle, its
+    /// body's index (u32).
+    Body,
+    /// `solver.volumetric_strain = "cell_average"` only: per grid cell and
+    /// body, [Σ V tr L, Σ V] (cell_average.wgsl).
+    CellAvg,
 }
 
 impl Buf {
-    pub const ALL: [Buf; 48] = [
+    pub const ALL: [Buf; 50] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -153,6 +159,8 @@ impl Buf {
         Buf::ContactNormal,
         Buf::PointTable,
         Buf::PointWork,
+        Buf::Body,
+        Buf::CellAvg,
     ];
 
     pub fn binding(self) -> u32 {
@@ -465,6 +473,14 @@ fn grid_and_output_data(
             Buf::ContactNormal,
             vec![0u8; 12 * c.pairs.len() * g.n_nodes()],
         ));
+    }
+    if model.cell_average_volumetric {
+        data.push((
+            Buf::Body,
+            bytemuck::cast_slice(&model.particles.body).to_vec(),
+        ));
+        let slots = 2 * (g.nx - 1) * (g.ny - 1) * model.body_names.len().max(1);
+        data.push((Buf::CellAvg, vec![0u8; 4 * slots]));
     }
     if let Some((counts, table)) = super::constraint_points::tables(model) {
         data.push((Buf::PointTable, bytemuck::cast_slice(&table).to_vec()));

@@ -71,13 +71,6 @@ impl GpuBackend {
             )
             .into());
         }
-        if model.cell_average_volumetric {
-            return Err(crate::error::SceneError::invalid(
-                "solver.volumetric_strain",
-                crate::scene::VolumetricStrain::CPU_ONLY,
-            )
-            .into());
-        }
         // The points' tables mark freed nodes with a bit per group.
         if !model.constraints.points.is_empty() && model.constraints.groups.len() > 32 {
             return Err(crate::error::SceneError::invalid(

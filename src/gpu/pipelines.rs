@@ -53,6 +53,7 @@ fn domain(pass: Pass) -> Domain {
         | Pass::GridPredict
         | Pass::GridCorrect
         | Pass::RemapClear
+        | Pass::CellAverageClear
         | Pass::P2gGather
         | Pass::ForcesGather => Domain::Nodes,
         Pass::ContactExchange | Pass::ContactExchangeForce => Domain::Nodes,
@@ -131,6 +132,9 @@ pub struct Variant {
     /// Constraint points (CONSTRAINT_POINTS): their tables' counts
     /// (`gpu::constraint_points`).
     pub points: Option<PointCounts>,
+    /// `solver.volumetric_strain = "cell_average"` (CELL_AVERAGE): the
+    /// bodies' count (N_BODIES), the (cell, body) slots per cell; 0 off.
+    pub cell_average_bodies: u32,
 }
 
 impl Variant {
@@ -173,6 +177,11 @@ impl Variant {
                 _ => false,
             },
             bspline_cells: matches!(&model.shape, Shape::Bspline(b) if b.cells),
+            cell_average_bodies: if model.cell_average_volumetric {
+                model.body_names.len().max(1) as u32
+            } else {
+                0
+            },
         }
     }
 
@@ -188,8 +197,7 @@ impl Variant {
             walls: self.walls,
             contact: self.contact.is_some(),
             points: self.points.is_some(),
-            // The GPU refuses the cell average (`GpuBackend::with_options`).
-            cell_average: false,
+            cell_average: self.cell_average_bodies > 0,
         })
     }
 
@@ -230,7 +238,11 @@ impl Variant {
             .flag("CONSTRAINT_POINTS", self.points.is_some())
             .flag("BSPLINE_SMALL_GRID", self.bspline_small_grid)
             .flag("BSPLINE_CELLS", self.bspline_cells)
-            .flag("MUSL", self.integrator == Integrator::Musl);
+            .flag("MUSL", self.integrator == Integrator::Musl)
+            .flag("CELL_AVERAGE", self.cell_average_bodies > 0);
+        if self.cell_average_bodies > 0 {
+            d.value("N_BODIES", self.cell_average_bodies);
+        }
         if let Integrator::Npc { position, .. } = self.integrator {
             d.flag("NPC", true)
                 .flag("NPC_POSITION_CORRECTED", position == NpcPosition::Corrected)
@@ -329,7 +341,10 @@ pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
         "FORCES",
         matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
     )
-    .flag("CLEAR", pass == Pass::RemapClear)
+    .flag(
+        "CLEAR",
+        matches!(pass, Pass::RemapClear | Pass::CellAverageClear),
+    )
     .flag(
         "PARTICLES",
         matches!(pass, Pass::MlsFitParticles | Pass::MlsGradParticles),
@@ -633,6 +648,7 @@ mod tests {
                                 patch: false,
                                 contact: None,
                                 points: None,
+                                cell_average_bodies: 0,
                             };
                             let src = expand(Pass::StressForces, &v.defines()).unwrap();
                             let m = validate(&src, "stress.wgsl", atomics)

@@ -578,12 +578,6 @@ pub enum VolumetricStrain {
     CellAverage,
 }
 
-impl VolumetricStrain {
-    /// Why the GPU path refuses `cell_average`.
-    pub const CPU_ONLY: &str = "= \"cell_average\" runs on the CPU path only: use --backend cpu \
-                                or auto (its GPU pass is not built yet)";
-}
-
 /// Where the B-splines' knots sit (`solver.bspline_knots`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -264,7 +264,8 @@ const FOOTING_B: f64 = 1.0;
 /// Prandtl's limit pressure over c, (2 + π).
 pub const PRANDTL: f64 = 2.0 + std::f64::consts::PI;
 
-/// The footing's runs (full study, CPU: the cell average has no GPU pass):
+/// The footing's runs (full study, on the f64 CPU path whatever the study's
+/// backends; `run_parity::footing_gpu_matches_cpu` holds the GPU to it):
 /// smooth and rough on every grid with the cell-averaged volumetric strain
 /// rate (the case's), and smooth with each particle's own on the two
 /// coarser grids, to show the locking it removes.
