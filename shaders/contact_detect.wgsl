@@ -114,7 +114,8 @@ fn det3(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>) -> f32 {
 // fields fa and fb that reach node (i, j), from n0. CPU twin: `lr_normal`
 // in src/cpu/contact.rs (the same steps: mean position and half-width,
 // LR_ITERATIONS Newton steps with the ridge LR_RIDGE from 0, each |Δφ|
-// capped at LR_MAX_STEP, Cramer's rule; n0 where it separates nothing).
+// capped at LR_MAX_STEP, Cramer's rule; n0 where it separates nothing,
+// and where the fit lies within 3° of n0: LR_FLAT_COS).
 fn lr_normal(fa: u32, fb: u32, i: u32, j: u32, n0: vec2<f32>) -> vec2<f32> {
     let cells = cells_reaching(i, j);
     var c = vec2<f32>(0.0);
@@ -172,7 +173,12 @@ fn lr_normal(fa: u32, fb: u32, i: u32, j: u32, n0: vec2<f32>) -> vec2<f32> {
     }
     let len = length(th.xy);
     if len >= LR_MIN_SCALE && len < 3.4e38 {
-        return -th.xy / len;
+        let n = -th.xy / len;
+        // Within 3° of the gradient normal: a flat face's gradient is exact.
+        if dot(n, n0) >= LR_FLAT_COS {
+            return n0;
+        }
+        return n;
     }
     return n0;
 }

@@ -25,6 +25,9 @@ const LR_RIDGE: f32 = 1e-9;
 const LR_ITERATIONS: u32 = 10u;
 const LR_MAX_STEP: f32 = 4.0;
 const LR_MIN_SCALE: f32 = 2.0;
+// cos 3°: where the fit's normal is this close to the gradient normal, the
+// gradient is kept. Keep in sync with `LR_FLAT_COS`.
+const LR_FLAT_COS: f32 = 0.99862953475;
 
 // "No gap measured" (the CPU's infinity; WGSL may assume no infinities).
 const CONTACT_NO_GAP: f32 = 3.4028235e38;
