@@ -102,9 +102,17 @@ impl Observer for MeanSpeed {
 /// |v| (m/s), its largest value, and the final model.
 fn run(sets: &[&str]) -> (f64, f64, Model) {
     let (obs, m) = observe(sets);
-    let mean = obs.means.iter().sum::<f64>() / obs.means.len() as f64;
-    let max = obs.means.iter().cloned().fold(0.0, f64::max);
+    let (mean, max) = obs.mean_and_max();
     (mean, max, m)
+}
+
+impl MeanSpeed {
+    /// The mean over time of the particles' mean |v| (m/s), and its
+    /// largest value.
+    fn mean_and_max(&self) -> (f64, f64) {
+        let mean = self.means.iter().sum::<f64>() / self.means.len() as f64;
+        (mean, self.means.iter().cloned().fold(0.0, f64::max))
+    }
 }
 
 /// Runs the column, observed every 0.02 s, and the final model.
@@ -280,8 +288,7 @@ fn fixed_nodes_hold_the_lme_geostatic_column() {
     let o = [Override::parse("solver.shape=lme").unwrap()];
     let scene = Scene::from_str(&text, "test scene", "test", &o).unwrap();
     let (obs, m) = observe_scene(&scene);
-    let mean = obs.means.iter().sum::<f64>() / obs.means.len() as f64;
-    let max = obs.means.iter().cloned().fold(0.0, f64::max);
+    let (mean, max) = obs.mean_and_max();
     let bound = AT_REST * (G * H).sqrt();
     let s = worst_sigma_yy(&m);
     println!(
