@@ -49,6 +49,23 @@ pub struct State {
     /// step, per node then wall (`held_contact_code`), where the next step
     /// starts its active set; empty for the explicit integrators.
     pub held_contacts: Vec<u8>,
+    /// A GMM run's node cloud (`solver.method = "gmm"`); None otherwise.
+    pub cloud: Option<CloudState>,
+}
+
+/// What a GMM run's node cloud carries from step to step, beyond what its
+/// scene rebuilds (the nodes' lattice origin, constraints and distance
+/// outside the body come from the initial particles): per node, the
+/// position (m), displacement since the start (m), velocity (m/s) and
+/// acceleration (m/s²) of the last converged step; per particle, LME's
+/// multiplier λ of the last step (its Newton solve's warm start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CloudState {
+    pub x: Vec<[f64; 2]>,
+    pub u: Vec<[f64; 2]>,
+    pub v: Vec<[f64; 2]>,
+    pub a: Vec<[f64; 2]>,
+    pub lambda: Vec<[f64; 2]>,
 }
 
 /// State of one probe particle.
@@ -181,6 +198,10 @@ pub trait Backend {
     fn held_contacts(&self) -> Vec<u8> {
         Vec::new()
     }
+    /// A GMM run's node cloud (see `State::cloud`); None for the others.
+    fn cloud_state(&self) -> Option<CloudState> {
+        None
+    }
 }
 
 /// The probes' state now, in `Model::probes` order.
@@ -212,6 +233,14 @@ pub fn check_state(model: &Model, state: &State) -> Result<()> {
         && p.plastic.len() == q.plastic.len()
         && state.mv.len() == model.grid.n_nodes() * model.n_fields()
         && state.force.len() == model.grid.n_nodes() * model.n_fields();
+    let gmm = matches!(&model.integrator, crate::model::Integrator::Implicit(s) if s.gmm.is_some());
+    if state.cloud.is_some() && !gmm {
+        return Err(Error::Checkpoint(
+            "holds a GMM run's node cloud, and the scene is not a GMM run: resume it with \
+             solver.integrator = \"implicit\" and solver.method = \"gmm\""
+                .into(),
+        ));
+    }
     if same {
         Ok(())
     } else {

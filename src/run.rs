@@ -131,6 +131,7 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
         dt: ck.dt,
         newton: ck.newton.clone(),
         held_contacts: ck.held_contacts.clone(),
+        cloud: ck.cloud.clone(),
     };
     sim.backend().restore(&state, ck.steps)?;
     // What the run wrote after its checkpoint goes; the snapshots up to it stay.
@@ -556,6 +557,7 @@ impl Observer for Writer {
             snapshots: self.snapshots.clone(),
             newton: backend.newton().cloned(),
             held_contacts: backend.held_contacts(),
+            cloud: backend.cloud_state(),
         };
         self.write(checkpoint::FILE, &ck.encode())?;
         // The CSV files as of the checkpoint, so a kill leaves them consistent with it.

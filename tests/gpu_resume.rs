@@ -43,6 +43,7 @@ impl Observer for Stopper {
             dt: 0.0,
             newton: None,
             held_contacts: Vec::new(),
+            cloud: None,
         };
         self.saved = Some((state, b.steps(), *cursor));
         Ok(())

@@ -754,12 +754,11 @@ fn a_completed_run_can_be_extended_and_the_key_turns_it_off() {
     assert_eq!(resume(&off, &["solver.t_end=3e-5"]).status.code(), Some(2));
 }
 
-#[test]
-fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
-    // The rolling disk (a friction wall, Newton's held contact states),
-    // coarse: the checkpoint at 0.02 s must carry the contact states, or
-    // the resumed steps start Newton elsewhere and end 1e-13 apart.
-    let sets = &[
+/// The rolling disk, implicit and coarse, run to 0.04 s with a checkpoint
+/// at 0.02 s, then resumed from it in the same folder (with `more` keys):
+/// the probes and particles must come out the same, byte for byte.
+fn implicit_disk_resumes_bit_for_bit(name: &str, more: &[&str]) {
+    let mut sets = vec![
         "solver.integrator=implicit",
         "grid.h=0.1",
         "solver.dt=0.005",
@@ -769,8 +768,9 @@ fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
         "output.checkpoint_interval=0.02",
         "output.final_checkpoint=false",
     ];
-    let whole = tmp("disk-whole");
-    let o = run("rolling_disk.toml", &whole, sets);
+    sets.extend_from_slice(more);
+    let whole = tmp(name);
+    let o = run("rolling_disk.toml", &whole, &sets);
     assert!(o.status.success(), "{}", stderr(&o));
     let particles = read(&whole.join("particles.csv"));
     let probes = read(&whole.join("probes.csv"));
@@ -788,6 +788,23 @@ fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
         particles,
         "particles differ after resume"
     );
+}
+
+#[test]
+fn an_interrupted_implicit_run_with_a_wall_resumes_bit_for_bit() {
+    // A friction wall, Newton's held contact states: the checkpoint must
+    // carry them, or the resumed steps start Newton elsewhere and end
+    // 1e-13 apart.
+    implicit_disk_resumes_bit_for_bit("disk-whole", &[]);
+}
+
+#[test]
+fn an_interrupted_gmm_run_resumes_bit_for_bit() {
+    // GMM's node cloud moves with the body and keeps its velocity and
+    // acceleration (Newmark's predictor reads them) and each particle its
+    // LME multiplier: the checkpoint must carry them all (left without
+    // the nodes' acceleration, the probes differ from the 7th row on).
+    implicit_disk_resumes_bit_for_bit("disk-gmm", &["solver.method=gmm"]);
 }
 
 #[test]

@@ -279,6 +279,7 @@ impl CpuBackend {
             dt: self.dt,
             newton: None,
             held_contacts: Vec::new(),
+            cloud: None,
         }
     }
 

@@ -1,8 +1,9 @@
 //! `checkpoint.lmeck`: everything a run needs to continue exactly where it
 //! stopped (the particles with every per-particle state, the time, the step
 //! count, the driver's counters, the resolved scene, the samples and
-//! snapshots written so far, and the implicit integrator's Newton counters
-//! and held wall contact states). Binary, little-endian:
+//! snapshots written so far, the implicit integrator's Newton counters
+//! and held wall contact states, and a GMM run's node cloud). Binary,
+//! little-endian:
 //!
 //! ```text
 //! "LMEMPMCK"  magic (8 bytes)
@@ -15,7 +16,7 @@
 //! items; f64 are stored bit for bit, so a resumed run starts from the exact
 //! state. A file from another version or with a wrong checksum is refused.
 
-use crate::backend::{NewtonSample, NewtonSeconds, NewtonStats, ProbeState, Sample};
+use crate::backend::{CloudState, NewtonSample, NewtonSeconds, NewtonStats, ProbeState, Sample};
 use crate::error::{Error, Result};
 use crate::model::Particles;
 use crate::model::energy::Energy;
@@ -27,8 +28,8 @@ pub const FILE: &str = "checkpoint.lmeck";
 const MAGIC: &[u8; 8] = b"LMEMPMCK";
 /// Bumped whenever the payload changes (2: the plastic state; 3: the
 /// implicit integrator's Newton statistics and per-sample Newton figures;
-/// 4: its held wall contact states).
-pub const FORMAT: u32 = 4;
+/// 4: its held wall contact states; 5: a GMM run's node cloud).
+pub const FORMAT: u32 = 5;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -54,6 +55,8 @@ pub struct Checkpoint {
     /// The implicit integrator's held wall contact states, per node then
     /// wall (`backend::State::held_contacts`); empty otherwise.
     pub held_contacts: Vec<u8>,
+    /// A GMM run's node cloud (`backend::State::cloud`); None otherwise.
+    pub cloud: Option<CloudState>,
 }
 
 impl Checkpoint {
@@ -122,6 +125,11 @@ impl Checkpoint {
             }
         });
         e.list(&self.held_contacts, |e, c| e.u32(u32::from(*c)));
+        e.option(self.cloud.as_ref(), |e, c| {
+            for v in [&c.x, &c.u, &c.v, &c.a, &c.lambda] {
+                e.pairs(v);
+            }
+        });
         let sum = fnv1a(&e.0);
         e.u64(sum);
         e.0
@@ -219,6 +227,15 @@ impl Checkpoint {
         })?;
         let held_contacts =
             d.list(|d| u8::try_from(d.u32()?).map_err(|_| bad("holds an invalid contact state")))?;
+        let cloud = d.option(|d| {
+            Ok(CloudState {
+                x: d.pairs()?,
+                u: d.pairs()?,
+                v: d.pairs()?,
+                a: d.pairs()?,
+                lambda: d.pairs()?,
+            })
+        })?;
         if !d.0.is_empty() {
             return Err(bad("has trailing bytes"));
         }
@@ -239,6 +256,16 @@ impl Checkpoint {
         if !fields_ok {
             return Err(bad("holds particle fields of different lengths"));
         }
+        if let Some(c) = &cloud {
+            let nodes = c.x.len();
+            if [c.u.len(), c.v.len(), c.a.len()]
+                .iter()
+                .any(|&l| l != nodes)
+                || c.lambda.len() != n
+            {
+                return Err(bad("holds a node cloud whose fields differ in length"));
+            }
+        }
         Ok(Checkpoint {
             scene_name,
             scene_toml,
@@ -251,6 +278,7 @@ impl Checkpoint {
             snapshots,
             newton,
             held_contacts,
+            cloud,
         })
     }
 
@@ -447,6 +475,13 @@ mod tests {
                 },
             }),
             held_contacts: vec![0, 1, 2, 3, 1],
+            cloud: Some(CloudState {
+                x: vec![[0.0, 0.1], [0.1 + 1e-17, 0.1]],
+                u: vec![[1e-300, -0.0], [2e-3, 0.0]],
+                v: vec![[0.25, -1.0 / 3.0], [0.0; 2]],
+                a: vec![[-9.81, f64::MIN_POSITIVE], [0.5, 0.5]],
+                lambda: vec![[1.5, -2.0]; 3],
+            }),
         }
     }
 
@@ -468,6 +503,21 @@ mod tests {
         assert_eq!(d.scene_toml, c.scene_toml);
         assert_eq!(d.newton, c.newton);
         assert_eq!(d.held_contacts, c.held_contacts);
+        assert_eq!(d.cloud, c.cloud);
+        // Without a cloud (every run but GMM's) it reads back as none.
+        let c = Checkpoint {
+            cloud: None,
+            ..sample_checkpoint()
+        };
+        assert_eq!(Checkpoint::decode(&c.encode()).unwrap().cloud, None);
+    }
+
+    #[test]
+    fn a_cloud_of_mismatched_lengths_is_refused() {
+        let mut c = sample_checkpoint();
+        c.cloud.as_mut().unwrap().lambda.pop();
+        let e = Checkpoint::decode(&c.encode()).unwrap_err().to_string();
+        assert!(e.contains("node cloud"), "{e}");
     }
 
     #[test]

@@ -85,6 +85,40 @@ impl GmmNodes {
         })
     }
 
+    /// What a checkpoint keeps of the cloud (`backend::CloudState`).
+    pub fn state(&self) -> crate::backend::CloudState {
+        let c = &self.cloud;
+        crate::backend::CloudState {
+            x: c.x.clone(),
+            u: c.u.clone(),
+            v: c.v.clone(),
+            a: c.a.clone(),
+            lambda: self.lambda.clone(),
+        }
+    }
+
+    /// Takes a checkpoint's cloud over this one, which the same scene
+    /// built from its initial particles (so its lattice origin,
+    /// constraints and distances outside the body are the run's own);
+    /// `Err` says what does not match.
+    pub fn load(&mut self, s: &crate::backend::CloudState) -> Result<(), String> {
+        let (n, p) = (self.cloud.len(), self.lambda.len());
+        if s.x.len() != n || s.lambda.len() != p {
+            return Err(format!(
+                "holds a node cloud of {} nodes and {} particles; the scene makes {n} and {p}",
+                s.x.len(),
+                s.lambda.len()
+            ));
+        }
+        let c = &mut self.cloud;
+        c.x.clone_from(&s.x);
+        c.u.clone_from(&s.u);
+        c.v.clone_from(&s.v);
+        c.a.clone_from(&s.a);
+        self.lambda.clone_from(&s.lambda);
+        Ok(())
+    }
+
     /// "GMM-LME" or "GMM-MLS", for the backend's name.
     pub fn label(&self) -> &'static str {
         match self.basis {

@@ -1100,14 +1100,26 @@ impl Backend for ImplicitBackend {
         self.node_states.iter().map(|&s| contact::code(s)).collect()
     }
 
+    fn cloud_state(&self) -> Option<crate::backend::CloudState> {
+        match &self.nodes {
+            Nodes::Cloud(c) => Some(c.state()),
+            Nodes::Grid => None,
+        }
+    }
+
     fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
         crate::backend::check_state(&self.model, state)?;
-        if let Nodes::Cloud(_) = self.nodes {
-            return Err(Error::Checkpoint(
-                "is of a GMM run (solver.method = \"gmm\"), whose node cloud a checkpoint does \
-                 not hold yet: run it again from the start"
-                    .into(),
-            ));
+        match (&mut self.nodes, &state.cloud) {
+            (Nodes::Cloud(c), Some(s)) => c.load(s).map_err(Error::Checkpoint)?,
+            (Nodes::Cloud(_), None) => {
+                return Err(Error::Checkpoint(
+                    "holds no node cloud, and the scene is a GMM run (solver.method = \"gmm\"): \
+                     resume it with the scene it was written with"
+                        .into(),
+                ));
+            }
+            // `check_state` refused a cloud for a scene that is not GMM.
+            (Nodes::Grid, _) => {}
         }
         // The contact states the next step starts from (none saved: a run
         // from before they were kept, or an explicit run's state).
