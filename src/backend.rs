@@ -118,6 +118,9 @@ pub struct NewtonStats {
     pub last_corrections: Vec<f64>,
     /// Halvings of Δt over the run.
     pub cuts: u64,
+    /// Jacobians assembled and factored (every iteration's with full
+    /// Newton, fewer with `solver.newton_jacobian = "reuse"`).
+    pub factorizations: u64,
     /// Where the time went, summed over every attempt (failed ones too).
     pub seconds: NewtonSeconds,
 }
@@ -132,9 +135,10 @@ pub struct NewtonSeconds {
     pub symbolic: f64,
     /// Residual assembly, stress updates included (once per iterate).
     pub residual: f64,
-    /// Jacobian assembly (once per iteration).
+    /// Jacobian assembly (once per iteration, or per factorization with
+    /// `solver.newton_jacobian = "reuse"`).
     pub jacobian: f64,
-    /// faer's numeric LU factorisation (once per iteration).
+    /// faer's numeric LU factorisation (likewise).
     pub factor: f64,
     /// The triangular solves and the update of Δu (once per iteration).
     pub solve: f64,

@@ -132,6 +132,9 @@ pub struct ImplicitSettings {
     /// Relative residual and correction norms that end Newton.
     pub tol: f64,
     pub max_iter: u32,
+    /// Keep Newton's factorization from one iteration to the next while
+    /// it converges fast (`solver.newton_jacobian = "reuse"`).
+    pub reuse_jacobian: bool,
     /// Halvings of Δt allowed for a step before the run is unstable.
     pub max_cuts: u32,
     /// Lumped instead of consistent mass.
@@ -282,6 +285,7 @@ impl Model {
                 load_steps: f.solver.load_steps,
                 tol: f.solver.newton_tol,
                 max_iter: f.solver.newton_max_iter,
+                reuse_jacobian: f.solver.newton_jacobian == crate::scene::NewtonJacobian::Reuse,
                 max_cuts: f.solver.newton_max_cuts,
                 lumped_mass: f.solver.implicit_mass == ImplicitMass::Lumped,
                 consistent_start: f.solver.implicit_start == ImplicitStart::Consistent,

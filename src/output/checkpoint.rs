@@ -28,8 +28,9 @@ pub const FILE: &str = "checkpoint.lmeck";
 const MAGIC: &[u8; 8] = b"LMEMPMCK";
 /// Bumped whenever the payload changes (2: the plastic state; 3: the
 /// implicit integrator's Newton statistics and per-sample Newton figures;
-/// 4: its held wall contact states; 5: a GMM run's node cloud).
-pub const FORMAT: u32 = 5;
+/// 4: its held wall contact states; 5: a GMM run's node cloud; 6: the
+/// Newton factorizations' count).
+pub const FORMAT: u32 = 6;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -117,6 +118,7 @@ impl Checkpoint {
             e.f64s(&n.last_residuals);
             e.f64s(&n.last_corrections);
             e.u64(n.cuts);
+            e.u64(n.factorizations);
             let s = &n.seconds;
             for v in [
                 s.map, s.symbolic, s.residual, s.jacobian, s.factor, s.solve, s.convect,
@@ -214,6 +216,7 @@ impl Checkpoint {
                 last_residuals: d.list(|d| d.f64())?,
                 last_corrections: d.list(|d| d.f64())?,
                 cuts: d.u64()?,
+                factorizations: d.u64()?,
                 seconds: NewtonSeconds {
                     map: d.f64()?,
                     symbolic: d.f64()?,
@@ -464,6 +467,7 @@ mod tests {
                 last_residuals: vec![1.0, 3e-4, 1e-9],
                 last_corrections: vec![1.0, 2e-6],
                 cuts: 1,
+                factorizations: 29,
                 seconds: NewtonSeconds {
                     map: 0.1,
                     symbolic: 0.2,

@@ -84,6 +84,9 @@ pub struct NewtonSummary {
     pub iterations_max: u32,
     /// Halvings of Δt (steps retried after Newton failed).
     pub cuts: u64,
+    /// Jacobians assembled and factored over the run (one per iteration
+    /// with full Newton; fewer with `solver.newton_jacobian = "reuse"`).
+    pub factorizations: u64,
     /// The last step's residual norms over its reference, one per iterate
     /// (the first is the predictor's): quadratic convergence squares them.
     pub last_step_residuals: Vec<f64>,
@@ -101,6 +104,7 @@ impl NewtonSummary {
             iterations_mean: s.mean_iterations(),
             iterations_max: s.max_iterations,
             cuts: s.cuts,
+            factorizations: s.factorizations,
             last_step_residuals: s.last_residuals.clone(),
             last_step_corrections: s.last_corrections.clone(),
             seconds: s.seconds,
