@@ -238,12 +238,22 @@ pub fn check_state(model: &Model, state: &State) -> Result<()> {
         && state.mv.len() == model.grid.n_nodes() * model.n_fields()
         && state.force.len() == model.grid.n_nodes() * model.n_fields();
     let gmm = matches!(&model.integrator, crate::model::Integrator::Implicit(s) if s.gmm.is_some());
-    if state.cloud.is_some() && !gmm {
-        return Err(Error::Checkpoint(
-            "holds a GMM run's node cloud, and the scene is not a GMM run: resume it with \
-             solver.integrator = \"implicit\" and solver.method = \"gmm\""
-                .into(),
-        ));
+    match (state.cloud.is_some(), gmm) {
+        (true, false) => {
+            return Err(Error::Checkpoint(
+                "holds a GMM run's node cloud, and the scene is not a GMM run: resume it with \
+                 solver.integrator = \"implicit\" and solver.method = \"gmm\""
+                    .into(),
+            ));
+        }
+        (false, true) => {
+            return Err(Error::Checkpoint(
+                "holds no node cloud, and the scene is a GMM run (solver.method = \"gmm\"): \
+                 resume it with the scene it was written with"
+                    .into(),
+            ));
+        }
+        _ => {}
     }
     if same {
         Ok(())

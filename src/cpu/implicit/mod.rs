@@ -742,13 +742,7 @@ impl ImplicitBackend {
                 self.stats.seconds.factor += assembled.elapsed().as_secs_f64();
                 self.stats.factorizations += 1;
                 let lu = lu.map_err(|_| AttemptFail::Newton(ratio))?;
-                match &mut kept {
-                    Some((l, h)) => {
-                        *l = lu;
-                        h.clone_from(&self.held);
-                    }
-                    None => kept = Some((lu, self.held.clone())),
-                }
+                kept = Some((lu, self.held.clone()));
             }
             let factored = Instant::now();
             let Some((lu, _)) = &kept else {
@@ -1140,17 +1134,9 @@ impl Backend for ImplicitBackend {
 
     fn restore(&mut self, state: &State, steps: u64) -> Result<()> {
         crate::backend::check_state(&self.model, state)?;
-        match (&mut self.nodes, &state.cloud) {
-            (Nodes::Cloud(c), Some(s)) => c.load(s).map_err(Error::Checkpoint)?,
-            (Nodes::Cloud(_), None) => {
-                return Err(Error::Checkpoint(
-                    "holds no node cloud, and the scene is a GMM run (solver.method = \"gmm\"): \
-                     resume it with the scene it was written with"
-                        .into(),
-                ));
-            }
-            // `check_state` refused a cloud for a scene that is not GMM.
-            (Nodes::Grid, _) => {}
+        // `check_state` has matched the cloud to the scene's method.
+        if let (Nodes::Cloud(c), Some(s)) = (&mut self.nodes, &state.cloud) {
+            c.load(s).map_err(Error::Checkpoint)?;
         }
         // The contact states the next step starts from (none saved: a run
         // from before they were kept, or an explicit run's state).
