@@ -187,6 +187,23 @@ impl Cloud {
         }
         out.sort_unstable();
     }
+
+    /// Every node within `radius` (m, any size: a scan of the whole
+    /// cloud, not the cell list) of `x`, nearest first, into `out`
+    /// (cleared first). For the rare particle whose cloud needs nodes
+    /// beyond the cell list's reach.
+    pub fn nearest_within(&self, x: [f64; 2], radius: f64, out: &mut Vec<(f64, u32)>) {
+        out.clear();
+        let r2 = radius * radius;
+        for (n, xn) in self.x.iter().enumerate() {
+            let d = [x[0] - xn[0], x[1] - xn[1]];
+            let d2 = d[0] * d[0] + d[1] * d[1];
+            if d2 <= r2 {
+                out.push((d2, n as u32));
+            }
+        }
+        out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    }
 }
 
 /// Distance (m) from `p` to the union of the `outline`'s shapes: 0 inside

@@ -427,9 +427,9 @@ impl Cohesive<'_> {
             md,
             "**GMM** (`{}`, mesh 1; {status}): at {t:.2} s, the last output time it reached, its \
              run-out is {} m and its height {} m, against {}–{} m and {}–{} m for the four shapes \
-             (explicit MPM) on the same mesh. Mesh 2 is not run (about three hours on 2 cores); \
-             the paper's GMM reaches 2 s on both meshes with a convex-hull guard that is not built \
-             ([methods](methods.md#gmm)).\n",
+             (explicit MPM) on the same mesh. Mesh 2 is not run here (hours on 2 cores). The paper's \
+             GMM reaches 2 s on both meshes with a variable radius and a convex-hull guard; ours has \
+             both, and what stops it is a node that leaves the body ([methods](methods.md#gmm)).\n",
             GMM.0,
             sig(run_out(p, h)),
             sig(height(p, h)),

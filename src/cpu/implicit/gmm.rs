@@ -26,6 +26,7 @@ use crate::cpu::ShapeCache;
 use crate::error::SceneError;
 use crate::gmm::{Basis, Cloud};
 use crate::model::fault::{Fault, FaultKind};
+use crate::model::shape::ShapeFault;
 use crate::model::walls::{CONTACT_STICK, Wall};
 use crate::model::{GmmSettings, Model};
 use rayon::prelude::*;
@@ -42,6 +43,19 @@ const STRIDE_SLACK: f64 = 2.0;
 /// (its Hessian turns singular: the particle lies outside the hull of
 /// the nodes it gathered). The cell list is built for the widest.
 const RADIUS_GROWTH: [f64; 3] = [1.0, 1.5, 2.0];
+
+/// Past the widest radius a particle adds the nodes nearest it,
+/// `WIDEN_STEP` at a time in order of distance, out to `WIDEN_REACH`
+/// times the search radius: the paper's "old connections plus the next
+/// nodes closer to the material point" (§5.3), its guard against a cloud
+/// that no longer encloses the particle. It always succeeds for LME where
+/// the last step's cloud lies within reach: LME's weights are positive
+/// and reproduce x, and the step moves the particle by Σ N_a Δu_a and
+/// its nodes by Δu_a, so the particle ends strictly inside the hull of
+/// the nodes it gathered last step, and any set holding those encloses
+/// it.
+const WIDEN_STEP: usize = 2;
+const WIDEN_REACH: f64 = 4.0;
 
 /// The cloud, its basis and each particle's LME multiplier.
 pub struct GmmNodes {
@@ -151,27 +165,19 @@ impl GmmNodes {
                 .zip(self.lambda.par_iter_mut())
                 .enumerate()
                 .with_min_len(64)
-                .map_init(Vec::new, |list, (p, (((nodes, w), count), lam))| {
-                    let mut fault = None;
-                    for (k, grow) in RADIUS_GROWTH.iter().enumerate() {
-                        cloud.gather(x[p], grow * radius, list);
-                        if list.len() > stride {
-                            return (None, list.len());
+                .map_init(
+                    || (Vec::new(), Vec::new()),
+                    |(list, near), (p, (((nodes, w), count), lam))| match particle_cloud(
+                        cloud, basis, radius, x[p], list, near, nodes, w, lam,
+                    ) {
+                        Gathered::Kept(kept) => {
+                            *count = kept as u16;
+                            (None, 0)
                         }
-                        nodes[..list.len()].copy_from_slice(list);
-                        if k > 0 {
-                            *lam = [0.0; 2];
-                        }
-                        match basis.eval(x[p], &cloud.x, nodes, list.len(), lam, w) {
-                            Ok(kept) => {
-                                *count = kept as u16;
-                                return (None, 0);
-                            }
-                            Err(e) => fault = Some(Fault::at(p, FaultKind::Shape(e))),
-                        }
-                    }
-                    (fault, 0)
-                })
+                        Gathered::Failed(e) => (Some(Fault::at(p, FaultKind::Shape(e))), 0),
+                        Gathered::NeedSlots(m) => (None, m),
+                    },
+                )
                 .reduce(|| (None, 0), |a, b| (Fault::first(a.0, b.0), a.1.max(b.1)));
             if need > stride {
                 *cache = ShapeCache::new(x.len(), need + need / 2);
@@ -276,9 +282,151 @@ impl GmmNodes {
     }
 }
 
+/// What `particle_cloud` found.
+#[derive(Debug)]
+enum Gathered {
+    /// The basis over this many nodes (`nodes[..k]`, `w[..k]`).
+    Kept(usize),
+    /// No set it tried gave the basis a solution; the last one's fault.
+    Failed(ShapeFault),
+    /// A set it needed outnumbers the slots: this many.
+    NeedSlots(usize),
+}
+
+/// One particle's cloud and basis at `x`: the nodes within each of
+/// `RADIUS_GROWTH` times `radius` in turn, then the guard (`WIDEN_STEP`),
+/// into `nodes` and `w` (their length is the slots); `lam` is LME's warm
+/// start, reset to 0 past the first set. `list` and `near` are scratch.
+#[allow(clippy::too_many_arguments)]
+fn particle_cloud(
+    cloud: &Cloud,
+    basis: &Basis,
+    radius: f64,
+    x: [f64; 2],
+    list: &mut Vec<u32>,
+    near: &mut Vec<(f64, u32)>,
+    nodes: &mut [u32],
+    w: &mut [[f64; 3]],
+    lam: &mut [f64; 2],
+) -> Gathered {
+    let stride = nodes.len();
+    let mut fault = ShapeFault::LmeTooFewNodes { nodes: Some(0) };
+    for (k, grow) in RADIUS_GROWTH.iter().enumerate() {
+        cloud.gather(x, grow * radius, list);
+        if list.len() > stride {
+            return Gathered::NeedSlots(list.len());
+        }
+        nodes[..list.len()].copy_from_slice(list);
+        if k > 0 {
+            *lam = [0.0; 2];
+        }
+        match basis.eval(x, &cloud.x, nodes, list.len(), lam, w) {
+            Ok(kept) => return Gathered::Kept(kept),
+            Err(e) => fault = e,
+        }
+    }
+    // The guard: the nearest nodes beyond the widest radius, a few at a time.
+    cloud.nearest_within(x, WIDEN_REACH * radius, near);
+    let mut m = list.len();
+    while m < near.len() {
+        m = (m + WIDEN_STEP).min(near.len());
+        if m > stride {
+            return Gathered::NeedSlots(m);
+        }
+        list.clear();
+        list.extend(near[..m].iter().map(|&(_, n)| n));
+        list.sort_unstable();
+        nodes[..m].copy_from_slice(list);
+        *lam = [0.0; 2];
+        match basis.eval(x, &cloud.x, nodes, m, lam, w) {
+            Ok(kept) => return Gathered::Kept(kept),
+            Err(e) => fault = e,
+        }
+    }
+    Gathered::Failed(fault)
+}
+
 /// Node `n`'s gap to wall `w`'s line (m): its distance on the material's
 /// side, plus how far it lies outside the body (`Cloud::outside`).
 fn raw_gap(c: &Cloud, n: usize, w: &Wall) -> f64 {
     let x = c.x[n];
     (x[0] - w.point[0]) * w.normal[0] + (x[1] - w.point[1]) * w.normal[1] + c.outside[n]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::GmmSettings;
+    use crate::scene::GmmBasis;
+
+    /// A particle whose nodes within the widest radius all lie on one side
+    /// of it (the body stretched the cloud that enclosed it): LME has no
+    /// solution there, and the guard finds one with the nearest node
+    /// beyond, which reproduces x.
+    #[test]
+    fn the_guard_encloses_a_particle_the_widest_radius_leaves_outside() {
+        let h = 0.05;
+        let s = GmmSettings {
+            basis: GmmBasis::Lme,
+            gamma: 1.8,
+            search_radius: std::f64::consts::SQRT_2,
+            dilation: 1.0,
+        };
+        let radius = s.search_radius * h;
+        let widest = RADIUS_GROWTH[RADIUS_GROWTH.len() - 1] * radius;
+        // A half-lattice left of the particle at the origin, and one node
+        // to its right beyond the widest radius, within the guard's reach.
+        let mut xn = Vec::new();
+        for j in -6..=6 {
+            for i in 1..=6 {
+                xn.push([-(i as f64) * h, j as f64 * h]);
+            }
+        }
+        let far = [1.2 * widest, 0.0];
+        assert!(far[0] < WIDEN_REACH * radius);
+        xn.push(far);
+        let mut cloud = Cloud::from_points(h, xn);
+        cloud.rebuild(widest);
+        let basis = Basis::new(&s, h);
+        let x = [0.0, 0.01];
+        let slots = 200;
+        let (mut nodes, mut w) = (vec![0u32; slots], vec![[0.0; 3]; slots]);
+        let (mut list, mut near) = (Vec::new(), Vec::new());
+        // Without the guard: the widest radius alone faults.
+        cloud.gather(x, widest, &mut list);
+        let n = list.len();
+        nodes[..n].copy_from_slice(&list);
+        assert!(
+            basis
+                .eval(x, &cloud.x, &mut nodes, n, &mut [0.0; 2], &mut w)
+                .is_err()
+        );
+        let got = particle_cloud(
+            &cloud,
+            &basis,
+            radius,
+            x,
+            &mut list,
+            &mut near,
+            &mut nodes,
+            &mut w,
+            &mut [0.0; 2],
+        );
+        let Gathered::Kept(k) = got else {
+            panic!("the guard found no cloud: {got:?}")
+        };
+        assert!(nodes[..k].contains(&((cloud.len() - 1) as u32)));
+        let (mut sum, mut rx) = (0.0, [0.0; 2]);
+        for (a, wa) in nodes[..k].iter().zip(&w[..k]) {
+            sum += wa[0];
+            for (r, xa) in rx.iter_mut().zip(cloud.x[*a as usize]) {
+                *r += wa[0] * xa;
+            }
+        }
+        assert!((sum - 1.0).abs() < 1e-10, "partition of unity {sum}");
+        assert!(
+            (rx[0] - x[0]).abs() < 1e-9 * h && (rx[1] - x[1]).abs() < 1e-9 * h,
+            "{rx:?}"
+        );
+    }
 }
