@@ -558,14 +558,35 @@ fn contact_quick_measures_collisions_and_rolling() {
 const ROLLING_R10_MIN: f64 = 0.82;
 /// `study gmm --quick`: GMM-LME and GMM-MLS on the cantilever at h = 0.5,
 /// 0.25, 0.125 (milliseconds each), with the orders, Richardson limits and
-/// the paper's ordering of the two bases in the section.
+/// the paper's ordering of the two bases in the section; and the rolling
+/// disk's GMM rows beside implicit MPM Q4 (Δt1 to 0.03 s), implicit only.
 #[test]
 fn gmm_quick_reports_orders_and_the_paper_ordering() {
     let (results, md, dir) = run(StudyName::Gmm);
-    let chart = "study-gmm-cantilever-mesh.png";
-    assert!(md.contains(chart) && dir.join(chart).exists(), "{md}");
-    // GMM-LME and GMM-MLS at 3 sizes, implicit MPM Q4 at 2 (the cost rows).
-    assert_eq!(results.len(), 8);
+    for chart in ["study-gmm-cantilever-mesh.png", "study-gmm-disk-time.png"] {
+        assert!(
+            md.contains(chart) && dir.join(chart).exists(),
+            "{chart}: {md}"
+        );
+    }
+    // GMM-LME and GMM-MLS at 3 sizes, implicit MPM Q4 at 2 (the cost rows),
+    // and the disk: four GMM bases and Q4 at Δt1.
+    assert_eq!(results.len(), 13);
+    for m in [
+        "gmm-lme-g0.8",
+        "gmm-lme-g1.8",
+        "gmm-lme-g2.8",
+        "gmm-mls",
+        "linear",
+    ] {
+        assert!(md.contains(&format!("| implicit | {m} |")), "{m}: {md}");
+    }
+    // No explicit runs here, so no explicit rows or text.
+    assert!(
+        !md.contains("| explicit |") && !md.contains("Explicit NPC"),
+        "{md}"
+    );
+    assert!(md.contains("**GMM (issue 27).**"), "{md}");
     for r in &results {
         assert!(r.data().is_some_and(|d| d.completed()), "{}", r.job.label);
     }

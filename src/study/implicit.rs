@@ -257,32 +257,11 @@ pub fn jobs(quick: bool) -> Vec<Job> {
         }
     }
     for scheme in SCHEMES {
-        for (label, shape) in SHAPES {
-            for (k, dt) in disk_steps(scheme, quick).into_iter().enumerate() {
-                let mut j = super::disk::job(b, (label, shape, 0.0), k + 1, dt, disk_t_end(quick))
-                    .tag("case", "disk")
-                    .tag("scheme", scheme);
-                j.label = format!("disk-{scheme}-{label}-dt{}", k + 1);
-                if scheme == "implicit" {
-                    j = j.set("solver.integrator=implicit");
-                }
-                out.push(j);
-            }
+        for shape in SHAPES {
+            out.extend(disk_jobs(scheme, shape, quick));
         }
     }
-    for (label, keys) in DISK_GMM {
-        for (k, dt) in disk_steps("implicit", quick).into_iter().enumerate() {
-            let mut j = super::disk::job(b, (label, "lme", 0.0), k + 1, dt, disk_t_end(quick))
-                .tag("case", "disk")
-                .tag("scheme", "implicit")
-                .set("solver.integrator=implicit");
-            for key in keys {
-                j = j.set(*key);
-            }
-            j.label = format!("disk-implicit-{label}-dt{}", k + 1);
-            out.push(j);
-        }
-    }
+    out.extend(gmm_disk_jobs(quick));
     let (h, implicit, npc) = dyka_runs(quick);
     for (scheme, courants) in [("implicit", implicit), ("explicit", npc)] {
         let integrator = if scheme == "implicit" {
@@ -367,31 +346,37 @@ fn disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
 /// paper's MPM) at every Δt.
 fn gmm_disk_findings(md: &mut String, done: &DiskRuns, n: usize) {
     let gmm = "gmm-lme-g2.8";
-    let pairs: Vec<(usize, f64, f64)> = (1..=n)
+    let pairs: Vec<(usize, f64, f64, f64)> = (1..=n)
         .filter_map(|k| {
             let g = done.get(&("implicit", gmm, k))?;
             let m = done.get(&("implicit", "linear", k))?;
-            Some((k, g.0, m.0))
+            Some((k, g.0, m.0, g.1 / m.1.max(1e-9)))
         })
         .collect();
     if pairs.is_empty() {
         return;
     }
-    let below = pairs.iter().all(|&(_, g, m)| g < m);
+    let below = pairs.iter().all(|&(_, g, m, _)| g < m);
     let finest = done.get(&("implicit", gmm, n)).map(|g| g.0);
     let _ = writeln!(
         md,
         "**GMM (issue 27).** GMM-LME γ = 2.8 against implicit MPM (Q4): {}; {} at every Δt run. At the finest Δt \
          (Δt{n}): {} (acceptance: below {} %). Walls act on the cloud's nodes, each meeting the wall when the body's \
-         edge beside it does ([methods](methods.md#gmm)).\n",
+         edge beside it does ([methods](methods.md#gmm)). Cost, the same steps (wall time, GMM-LME γ = 2.8 over \
+         implicit MPM Q4; the paper: +8.5 to 16 % for GMM-LME): {}.\n",
         pairs
             .iter()
-            .map(|&(k, g, m)| format!("Δt{k} {} % against {} %", sig(g), sig(m)))
+            .map(|&(k, g, m, _)| format!("Δt{k} {} % against {} %", sig(g), sig(m)))
             .collect::<Vec<_>>()
             .join(", "),
         if below { "below" } else { "not below" },
-        finest.map_or("no completed run".into(), |e| format!("{} %", sig(e))),
-        sig(GMM_DISK_FINEST)
+        finest.map_or("no completed run".into(), |e| format!("{e:.3} %")),
+        sig(GMM_DISK_FINEST),
+        pairs
+            .iter()
+            .map(|&(k, _, _, r)| format!("Δt{k} {}×", sig(r)))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
 }
 
@@ -481,6 +466,37 @@ struct Report<'a> {
     dir: &'a Path,
 }
 
+/// The rolling disk with one of `SHAPES` at the three Δt of `scheme`.
+fn disk_jobs(scheme: &str, (label, shape): (&'static str, &'static str), quick: bool) -> Vec<Job> {
+    let b = BackendChoice::Cpu;
+    let mut out = Vec::new();
+    for (k, dt) in disk_steps(scheme, quick).into_iter().enumerate() {
+        let mut j = super::disk::job(b, (label, shape, 0.0), k + 1, dt, disk_t_end(quick))
+            .tag("case", "disk")
+            .tag("scheme", scheme);
+        j.label = format!("disk-{scheme}-{label}-dt{}", k + 1);
+        if scheme == "implicit" {
+            j = j.set("solver.integrator=implicit");
+        }
+        out.push(j);
+    }
+    out
+}
+
+/// GMM's rolling disk runs (`DISK_GMM`), implicit at the three Δt.
+fn gmm_disk_jobs(quick: bool) -> Vec<Job> {
+    let mut out = Vec::new();
+    for (label, keys) in DISK_GMM {
+        for mut j in disk_jobs("implicit", (label, "lme"), quick) {
+            for key in keys {
+                j = j.set(*key);
+            }
+            out.push(j);
+        }
+    }
+    out
+}
+
 /// GMM's cantilever runs (the implicit study's GMM rows).
 fn gmm_only_jobs(quick: bool) -> Vec<Job> {
     let mut out = Vec::new();
@@ -493,9 +509,15 @@ fn gmm_only_jobs(quick: bool) -> Vec<Job> {
 }
 
 /// `lme-mpm study gmm`: GMM's cantilever runs, and implicit MPM with Q4
-/// on the same scenes for the cost per step (seconds in all).
+/// on the same scenes for the cost per step (seconds in all); and the
+/// rolling disk, GMM's four bases and implicit MPM with Q4 at the three
+/// Δt (the implicit study's disk rows without its explicit and B-spline
+/// runs; 16 minutes on 2 cores on 2026-11-28; `--quick`: Δt1 to 0.03 s).
 pub fn gmm_jobs(quick: bool) -> Vec<Job> {
-    let mut out = gmm_only_jobs(quick);
+    // The longest first, so they do not trail.
+    let mut out: Vec<Job> = gmm_disk_jobs(quick).into_iter().rev().collect();
+    out.extend(disk_jobs("implicit", SHAPES[0], quick));
+    out.extend(gmm_only_jobs(quick));
     for &h in cantilever_h(quick).iter().rev() {
         out.push(cantilever_job("implicit", SHAPES[0], h));
     }
@@ -540,7 +562,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     );
     charts.extend(r.cantilever(&mut md)?);
     charts.extend(r.dyka(&mut md)?);
-    charts.extend(r.disk(&mut md)?);
+    charts.extend(r.disk(&mut md, "study-implicit-disk-time")?);
     r.cost(&mut md);
     Ok((md, charts))
 }
@@ -886,6 +908,15 @@ impl Report<'_> {
             .collect();
         self.gmm_acceptance(md, &gmm);
         self.gmm_cost(md);
+        let mut charts = charts;
+        if self
+            .results
+            .iter()
+            .any(|r| r.job.tag_value("case") == Some("disk"))
+        {
+            charts.extend(self.disk(md, "study-gmm-disk-time")?);
+            self.cost(md);
+        }
         Ok(charts)
     }
 
@@ -1203,9 +1234,11 @@ impl Report<'_> {
         Ok(files)
     }
 
-    /// The rolling disk: table beside Table 1 and error against wall time,
-    /// failed runs included.
-    fn disk(&self, md: &mut String) -> Result<Vec<PathBuf>> {
+    /// The rolling disk: table beside Table 1 and error against wall time
+    /// (chart `<chart>.png`), failed runs included; a method none of whose
+    /// runs is in the results (`study gmm` runs no explicit disk) has no
+    /// row.
+    fn disk(&self, md: &mut String, chart: &str) -> Result<Vec<PathBuf>> {
         let scene = Scene::from_str(ROLLING_DISK, "rolling_disk", "rolling_disk", &[])?;
         let exact = RollingDisk::from_scene(&scene);
         let m = scene.materials().next().expect("the disk has a material").1;
@@ -1213,16 +1246,31 @@ impl Report<'_> {
         let c = (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / m.density).sqrt();
         let courant = |dt: f64| dt * c / scene.file.grid.h;
         let n = disk_steps("implicit", self.quick).len();
+        let has_run = |scheme: &str, label: &str| {
+            self.results.iter().any(|r| {
+                r.job.tag_value("case") == Some("disk")
+                    && r.job.tag_value("scheme") == Some(scheme)
+                    && r.job.tag_value("method") == Some(label)
+            })
+        };
+        let explicit = SHAPES.iter().any(|(l, _)| has_run("explicit", l));
         let _ = writeln!(
             md,
             "### Rolling disk\n\nThe `disk` study's case (`cases/rolling_disk.toml`, friction wall μ = 0.5, h = 0.025 m, \
-             up to t = {} s), eq. 67 error (percent) over the centre's displacement every 0.01 s. Explicit NPC at \
-             Δt1 = {} s (Courant {}), implicit at Δt1 = {} s (Courant {}), each with Δt1 = 2Δt2 = 4Δt3; the paper's \
-             Table 1 (implicit, its Δt unstated) beside them. A run that stops is listed with the time it reached \
-             and why, and marked in the chart's legend.\n",
+             up to t = {} s), eq. 67 error (percent) over the centre's displacement every 0.01 s. {}Implicit at \
+             Δt1 = {} s (Courant {}), with Δt1 = 2Δt2 = 4Δt3; the paper's Table 1 (implicit, its Δt unstated) \
+             beside them. A run that stops is listed with the time it reached and why, and marked in the chart's \
+             legend.\n",
             sig(disk_t_end(self.quick)),
-            sig(super::disk::DT1),
-            sig(courant(super::disk::DT1)),
+            if explicit {
+                format!(
+                    "Explicit NPC at Δt1 = {} s (Courant {}), with Δt1 = 2Δt2 = 4Δt3. ",
+                    sig(super::disk::DT1),
+                    sig(courant(super::disk::DT1))
+                )
+            } else {
+                String::new()
+            },
             sig(DISK_IMPLICIT_DT1),
             sig(courant(DISK_IMPLICIT_DT1))
         );
@@ -1236,6 +1284,8 @@ impl Report<'_> {
         // "implicit linear: Δt1 at 0.0443 s, …" per series with a stopped run.
         let mut stopped_text = Vec::new();
         let mut done = DiskRuns::new();
+        // Whether a stopped run's reason is the friction contact's.
+        let mut diverged = false;
         for (scheme, dashed) in [("implicit", false), ("explicit", true)] {
             // GMM runs implicit only.
             let labels = SHAPES.iter().map(|(l, _)| *l).chain(
@@ -1245,6 +1295,9 @@ impl Report<'_> {
                     .map(|(l, _)| *l),
             );
             for (ci, label) in labels.enumerate() {
+                if !has_run(scheme, label) {
+                    continue;
+                }
                 let mut row = vec![scheme.to_string(), label.to_string()];
                 let mut points = Vec::new();
                 let mut stopped = Vec::new();
@@ -1270,7 +1323,9 @@ impl Report<'_> {
                             }
                         }
                         Some((r, None)) => {
-                            row.push(super::failure_text(r).replace('|', "/"));
+                            let why = super::failure_text(r);
+                            diverged |= why.contains("newton_diverged");
+                            row.push(why.replace('|', "/"));
                             row.push(wall(r));
                             stopped.push(format!(
                                 "Δt{k} at {} s",
@@ -1306,15 +1361,19 @@ impl Report<'_> {
         }
         md.push_str(&table(&header, &rows));
         let (files, _) = report::front_chart(
-            "Rolling disk: eq. 67 error against wall time (each point one Δt; dashed explicit)",
+            if explicit {
+                "Rolling disk: eq. 67 error against wall time (each point one Δt; dashed explicit)"
+            } else {
+                "Rolling disk: eq. 67 error against wall time (each point one Δt)"
+            },
             "error (%)",
             &curves,
-            &self.dir.join("study-implicit-disk-time"),
+            &self.dir.join(chart),
         )?;
         md.push('\n');
         md.push_str(&image(
             "rolling disk error against wall time",
-            "study-implicit-disk-time.png",
+            &format!("{chart}.png"),
         ));
         let _ = writeln!(
             md,
@@ -1324,10 +1383,15 @@ impl Report<'_> {
             } else {
                 format!(
                     "Runs that stopped, with the time reached (no eq. 67 error over the whole history, so no point \
-                     in the chart; named in its legend): {}. `newton_diverged` is the implicit friction contact: \
-                     nodes switch between stick and slip from one Newton iterate to the next (see the implicit \
-                     integrator in [methods](methods.md#implicit-integrator)).",
-                    stopped_text.join("; ")
+                     in the chart; named in its legend): {}.{}",
+                    stopped_text.join("; "),
+                    if diverged {
+                        " `newton_diverged` is the implicit friction contact: nodes switch between stick and slip \
+                         from one Newton iterate to the next (see the implicit integrator in \
+                         [methods](methods.md#implicit-integrator))."
+                    } else {
+                        ""
+                    }
                 )
             }
         );

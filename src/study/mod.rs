@@ -57,9 +57,11 @@ pub enum StudyName {
     /// on a Tresca soil against Prandtl's 5.14 c, smooth and rough, three
     /// grids (full run only) (CPU; about 15 minutes, --quick about 1).
     Contact,
-    /// The Galerkin meshfree method on the static cantilever: GMM-LME and
-    /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson (the
-    /// implicit study's GMM rows alone, seconds).
+    /// The Galerkin meshfree method: the static cantilever (GMM-LME and
+    /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson) and
+    /// the rolling disk (GMM-LME γ = 0.8, 1.8, 2.8, GMM-MLS and implicit
+    /// MPM Q4 × 3 time steps), the implicit study's GMM rows alone (about
+    /// 20 minutes on 2 cores; --quick: seconds).
     Gmm,
     /// All of them, in that order.
     All,
