@@ -909,11 +909,7 @@ impl Report<'_> {
         self.gmm_acceptance(md, &gmm);
         self.gmm_cost(md);
         let mut charts = charts;
-        if self
-            .results
-            .iter()
-            .any(|r| r.job.tag_value("case") == Some("disk"))
-        {
+        if find(self.results, &[("case", "disk")]).is_some() {
             charts.extend(self.disk(md, "study-gmm-disk-time")?);
             self.cost(md);
         }
@@ -1247,11 +1243,11 @@ impl Report<'_> {
         let courant = |dt: f64| dt * c / scene.file.grid.h;
         let n = disk_steps("implicit", self.quick).len();
         let has_run = |scheme: &str, label: &str| {
-            self.results.iter().any(|r| {
-                r.job.tag_value("case") == Some("disk")
-                    && r.job.tag_value("scheme") == Some(scheme)
-                    && r.job.tag_value("method") == Some(label)
-            })
+            find(
+                self.results,
+                &[("case", "disk"), ("scheme", scheme), ("method", label)],
+            )
+            .is_some()
         };
         let explicit = SHAPES.iter().any(|(l, _)| has_run("explicit", l));
         let _ = writeln!(
