@@ -54,8 +54,8 @@ pub struct State {
 }
 
 /// What a GMM run's node cloud carries from step to step, beyond what its
-/// scene rebuilds (the nodes' lattice origin, constraints and distance
-/// outside the body come from the initial particles): per node, the
+/// scene rebuilds (the nodes' lattice origin, constraints and the rim
+/// nodes' fit to the outline come from the initial particles): per node, the
 /// position (m), displacement since the start (m), velocity (m/s) and
 /// acceleration (m/s²) of the last converged step; per particle, LME's
 /// multiplier λ of the last step (its Newton solve's warm start).

@@ -11,10 +11,13 @@
 //! constraint's box, `Model::constraints`), through the grid index each
 //! cloud node was made from.
 //!
-//! Walls act on the cloud's nodes (`cpu::implicit::gmm`), and a lattice
-//! node of a cell the body only partly covers lies outside the body, by
-//! up to a cell's diagonal: each node keeps how far (`outside`), so that it
-//! meets a wall when the body's edge beside it does, not before.
+//! A lattice node of a cell the body only partly covers lies outside the
+//! body, by up to a cell's diagonal. Such nodes are moved onto the body's
+//! outline (`fit_to_outline`), as a mesh that conforms to the body has its
+//! boundary nodes on it (the paper's triangulation does): walls act on the
+//! cloud's nodes (`cpu::implicit::gmm`), and a node the wall holds
+//! outside the body would make the body roll about it, a disk on a radius
+//! up to a cell larger than its own.
 
 use crate::error::SceneError;
 use crate::model::{BodyOutline, FIX_X, FIX_Y, Model};
@@ -38,11 +41,6 @@ pub struct Cloud {
     pub fix: Vec<u8>,
     /// Per constraint group (`Model::constraints.groups` order): its nodes.
     pub groups: Vec<Vec<u32>>,
-    /// Per node: its distance (m) from the body at the start, measured to
-    /// the bodies' shapes (`BodyOutline`; 0 for a node inside one). The
-    /// node moves with the body, so it keeps this distance as the body
-    /// turns (`set_outside`; 0 until then).
-    pub outside: Vec<f64>,
     cells: CellList,
 }
 
@@ -121,7 +119,6 @@ impl Cloud {
             grid_node,
             fix,
             groups,
-            outside: vec![0.0; n],
             cells: CellList::default(),
         })
     }
@@ -137,16 +134,83 @@ impl Cloud {
             grid_node: vec![u32::MAX; n],
             fix: vec![0; n],
             groups: Vec::new(),
-            outside: vec![0.0; n],
             x,
             cells: CellList::default(),
         }
     }
 
-    /// Measures each node's distance from the bodies' `outline` (m, 0
-    /// inside), into `outside`.
-    pub fn set_outside(&mut self, outline: &BodyOutline) {
-        self.outside = self.x.iter().map(|&p| distance(outline, p)).collect();
+    /// Moves every node that lies outside the bodies' `outline` onto its
+    /// nearest point of the outline, and drops one that lands within
+    /// `MERGE` node spacings of a node it keeps (inside nodes first, then
+    /// the moved ones in order; a constrained node is never dropped). A
+    /// node keeps its lattice index, so constraints select it as before.
+    /// Returns (moved, dropped). A body whose edges lie on the lattice's
+    /// lines (the cantilever, the column) has no node outside and keeps
+    /// its cloud as it was.
+    pub fn fit_to_outline(&mut self, outline: &BodyOutline) -> (usize, usize) {
+        let moved: Vec<usize> = (0..self.len())
+            .filter_map(|n| {
+                let q = nearest_on_outline(outline, self.x[n])?;
+                self.x[n] = q;
+                Some(n)
+            })
+            .collect();
+        if moved.is_empty() {
+            return (0, 0);
+        }
+        let merge = MERGE * self.h;
+        self.cells.build(&self.x, merge);
+        let mut is_moved = vec![false; self.len()];
+        for &n in &moved {
+            is_moved[n] = true;
+        }
+        let mut keep = vec![true; self.len()];
+        let mut near = Vec::new();
+        for &n in &moved {
+            if self.fix[n] != 0 || self.groups.iter().any(|g| g.contains(&(n as u32))) {
+                continue;
+            }
+            self.gather(self.x[n], merge, &mut near);
+            // A kept node that is not moved, or moved before this one.
+            if near.iter().any(|&m| {
+                m as usize != n && keep[m as usize] && (!is_moved[m as usize] || (m as usize) < n)
+            }) {
+                keep[n] = false;
+            }
+        }
+        let dropped = keep.iter().filter(|&&k| !k).count();
+        if dropped > 0 {
+            self.retain(&keep);
+        }
+        (moved.len(), dropped)
+    }
+
+    /// Keeps the nodes with `keep[n]`, renumbering the constraint groups.
+    fn retain(&mut self, keep: &[bool]) {
+        let mut new_index = vec![u32::MAX; keep.len()];
+        let mut next = 0u32;
+        for (n, &k) in keep.iter().enumerate() {
+            if k {
+                new_index[n] = next;
+                next += 1;
+            }
+        }
+        fn keep_only<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
+            let mut it = keep.iter();
+            v.retain(|_| *it.next().expect("one flag per node"));
+        }
+        keep_only(&mut self.x, keep);
+        keep_only(&mut self.u, keep);
+        keep_only(&mut self.v, keep);
+        keep_only(&mut self.a, keep);
+        keep_only(&mut self.grid_node, keep);
+        keep_only(&mut self.fix, keep);
+        for g in &mut self.groups {
+            // Constrained nodes are never dropped.
+            for n in g.iter_mut() {
+                *n = new_index[*n as usize];
+            }
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -206,23 +270,33 @@ impl Cloud {
     }
 }
 
-/// Distance (m) from `p` to the union of the `outline`'s shapes: 0 inside
-/// one, else the nearest shape's boundary.
-pub fn distance(outline: &BodyOutline, p: [f64; 2]) -> f64 {
+/// Where a node moved onto the outline may land within this many node
+/// spacings of another node and is dropped instead: two lattice nodes
+/// outside a curved edge can lie on nearly one normal to it (the R/h = 20
+/// rolling disk moves 124 rim nodes and drops none; see the test).
+const MERGE: f64 = 0.25;
+
+/// The nearest point (m) to `p` on the boundary of the union of the
+/// `outline`'s shapes, or None where `p` lies inside one.
+pub fn nearest_on_outline(outline: &BodyOutline, p: [f64; 2]) -> Option<[f64; 2]> {
     let rects = outline.rects.iter().map(|r| {
-        let dx = (r[0] - p[0]).max(p[0] - r[2]).max(0.0);
-        let dy = (r[1] - p[1]).max(p[1] - r[3]).max(0.0);
-        dx.hypot(dy)
+        let q = [p[0].clamp(r[0], r[2]), p[1].clamp(r[1], r[3])];
+        ((p[0] - q[0]).hypot(p[1] - q[1]), q)
     });
-    let disks = outline
-        .disks
-        .iter()
-        .map(|d| ((p[0] - d[0]).hypot(p[1] - d[1]) - d[2]).max(0.0));
+    let disks = outline.disks.iter().map(|d| {
+        let (dx, dy) = (p[0] - d[0], p[1] - d[1]);
+        let r = dx.hypot(dy);
+        if r <= d[2] {
+            (0.0, p)
+        } else {
+            (r - d[2], [d[0] + dx * d[2] / r, d[1] + dy * d[2] / r])
+        }
+    });
     let polygons = outline.polygons.iter().map(|poly| {
         // Even-odd inside test (as the seeding's), else the nearest edge.
         let n = poly.len();
         let mut inside = false;
-        let mut nearest = f64::INFINITY;
+        let mut nearest = (f64::INFINITY, p);
         for i in 0..n {
             let (a, b) = (poly[i], poly[(i + n - 1) % n]);
             if (a[1] > p[1]) != (b[1] > p[1])
@@ -237,14 +311,19 @@ pub fn distance(outline: &BodyOutline, p: [f64; 2]) -> f64 {
             } else {
                 0.0
             };
-            nearest = nearest.min((p[0] - a[0] - s * e[0]).hypot(p[1] - a[1] - s * e[1]));
+            let q = [a[0] + s * e[0], a[1] + s * e[1]];
+            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if d < nearest.0 {
+                nearest = (d, q);
+            }
         }
-        if inside { 0.0 } else { nearest }
+        if inside { (0.0, p) } else { nearest }
     });
-    rects
+    let (d, q) = rects
         .chain(disks)
         .chain(polygons)
-        .fold(f64::INFINITY, f64::min)
+        .fold((f64::INFINITY, p), |a, b| if b.0 < a.0 { b } else { a });
+    (d > 0.0 && d.is_finite()).then_some(q)
 }
 
 /// Nodes binned by square cells (a counting sort), rebuilt each step.
@@ -323,23 +402,80 @@ mod tests {
     use crate::rng::SplitMix64;
 
     #[test]
-    fn distance_to_the_outline_is_zero_inside_and_the_boundarys_outside() {
+    fn the_nearest_point_of_the_outline_is_none_inside_and_on_the_boundary_outside() {
         let o = BodyOutline {
             rects: vec![[0.0, 0.0, 1.0, 1.0]],
             disks: vec![[3.0, 0.0, 0.5]],
             polygons: vec![vec![[5.0, 0.0], [6.0, 0.0], [5.0, 1.0]]],
         };
-        let close = |p: [f64; 2], want: f64| {
-            let d = distance(&o, p);
-            assert!((d - want).abs() < 1e-14, "{p:?}: {d} against {want}");
+        let close = |p: [f64; 2], want: Option<[f64; 2]>| {
+            let q = nearest_on_outline(&o, p);
+            match (q, want) {
+                (None, None) => {}
+                (Some(q), Some(w)) => assert!(
+                    (q[0] - w[0]).hypot(q[1] - w[1]) < 1e-14,
+                    "{p:?}: {q:?} against {w:?}"
+                ),
+                _ => panic!("{p:?}: {q:?} against {want:?}"),
+            }
         };
-        close([0.5, 0.5], 0.0);
-        close([1.3, 1.4], 0.5);
-        close([3.0, 0.8], 0.3);
-        close([3.1, 0.1], 0.0);
-        close([5.2, 0.2], 0.0);
-        close([6.0, 1.0], 0.5f64.sqrt());
-        close([5.5, -0.25], 0.25);
+        close([0.5, 0.5], None);
+        close([1.3, 1.4], Some([1.0, 1.0]));
+        close([3.0, 0.8], Some([3.0, 0.5]));
+        close([3.1, 0.1], None);
+        close([5.2, 0.2], None);
+        close([6.0, 1.0], Some([5.5, 0.5]));
+        close([5.5, -0.25], Some([5.5, 0.0]));
+    }
+
+    /// The cloud of a scene run as GMM (implicit), and its model.
+    fn scene_cloud(text: &str) -> (Cloud, Model) {
+        use crate::scene::{Override, Scene};
+        let sets: Vec<Override> = ["solver.integrator=implicit", "solver.method=gmm"]
+            .iter()
+            .map(|a| Override::parse(a).unwrap())
+            .collect();
+        let scene = Scene::from_str(text, "test", "test", &sets).unwrap();
+        let model = Model::new(&scene).unwrap();
+        (Cloud::from_model(&model).unwrap(), model)
+    }
+
+    /// The rolling disk (R/h = 20): the lattice nodes of the cells its rim
+    /// cuts lie outside it, up to a cell diagonal; fitted, every node lies
+    /// in the disk or on its circle, none closer than `MERGE` h to another,
+    /// and the nodes inside have not moved. The column's rectangle lies on
+    /// the lattice's lines: nothing moves.
+    #[test]
+    fn fitting_puts_the_rim_nodes_on_the_outline_and_leaves_a_lattice_edge_alone() {
+        let (mut c, m) = scene_cloud(crate::cases::ROLLING_DISK);
+        let before = c.x.clone();
+        let outside = before
+            .iter()
+            .filter(|&&p| nearest_on_outline(&m.outline, p).is_some())
+            .count();
+        let (moved, dropped) = c.fit_to_outline(&m.outline);
+        assert_eq!(moved, outside);
+        assert!(moved > 100, "{moved} rim nodes");
+        assert!(dropped < moved / 10, "{dropped} of {moved} dropped");
+        assert_eq!(c.len(), before.len() - dropped);
+        let d = m.outline.disks[0];
+        let mut still = 0;
+        for (n, p) in c.x.iter().enumerate() {
+            let r = (p[0] - d[0]).hypot(p[1] - d[1]);
+            assert!(r <= d[2] * (1.0 + 1e-12), "node {n} at r = {r}");
+            still += before.contains(p) as usize;
+            for q in &c.x[..n] {
+                let gap = (p[0] - q[0]).hypot(p[1] - q[1]);
+                assert!(gap >= MERGE * c.h, "nodes {gap} m apart");
+            }
+        }
+        assert_eq!(still, c.len() - (moved - dropped));
+        assert_eq!(c.grid_node.len(), c.len());
+
+        let (mut c, m) = scene_cloud(crate::cases::COLUMN_COLLAPSE);
+        let before = c.x.clone();
+        assert_eq!(c.fit_to_outline(&m.outline), (0, 0));
+        assert_eq!(c.x, before);
     }
 
     #[test]

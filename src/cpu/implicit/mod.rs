@@ -1012,7 +1012,7 @@ impl ImplicitBackend {
             let walls = m.walls.list.len();
             for p in &self.pairs {
                 let state = self.node_states[state_slot(p, walls)];
-                c.hold_on_stick_wall(p.node as usize, &m.walls.list[p.wall as usize], state);
+                c.persist_contact(p.node as usize, &m.walls.list[p.wall as usize], state);
             }
         }
     }
