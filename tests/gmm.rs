@@ -532,24 +532,33 @@ const STICK_BOUNCE: f64 = 0.5;
 /// released over a step is of order 1e-7 m/s.
 const STICK_LEAVING: f64 = 1e-5;
 
-#[test]
-fn a_stick_floor_holds_its_nodes_at_rest() {
-    let text = block_scene(
-        "contact = \"stick\"",
-        [0.0, -9.81],
-        "dt = 5e-3\nt_end = 0.5",
-    );
+/// The block dropped under sudden gravity onto a floor of `contact`,
+/// run for 0.5 s (Δt 5 ms): the backend, and its fastest particle (m/s).
+fn drop_block(contact: &str) -> (ImplicitBackend, f64) {
+    let text = block_scene(contact, [0.0, -9.81], "dt = 5e-3\nt_end = 0.5");
     let mut b = ImplicitBackend::new(block_model(&text)).unwrap();
     let stop = std::sync::atomic::AtomicBool::new(false);
     b.advance(0.5, &stop).unwrap();
     let p = b.particles().unwrap();
     let fastest = p.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+    (b, fastest)
+}
+
+/// A GMM backend's cloud and its nodes on the floor y = 0.
+fn floor_nodes(b: &ImplicitBackend) -> (&lme_mpm::cpu::implicit::gmm::GmmNodes, Vec<usize>) {
     let Nodes::Cloud(c) = &b.nodes else {
         panic!("a GMM run solves on its cloud");
     };
-    let floor: Vec<usize> = (0..c.cloud.len())
+    let floor = (0..c.cloud.len())
         .filter(|&n| c.cloud.x[n][1].abs() < 1e-3)
         .collect();
+    (c, floor)
+}
+
+#[test]
+fn a_stick_floor_holds_its_nodes_at_rest() {
+    let (b, fastest) = drop_block("contact = \"stick\"");
+    let (c, floor) = floor_nodes(&b);
     // Held: nothing along the floor and nothing normal while closed; a
     // node whose contact opened keeps Newmark's leaving part (the
     // penalty's release of its squash, 1e-7 m/s at most).
@@ -577,18 +586,8 @@ fn a_stick_floor_holds_its_nodes_at_rest() {
 /// approach each node landed with, flipping sign every step.
 #[test]
 fn a_slip_floor_keeps_no_approach_at_its_closed_nodes() {
-    let text = block_scene("contact = \"slip\"", [0.0, -9.81], "dt = 5e-3\nt_end = 0.5");
-    let mut b = ImplicitBackend::new(block_model(&text)).unwrap();
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    b.advance(0.5, &stop).unwrap();
-    let p = b.particles().unwrap();
-    let fastest = p.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
-    let Nodes::Cloud(c) = &b.nodes else {
-        panic!("a GMM run solves on its cloud");
-    };
-    let floor: Vec<usize> = (0..c.cloud.len())
-        .filter(|&n| c.cloud.x[n][1].abs() < 1e-3)
-        .collect();
+    let (b, fastest) = drop_block("contact = \"slip\"");
+    let (c, floor) = floor_nodes(&b);
     assert!(!floor.is_empty());
     let leaving = floor.iter().map(|&n| c.cloud.v[n][1]).fold(0.0, f64::max);
     println!(
