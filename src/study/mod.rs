@@ -43,9 +43,10 @@ pub enum StudyName {
     /// Rolling disk: linear, uGIMP, LME γ = 2.8, bspline2 × 3 time steps;
     /// error against wall time beside the paper's Table 1.
     Disk,
-    /// Soil column collapse: 4 shapes × 2 meshes and GMM-LME on mesh 1,
+    /// Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both,
     /// profiles, run-out; and the cohesionless run-out against the
-    /// experimental scaling (about 1.5 h on 2 cores).
+    /// experimental scaling (about 2.5 h on 2 cores, GMM on mesh 2 the
+    /// longest run; an estimate, not yet timed in one study run).
     Column,
     /// Implicit against explicit: the static cantilever (mesh study), Dyka's
     /// bar and the rolling disk, error against wall time per case, and the
