@@ -164,10 +164,14 @@ impl Cloud {
         for &n in &moved {
             is_moved[n] = true;
         }
+        let mut held: Vec<bool> = self.fix.iter().map(|&f| f != 0).collect();
+        for &n in self.groups.iter().flatten() {
+            held[n as usize] = true;
+        }
         let mut keep = vec![true; self.len()];
         let mut near = Vec::new();
         for &n in &moved {
-            if self.fix[n] != 0 || self.groups.iter().any(|g| g.contains(&(n as u32))) {
+            if held[n] {
                 continue;
             }
             self.gather(self.x[n], merge, &mut near);

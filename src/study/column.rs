@@ -159,6 +159,17 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     gmm
 }
 
+/// The ranges (lowest, highest) of the run-outs and of the heights in
+/// `figs` ((run-out, height) pairs, m).
+fn spans(figs: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
+    let span = |f: fn(&(f64, f64)) -> f64| {
+        let lo = figs.iter().map(f).fold(f64::INFINITY, f64::min);
+        let hi = figs.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+        (lo, hi)
+    };
+    (span(|x| x.0), span(|x| x.1))
+}
+
 /// Half the particle spacing at cell size `h`: a particle's extent beyond
 /// its centre.
 fn half_spacing(h: f64) -> f64 {
@@ -421,12 +432,7 @@ impl Cohesive<'_> {
                 .filter_map(|m| self.get(m.0, h).and_then(|r| at(r, t)))
                 .map(|q| (run_out(q, h), height(q, h)))
                 .collect();
-            let span = |f: fn(&(f64, f64)) -> f64| {
-                let lo = shapes.iter().map(f).fold(f64::INFINITY, f64::min);
-                let hi = shapes.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
-                (lo, hi)
-            };
-            let (ro, ht) = (span(|x| x.0), span(|x| x.1));
+            let (ro, ht) = spans(&shapes);
             let status = g
                 .data()
                 .map_or_else(|| super::failure_text(g), |d| d.status_text());
@@ -475,12 +481,7 @@ impl Cohesive<'_> {
             }
         }
         if !fine.is_empty() {
-            let span = |f: fn(&(f64, f64)) -> f64| {
-                let lo = fine.iter().map(f).fold(f64::INFINITY, f64::min);
-                let hi = fine.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
-                (lo, hi)
-            };
-            let (ro, ht) = (span(|x| x.0), span(|x| x.1));
+            let (ro, ht) = spans(&fine);
             let _ = writeln!(
                 md,
                 "**Findings.** From mesh 1 to mesh 2 the run-out at {t_last} s moves by at most {:.1} % and \
