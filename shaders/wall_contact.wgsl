@@ -14,7 +14,8 @@
 // (`wall_force`, which `correct` adds to f_I), the preload's share of F_n
 // and the friction (where those weights have no negative part: linear
 // shapes) on the wall's line x_p − d n (d: `wall_depth`) with the weights
-// there to first order, N − d n·∇N, and into the wall's reaction. `clear_grid` zeroes `wall_force`. With GATES only the walls
+// there to first order, N − d n·∇N, and into the wall's reaction; with
+// WALL_PRE_FIT the preload's fit, N_I min(P, F_n) a_I, too. `clear_grid` zeroes `wall_force`. With GATES only the walls
 // that act at the step's start time t (appear_at <= t < remove_at) push.
 // CPU twin: `wall_contact` in src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
@@ -36,6 +37,9 @@
 #include "shared/wall_spring.wgsl"
 #if WALL_PRELOAD
 @group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read> wall_pre_force: array<f32>;
+#endif
+#if WALL_PRE_FIT
+@group(0) @binding({{B_WALL_PRE_FIT}}) var<storage, read> wall_pre_fit: array<vec2<f32>>;
 #endif
 
 // Keep in sync with src/model/walls.rs.
@@ -159,6 +163,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                     }
                 }
             }
+        }
+#endif
+#if WALL_PRE_FIT
+        // The preload's fit to the body's discrete reaction goes with the
+        // preload it carries now (`Walls::pre_fit`).
+        if f_pre > 0.0 {
+            var fit_sum = vec2<f32>(0.0);
+            for (var r = 0u; r < SHAPE_ROWS; r++) {
+                let span = shape_span(c, r);
+                for (var s = span.x; s < span.y; s++) {
+                    let nw = shape_node(c, s);
+                    if nw.ok && nw.n != 0.0 {
+                        let a = wall_pre_fit[nw.node];
+                        if a.x != 0.0 || a.y != 0.0 {
+                            let o = nw.n * f_pre * a;
+                            wall_force_add(2u * nw.node, o.x);
+                            wall_force_add(2u * nw.node + 1u, o.y);
+                            fit_sum += o;
+                        }
+                    }
+                }
+            }
+            reaction_add(2u * (params.n_groups + k), fit_sum.x);
+            reaction_add(2u * (params.n_groups + k) + 1u, fit_sum.y);
         }
 #endif
         let f_at = fw - f_pre * wl.normal - ft_line;

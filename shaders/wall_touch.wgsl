@@ -9,7 +9,9 @@
 // (linear shapes), else N (`wall_contact` sizes the friction with them).
 // With WALL_PRELOAD, each contact's preload
 // onto the nodes at the wall's line (B-splines: their basis evaluated at
-// the line's point; else N − d n·∇N), into `wall_pre_force`. `wall_contact`
+// the line's point; else N − d n·∇N), into `wall_pre_force`, and with
+// WALL_PRE_FIT its fit to the body's discrete reaction, P N_I a_I
+// (`Walls::pre_fit`, src/cpu/preload_fit.rs). `wall_contact`
 // reads it; `clear_grid` zeroes it. With GATES only the walls that act at
 // the step's start time t (appear_at <= t < remove_at) are in contact.
 // CPU twin: `wall_touch` in src/cpu/grid_update.rs.
@@ -28,6 +30,9 @@
 #if WALL_PRELOAD
 @group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read_write> wall_pre_force: array<{{ATOMIC_T}}>;
 #include "shared/atomics.wgsl" ARR=wall_pre_force FN=pre_force_add
+#endif
+#if WALL_PRE_FIT
+@group(0) @binding({{B_WALL_PRE_FIT}}) var<storage, read> wall_pre_fit: array<vec2<f32>>;
 #endif
 
 @compute @workgroup_size(256)
@@ -106,6 +111,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                     pre_force_add(2u * nw.node, f.x);
                     pre_force_add(2u * nw.node + 1u, f.y);
                 }
+#if WALL_PRE_FIT
+                // The fit to the body's discrete reaction (`Walls::pre_fit`).
+                if sp.y > 0.0 && nw.n != 0.0 {
+                    let a = wall_pre_fit[nw.node];
+                    if a.x != 0.0 || a.y != 0.0 {
+                        let f = sp.y * nw.n * a;
+                        pre_force_add(2u * nw.node, f.x);
+                        pre_force_add(2u * nw.node + 1u, f.y);
+                    }
+                }
+#endif
 #endif
             }
         }

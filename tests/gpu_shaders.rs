@@ -140,6 +140,10 @@ fn variants() -> Vec<Variant> {
                                         // against them) where the walls are.
                                         wall_preload: atomics == AtomicMode::CompareExchange
                                             && !mls,
+                                        // Its fit to the discrete reaction
+                                        // with it.
+                                        wall_pre_fit: atomics == AtomicMode::CompareExchange
+                                            && !mls,
                                         pic: atomics == AtomicMode::CompareExchange && !mls,
                                         local_damping: atomics == AtomicMode::CompareExchange
                                             && !mls,

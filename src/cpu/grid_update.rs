@@ -96,6 +96,23 @@ fn contact_spring(p: usize, k: usize, pt: &ContactParticles, walls: &Walls) -> (
     )
 }
 
+/// The preload (N per unit thickness) that particle `p` carries at time
+/// `t` (s) over the walls it is in contact with (`contact_spring` > 0),
+/// by which the preload's fit weighs its nodes (`cpu::preload_fit`).
+pub fn preload_scale(p: usize, pt: &ContactParticles, walls: &Walls, t: f64) -> f64 {
+    let mut s = 0.0;
+    for (k, wl) in walls.list.iter().enumerate() {
+        if !wl.active_at(t) {
+            continue;
+        }
+        let (spring, pre) = contact_spring(p, k, pt, walls);
+        if spring > 0.0 && pre > 0.0 {
+            s += pre;
+        }
+    }
+    s
+}
+
 /// What the contact reads of the particles: positions (m), masses (kg
 /// per unit thickness), densities (kg/m³), stresses (Pa, for the
 /// preload) and the scene's full gravity (m/s², zero without).
@@ -238,6 +255,15 @@ pub fn wall_touch(
                     let f = pre * face_weight(wk, wl.normal, d);
                     pre_force[n as usize][0] += f * wl.normal[0];
                     pre_force[n as usize][1] += f * wl.normal[1];
+                }
+            }
+            // The fit to the discrete reaction (`Walls::pre_fit`; empty
+            // where the line's weights already give it).
+            if pre > 0.0 && !walls.pre_fit.is_empty() {
+                for (&n, wk) in nodes.iter().zip(w) {
+                    let a = walls.pre_fit[n as usize];
+                    pre_force[n as usize][0] += pre * wk[0] * a[0];
+                    pre_force[n as usize][1] += pre * wk[0] * a[1];
                 }
             }
         }
@@ -444,6 +470,18 @@ pub fn wall_contact(
                 fw[0] - f_pre * nrm[0] - ft_line[0],
                 fw[1] - f_pre * nrm[1] - ft_line[1],
             ];
+            // The preload's fit to the body's discrete reaction
+            // (`Walls::pre_fit`) goes with the preload it carries now.
+            if f_pre > 0.0 && !walls.pre_fit.is_empty() {
+                for (&n, wk) in nodes.iter().zip(wt) {
+                    let a = walls.pre_fit[n as usize];
+                    let f = [wk[0] * f_pre * a[0], wk[0] * f_pre * a[1]];
+                    wall_force[n as usize][0] += f[0];
+                    wall_force[n as usize][1] += f[1];
+                    wall_r[k][0] += f[0];
+                    wall_r[k][1] += f[1];
+                }
+            }
             let f_pre = if exact { 0.0 } else { f_pre };
             for (&n, wk) in nodes.iter().zip(wt) {
                 let face = face_weight(wk, nrm, d);
@@ -599,6 +637,7 @@ mod tests {
             list: vec![wall],
             mask: vec![1],
             preload: Vec::new(),
+            pre_fit: Vec::new(),
         };
         let mut cache = ShapeCache::new(1, 1);
         cache.count[0] = 1;
@@ -690,6 +729,7 @@ mod tests {
             list: vec![wall],
             mask: vec![1],
             preload: Vec::new(),
+            pre_fit: Vec::new(),
         };
         let mut cache = ShapeCache::new(1, 2);
         cache.count[0] = 2;

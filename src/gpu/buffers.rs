@@ -76,6 +76,10 @@ pub enum Buf {
     /// Per node: the walls' preloads this step (wall_touch.wgsl), which
     /// wall_contact.wgsl counts in the body's velocity; with `WallPreload`.
     WallPreForce,
+    /// Per grid node: the preload's fit to the body's discrete reaction
+    /// (`Walls::pre_fit`, vec2 f32), read by wall_touch.wgsl and
+    /// wall_contact.wgsl; only when there is one.
+    WallPreFit,
     ExtForce,
     /// MUSL: each particle's position at the step's start (grid-relative),
     /// for the remap and the stress, which run after g2p has moved it.
@@ -110,7 +114,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 50] = [
+    pub const ALL: [Buf; 51] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -150,6 +154,7 @@ impl Buf {
         Buf::WallTouch,
         Buf::WallPreload,
         Buf::WallPreForce,
+        Buf::WallPreFit,
         Buf::ExtForce,
         Buf::XStart,
         Buf::Field,
@@ -430,6 +435,10 @@ fn grid_and_output_data(
             let pre: Vec<f32> = model.walls.preload.iter().map(|&t| t as f32).collect();
             data.push((Buf::WallPreload, bytemuck::cast_slice(&pre).to_vec()));
             data.push((Buf::WallPreForce, vec![0u8; 8 * field_nodes]));
+        }
+        if !model.walls.pre_fit.is_empty() {
+            let fit: Vec<[f32; 2]> = model.walls.pre_fit.iter().map(|&a| f32x2(a)).collect();
+            data.push((Buf::WallPreFit, bytemuck::cast_slice(&fit).to_vec()));
         }
     }
     let probe_idx: Vec<u32> = model.probes.iter().map(|pr| pr.particle as u32).collect();

@@ -103,6 +103,9 @@ pub struct Variant {
     /// (WALL_PRELOAD: the `WallPreload` buffer, read with the stress by
     /// `shared/wall_spring.wgsl`).
     pub wall_preload: bool,
+    /// The walls' preload has a fit to the body's discrete reaction
+    /// (WALL_PRE_FIT: the `WallPreFit` buffer, `Walls::pre_fit`).
+    pub wall_pre_fit: bool,
     /// `solver.pic_fraction` > 0 (PIC: `g2p` blends Σ N v_I in).
     pub pic: bool,
     /// `solver.local_damping` > 0 (LOCAL_DAMPING: `grid_update` built
@@ -159,6 +162,7 @@ impl Variant {
             walls: !model.walls.is_empty(),
             gates: model.walls.timed(),
             wall_preload: !model.walls.preload.is_empty(),
+            wall_pre_fit: !model.walls.pre_fit.is_empty(),
             pic: model.pic_fraction > 0.0,
             local_damping: model.local_damping > 0.0,
             ext_force: model.external.is_some(),
@@ -227,6 +231,7 @@ impl Variant {
             .flag("WALLS", self.walls)
             .flag("GATES", self.gates)
             .flag("WALL_PRELOAD", self.wall_preload)
+            .flag("WALL_PRE_FIT", self.wall_pre_fit)
             .flag("PIC", self.pic)
             .flag("LOCAL_DAMPING", self.local_damping)
             .flag("EXT_FORCE", self.ext_force)
@@ -639,6 +644,7 @@ mod tests {
                                 walls: mms,
                                 gates: mms,
                                 wall_preload: mms,
+                                wall_pre_fit: mms,
                                 pic: mms,
                                 local_damping: mms,
                                 ext_force: mms,

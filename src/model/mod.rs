@@ -356,7 +356,7 @@ impl Model {
         let probes = build_probes(scene, &particles)?;
         let external = ExternalForces::from_scene(scene, &particles)?;
 
-        Ok(Model {
+        let mut model = Model {
             grid,
             shape,
             particles,
@@ -390,7 +390,13 @@ impl Model {
             } else {
                 BodyOutline::default()
             },
-        })
+        };
+        // The explicit integrators' walls give a body at rest its
+        // discrete reaction (the implicit one solves for it).
+        if !matches!(model.integrator, Integrator::Implicit(_)) {
+            model.walls.pre_fit = crate::cpu::preload_fit::preload_fit(&model);
+        }
+        Ok(model)
     }
 
     /// Names of the reactions a sample reports, in order: the constraints',

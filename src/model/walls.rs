@@ -90,6 +90,12 @@ pub struct Walls {
     /// particle starts so (every stress-free body): the scene pays
     /// nothing for it.
     pub preload: Vec<f64>,
+    /// Per grid node, the factor a_I by which each preloaded contact also
+    /// puts P_p N_Ip a_I on node I, fitted so that at the start the walls
+    /// give each node the body's discrete reaction −(f_int + f_ext)_I
+    /// (`cpu::preload_fit`); empty without preload, or where there is
+    /// nothing to fit.
+    pub pre_fit: Vec<[f64; 2]>,
 }
 
 impl Walls {
@@ -220,6 +226,7 @@ impl Walls {
             list,
             mask,
             preload: Vec::new(),
+            pre_fit: Vec::new(),
         })
     }
 }
