@@ -61,6 +61,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #if GATES
     let t = sim.t + sim.t_lo;
 #endif
+#if WALL_PRE_FIT
+    // The preload's fit acts while every wall that stood at the start
+    // stands (`Walls::fit_at`).
+    var fit_on = true;
+#if GATES
+    for (var k = 0u; k < arrayLength(&walls); k++) {
+        if walls[k].appear_at <= 0.0 && t >= walls[k].remove_at {
+            fit_on = false;
+        }
+    }
+#endif
+#endif
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let wl = walls[k];
 #if GATES
@@ -168,7 +180,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #if WALL_PRE_FIT
         // The preload's fit to the body's discrete reaction goes with the
         // preload it carries now (`Walls::pre_fit`).
-        if f_pre > 0.0 {
+        if f_pre > 0.0 && fit_on {
             var fit_sum = vec2<f32>(0.0);
             for (var r = 0u; r < SHAPE_ROWS; r++) {
                 let span = shape_span(c, r);

@@ -47,6 +47,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #if GATES
     let t = sim.t + sim.t_lo;
 #endif
+#if WALL_PRE_FIT
+    // The preload's fit acts while every wall that stood at the start
+    // stands (`Walls::fit_at`).
+    var fit_on = true;
+#if GATES
+    for (var k = 0u; k < arrayLength(&walls); k++) {
+        if walls[k].appear_at <= 0.0 && t >= walls[k].remove_at {
+            fit_on = false;
+        }
+    }
+#endif
+#endif
     // Per contact, the friction's weights: at the wall's line where none
     // of them is negative, else the particle's; with WALL_PRELOAD, its
     // preload P n onto the nodes at the wall's line (weights N − d n·∇N, or
@@ -112,8 +124,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                     pre_force_add(2u * nw.node + 1u, f.y);
                 }
 #if WALL_PRE_FIT
-                // The fit to the body's discrete reaction (`Walls::pre_fit`).
-                if sp.y > 0.0 && nw.n != 0.0 {
+                // The fit to the body's discrete reaction (`Walls::pre_fit`),
+                // while every wall that stood at the start stands.
+                if sp.y > 0.0 && nw.n != 0.0 && fit_on {
                     let a = wall_pre_fit[nw.node];
                     if a.x != 0.0 || a.y != 0.0 {
                         let f = sp.y * nw.n * a;

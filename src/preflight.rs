@@ -657,7 +657,7 @@ mod tests {
         use crate::scene::Override;
         let warned = |sets: &[&str]| {
             let o: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-            // The case as `study column` runs it for the shape set here.
+            // The case as `study granular` runs it for the shape set here.
             let shape = if sets.iter().any(|s| s.contains("linear")) {
                 "linear"
             } else {

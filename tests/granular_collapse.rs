@@ -12,7 +12,8 @@ use lme_mpm::model::{Model, Particles};
 use lme_mpm::scene::{Override, Scene};
 use lme_mpm::simulation::Simulation;
 use lme_mpm::solver::{Recorder, RunStatus, Schedule};
-use lme_mpm::study::column::{GRANULAR_H, run_out};
+use lme_mpm::study::column::run_out;
+use lme_mpm::study::granular::GRANULAR_H;
 
 /// The experiments' tolerance the issue accepts: within 25 % of 1.2 a.
 const RUN_OUT_REL: f64 = 0.25;

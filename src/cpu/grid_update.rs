@@ -259,7 +259,7 @@ pub fn wall_touch(
             }
             // The fit to the discrete reaction (`Walls::pre_fit`; empty
             // where the line's weights already give it).
-            if pre > 0.0 && !walls.pre_fit.is_empty() {
+            if pre > 0.0 && walls.fit_at(t) {
                 for (&n, wk) in nodes.iter().zip(w) {
                     let a = walls.pre_fit[n as usize];
                     pre_force[n as usize][0] += pre * wk[0] * a[0];
@@ -472,7 +472,7 @@ pub fn wall_contact(
             ];
             // The preload's fit to the body's discrete reaction
             // (`Walls::pre_fit`) goes with the preload it carries now.
-            if f_pre > 0.0 && !walls.pre_fit.is_empty() {
+            if f_pre > 0.0 && walls.fit_at(t) {
                 for (&n, wk) in nodes.iter().zip(wt) {
                     let a = walls.pre_fit[n as usize];
                     let f = [wk[0] * f_pre * a[0], wk[0] * f_pre * a[1]];

@@ -157,6 +157,21 @@ impl Walls {
             .unwrap_or(0.0)
     }
 
+    /// Whether the preload's fit (`pre_fit`) acts in the step starting at
+    /// `t` (s): there is one, and every wall stands that stood at the
+    /// start. Its per-node factors hold the walls' shares together (at a
+    /// corner the floor's contacts carry part of a gate's reaction), so a
+    /// wall that goes takes the whole fit with it; the body is no longer
+    /// at rest then, which is what the fit is for.
+    #[inline]
+    pub fn fit_at(&self, t: f64) -> bool {
+        !self.pre_fit.is_empty()
+            && self
+                .list
+                .iter()
+                .all(|w| w.appear_at > 0.0 || t < w.remove_at)
+    }
+
     /// Whether some wall appears or goes during the run (a gate).
     pub fn timed(&self) -> bool {
         self.list

@@ -8,6 +8,7 @@ pub mod column;
 pub mod contact;
 pub mod disk;
 pub mod dyka;
+pub mod granular;
 pub mod implicit;
 pub mod mms;
 pub mod plate;
@@ -44,10 +45,13 @@ pub enum StudyName {
     /// error against wall time beside the paper's Table 1.
     Disk,
     /// Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both,
-    /// profiles, run-out; and the cohesionless run-out against the
-    /// experimental scaling (about 2.5 h on 2 cores, GMM on mesh 2 the
-    /// longest run; an estimate, not yet timed in one study run).
+    /// profiles, run-out (about 2.5 h on 2 cores, GMM on mesh 2 the
+    /// longest run).
     Column,
+    /// Cohesionless column collapse from geostatic rest behind a gate:
+    /// run-out against the experimental scaling 1.2 H/W for H/W = 0.5, 1
+    /// and 2, 4 shapes, pure FLIP and 1 % PIC (about 15 minutes).
+    Granular,
     /// Implicit against explicit: the static cantilever (mesh study), Dyka's
     /// bar and the rolling disk, error against wall time per case, and the
     /// Newton iteration's cost split (CPU only).
@@ -78,6 +82,7 @@ impl StudyName {
             StudyName::Mms => "mms",
             StudyName::Disk => "disk",
             StudyName::Column => "column",
+            StudyName::Granular => "granular",
             StudyName::Implicit => "implicit",
             StudyName::Contact => "contact",
             StudyName::Gmm => "gmm",
@@ -158,6 +163,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms,
             StudyName::Disk,
             StudyName::Column,
+            StudyName::Granular,
             StudyName::Implicit,
             StudyName::Contact,
             StudyName::Gmm,
@@ -177,6 +183,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms => mms::jobs(opts.quick, &backends)?,
             StudyName::Disk => disk::jobs(opts.quick, &backends),
             StudyName::Column => column::jobs(opts.quick, &backends),
+            StudyName::Granular => granular::jobs(opts.quick, &backends),
             StudyName::Implicit => implicit::jobs(opts.quick),
             StudyName::Contact => contact::jobs(opts.quick, &backends),
             StudyName::Gmm => implicit::gmm_jobs(opts.quick),
@@ -205,6 +212,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             StudyName::Mms => mms::report(&results, &dir, opts.quick)?,
             StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
             StudyName::Column => column::report(&results, &dir, opts.quick)?,
+            StudyName::Granular => granular::report(&results, &dir, opts.quick)?,
             StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
             StudyName::Contact => contact::report(&results, &dir, opts.quick)?,
             StudyName::Gmm => implicit::gmm_report(&results, &dir, opts.quick)?,
