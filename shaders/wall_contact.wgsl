@@ -92,6 +92,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         var vp = v_p[p];
         var w = 0.0;
         var wf = 0.0;
+        var w_own = 0.0;
         for (var r = 0u; r < SHAPE_ROWS; r++) {
             let span = shape_span(c, r);
             for (var s = span.x; s < span.y; s++) {
@@ -110,12 +111,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                     vp += nw.n * sdt / m * f;
                     w += nw.n * wall_touch[2u * nw.node] / m;
                     wf += nw.n * wall_touch[2u * nw.node + 1u] / m;
+                    w_own += nw.n * nw.n / m;
                 }
             }
         }
         if w <= 0.0 {
             continue;
         }
+        // At least this contact's own weights (S_I ≥ N_Ip): a preloaded
+        // particle whose spring crossed zero since `wall_touch` is in
+        // contact here without them in S (CPU twin's comment).
+        w = max(w, w_own);
         w *= gdt;
         let vn = dot(v, wl.normal);
         let fnorm = max(sp.x - WALL_DAMPING * vn / w, 0.0);

@@ -385,7 +385,7 @@ pub fn wall_contact(
             // damping); vp: the particle's own next velocity (for the
             // friction); both without the walls' contact forces, with
             // their preloads.
-            let (mut v, mut w, mut wf) = ([0.0; 2], 0.0, 0.0);
+            let (mut v, mut w, mut wf, mut w_own) = ([0.0; 2], 0.0, 0.0, 0.0);
             let mut vp = pt.v[p];
             for (&n, wk) in nodes.iter().zip(wt) {
                 let node = &mv[n as usize];
@@ -400,11 +400,21 @@ pub fn wall_contact(
                     vp[1] += wk[0] * slip_dt * f[1] / node[0];
                     w += wk[0] * touch[n as usize][0] / node[0];
                     wf += wk[0] * touch[n as usize][1] / node[0];
+                    w_own += wk[0] * wk[0] / node[0];
                 }
             }
             if w <= 0.0 {
                 continue;
             }
+            // S_I counts this contact's own weights (S_I ≥ N_Ip), so
+            // w ≥ Σ N²/m; but `wall_touch` decided contact before the
+            // stress update, and a preloaded particle whose spring crosses
+            // zero in between is in contact here without its weights in S:
+            // w then held only its neighbours' tails (8e-10 against 8e-6)
+            // and the damping's ζ v_n / w kicked it off the wall at 130 m/s
+            // (LME granular collapse, docs/methods.md "Granular collapse:
+            // runs that stop").
+            w = w.max(w_own);
             w *= gamma_dt;
             let nrm = wl.normal;
             let vn = v[0] * nrm[0] + v[1] * nrm[1];

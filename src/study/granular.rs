@@ -5,7 +5,7 @@
 //! linear, uGIMP, LME γ = 1.8 and quadratic B-splines, with pure FLIP and
 //! with 1 % PIC (issue 23 item 4). It was the second half of `study
 //! column` until the two were split (2026-11-29), so that this one, about
-//! 15 minutes on 2 cores, reruns alone when the walls or the initial
+//! 5 minutes on one core, reruns alone when the walls or the initial
 //! states change, without the cohesive column's hours of GMM.
 
 use super::column::{METHODS, height, run_out};

@@ -45,12 +45,12 @@ pub enum StudyName {
     /// error against wall time beside the paper's Table 1.
     Disk,
     /// Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both,
-    /// profiles, run-out (about 2.5 h on 2 cores, GMM on mesh 2 the
-    /// longest run).
+    /// profiles, run-out (1 h 40 min on 2 cores on 2026-11-29, GMM on
+    /// mesh 2 the longest run, on one thread the whole time).
     Column,
     /// Cohesionless column collapse from geostatic rest behind a gate:
     /// run-out against the experimental scaling 1.2 H/W for H/W = 0.5, 1
-    /// and 2, 4 shapes, pure FLIP and 1 % PIC (about 15 minutes).
+    /// and 2, 4 shapes, pure FLIP and 1 % PIC (about 5 minutes on one core).
     Granular,
     /// Implicit against explicit: the static cantilever (mesh study), Dyka's
     /// bar and the rolling disk, error against wall time per case, and the
