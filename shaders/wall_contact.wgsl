@@ -62,16 +62,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let t = sim.t + sim.t_lo;
 #endif
 #if WALL_PRE_FIT
-    // The preload's fit acts while every wall that stood at the start
-    // stands (`Walls::fit_at`).
-    var fit_on = true;
-#if GATES
-    for (var k = 0u; k < arrayLength(&walls); k++) {
-        if walls[k].appear_at <= 0.0 && t >= walls[k].remove_at {
-            fit_on = false;
-        }
-    }
-#endif
+    let fit_on = pre_fit_on();
 #endif
     for (var k = 0u; k < arrayLength(&walls); k++) {
         let wl = walls[k];

@@ -11,7 +11,7 @@
 // onto the nodes at the wall's line (B-splines: their basis evaluated at
 // the line's point; else N − d n·∇N), into `wall_pre_force`, and with
 // WALL_PRE_FIT its fit to the body's discrete reaction, P N_I a_I
-// (`Walls::pre_fit`, src/cpu/preload_fit.rs). `wall_contact`
+// (`Walls::pre_fit`, src/model/preload_fit.rs). `wall_contact`
 // reads it; `clear_grid` zeroes it. With GATES only the walls that act at
 // the step's start time t (appear_at <= t < remove_at) are in contact.
 // CPU twin: `wall_touch` in src/cpu/grid_update.rs.
@@ -48,16 +48,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let t = sim.t + sim.t_lo;
 #endif
 #if WALL_PRE_FIT
-    // The preload's fit acts while every wall that stood at the start
-    // stands (`Walls::fit_at`).
-    var fit_on = true;
-#if GATES
-    for (var k = 0u; k < arrayLength(&walls); k++) {
-        if walls[k].appear_at <= 0.0 && t >= walls[k].remove_at {
-            fit_on = false;
-        }
-    }
-#endif
+    let fit_on = pre_fit_on();
 #endif
     // Per contact, the friction's weights: at the wall's line where none
     // of them is negative, else the particle's; with WALL_PRELOAD, its

@@ -186,7 +186,7 @@ fn geostatic_start_is_exact_overburden_with_k0() {
 /// the first step (`Walls::preload`, docs/methods.md "Walls"), onto the
 /// nodes on the wall's line, and the friction sees those loads before it
 /// acts. LME holds as well since the preload carries its fit to the
-/// body's discrete reaction (`Walls::pre_fit`, src/cpu/preload_fit.rs):
+/// body's discrete reaction (`Walls::pre_fit`, src/model/preload_fit.rs):
 /// measured 2026-11-29 2.4e-5 m/s (largest 4.6e-5), σ_yy to 7.7e-4 ρgH,
 /// against 4.1e-3 m/s and 0.28 ρgH with the first-order weights at the
 /// line alone. B-splines are held as

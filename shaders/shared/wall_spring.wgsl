@@ -44,6 +44,23 @@ fn line_weights_positive(c: ShapeCtx, n: vec2<f32>, d: f32) -> bool {
     return positive;
 }
 
+#if WALL_PRE_FIT
+// Whether the preload's fit to the body's discrete reaction acts in this
+// step: while every wall that stood at the start stands (with GATES, at
+// the step's start time). CPU twin: `Walls::fit_at` in src/model/walls.rs.
+fn pre_fit_on() -> bool {
+#if GATES
+    let t = sim.t + sim.t_lo;
+    for (var k = 0u; k < arrayLength(&walls); k++) {
+        if walls[k].appear_at <= 0.0 && t >= walls[k].remove_at {
+            return false;
+        }
+    }
+#endif
+    return true;
+}
+#endif
+
 // (spring force, preload) in N per unit thickness.
 fn contact_spring(p: u32, k: u32, w: Wall, x: vec2<f32>, lp: f32) -> vec2<f32> {
     let pen = lp * (abs(w.normal.x) + abs(w.normal.y)) - dot(x - w.point, w.normal) - w.offset;

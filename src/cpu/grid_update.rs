@@ -96,23 +96,6 @@ fn contact_spring(p: usize, k: usize, pt: &ContactParticles, walls: &Walls) -> (
     )
 }
 
-/// The preload (N per unit thickness) that particle `p` carries at time
-/// `t` (s) over the walls it is in contact with (`contact_spring` > 0),
-/// by which the preload's fit weighs its nodes (`cpu::preload_fit`).
-pub fn preload_scale(p: usize, pt: &ContactParticles, walls: &Walls, t: f64) -> f64 {
-    let mut s = 0.0;
-    for (k, wl) in walls.list.iter().enumerate() {
-        if !wl.active_at(t) {
-            continue;
-        }
-        let (spring, pre) = contact_spring(p, k, pt, walls);
-        if spring > 0.0 && pre > 0.0 {
-            s += pre;
-        }
-    }
-    s
-}
-
 /// What the contact reads of the particles: positions (m), masses (kg
 /// per unit thickness), densities (kg/m³), stresses (Pa, for the
 /// preload) and the scene's full gravity (m/s², zero without).

@@ -14,7 +14,6 @@ pub mod grid_update;
 pub mod implicit;
 pub mod mls;
 pub mod p2g;
-pub mod preload_fit;
 pub mod remap;
 pub mod scatter;
 pub mod shape_eval;
@@ -104,7 +103,7 @@ fn contact_particles<'a>(
 /// by ½ d² ∂²N, enough to unbalance a geostatic column); the others keep
 /// `face_weight` (exact for linear shapes; uGIMP holds as it is; LME
 /// would need a Newton solve per point).
-pub(crate) fn line_shape<'a>(
+fn line_shape<'a>(
     shape: &'a crate::model::shape::Shape,
     grid: &'a crate::model::Grid,
 ) -> Option<(&'a crate::model::shape::Shape, &'a crate::model::Grid)> {

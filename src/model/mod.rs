@@ -12,6 +12,7 @@ mod grid;
 pub mod loads;
 pub mod material;
 mod particles;
+pub mod preload_fit;
 pub mod shape;
 pub mod time_step;
 pub mod walls;
@@ -394,7 +395,15 @@ impl Model {
         // The explicit integrators' walls give a body at rest its
         // discrete reaction (the implicit one solves for it).
         if !matches!(model.integrator, Integrator::Implicit(_)) {
-            model.walls.pre_fit = crate::cpu::preload_fit::preload_fit(&model);
+            model.walls.pre_fit = preload_fit::preload_fit(
+                &model.shape,
+                &model.grid,
+                &model.particles,
+                &model.walls,
+                model.gravity.map_or([0.0; 2], |g| g.g),
+                model.contact.is_some(),
+                model.mls,
+            );
         }
         Ok(model)
     }

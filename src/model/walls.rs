@@ -93,7 +93,7 @@ pub struct Walls {
     /// Per grid node, the factor a_I by which each preloaded contact also
     /// puts P_p N_Ip a_I on node I, fitted so that at the start the walls
     /// give each node the body's discrete reaction −(f_int + f_ext)_I
-    /// (`cpu::preload_fit`); empty without preload, or where there is
+    /// (`model::preload_fit`); empty without preload, or where there is
     /// nothing to fit.
     pub pre_fit: Vec<[f64; 2]>,
 }
