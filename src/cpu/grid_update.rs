@@ -31,8 +31,8 @@
 use super::stage_inputs::ShapeCache;
 use crate::model::shape::Shape;
 use crate::model::walls::{
-    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, half_width, preload_force, wall_depth,
-    wall_penetration,
+    self, CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, face_weight, half_width,
+    wall_depth,
 };
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Grid, Walls};
 use rayon::prelude::*;
@@ -71,28 +71,19 @@ pub fn local_damping(f: [f64; 2], v: [f64; 2], alpha: f64) -> [f64; 2] {
     ]
 }
 
-/// The contact's normal spring force (N per unit thickness) of particle
-/// `p` on wall `k` before damping: the penalty k pen 2 l_p (pen from
-/// `wall_penetration`, negative once the domain is clear of the contact
-/// line) plus the particle's preload (`preload_force`, zero unless it
-/// started flush and compressed against the wall), and that preload.
-/// The particle is in contact while the sum is positive.
+/// `walls::contact_spring` of particle `p` on wall `k`, read from `pt`:
+/// (spring force, preload), N per unit thickness.
 #[inline]
 fn contact_spring(p: usize, k: usize, pt: &ContactParticles, walls: &Walls) -> (f64, f64) {
-    let w = &walls.list[k];
-    let lp = half_width(pt.mass[p], pt.rho[p]);
-    let pre = preload_force(
-        walls.preload_of(p, k),
-        pt.stress[p],
-        w.normal,
-        lp,
+    walls::contact_spring(
+        walls,
+        p,
+        k,
+        pt.x[p],
         pt.mass[p],
+        pt.rho[p],
+        pt.stress[p],
         pt.gravity,
-        wall_depth(pt.x[p], lp, w),
-    );
-    (
-        w.stiffness * wall_penetration(pt.x[p], lp, w) * 2.0 * lp + pre,
-        pre,
     )
 }
 
@@ -201,6 +192,7 @@ pub fn wall_touch(
 ) {
     touch.fill([0.0; 2]);
     pre_force.fill([0.0; 2]);
+    let fit_on = walls.fit_at(t);
     let mut lw = LineWeights::new(pt.line);
     for p in 0..pt.x.len() {
         let (nodes, w) = cache.particle(p);
@@ -242,7 +234,7 @@ pub fn wall_touch(
             }
             // The fit to the discrete reaction (`Walls::pre_fit`; empty
             // where the line's weights already give it).
-            if pre > 0.0 && walls.fit_at(t) {
+            if pre > 0.0 && fit_on {
                 for (&n, wk) in nodes.iter().zip(w) {
                     let a = walls.pre_fit[n as usize];
                     pre_force[n as usize][0] += pre * wk[0] * a[0];
@@ -257,16 +249,6 @@ pub fn wall_touch(
             touch[n as usize][0] += count as f64 * wk[0];
         }
     }
-}
-
-/// The weight of a node at the wall's line, from the particle's [N, ∇N]
-/// `wk` and the distance `d` (m, `wall_depth`) from its centre to the
-/// line along the normal `n`: N − d n·∇N, first order in d (exact for
-/// linear shapes while the line is in the particle's cell). They sum to
-/// one, as N does.
-#[inline]
-fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
-    wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
 }
 
 /// Whether the weights at the wall's line (`face_weight`) of a particle
@@ -352,6 +334,7 @@ pub fn wall_contact(
     for r in wall_r.iter_mut() {
         *r = [0.0; 2];
     }
+    let fit_on = walls.fit_at(t);
     let mut lw = LineWeights::new(pt.line);
     for p in 0..pt.x.len() {
         let lp = half_width(pt.mass[p], pt.rho[p]);
@@ -465,7 +448,7 @@ pub fn wall_contact(
             ];
             // The preload's fit to the body's discrete reaction
             // (`Walls::pre_fit`) goes with the preload it carries now.
-            if f_pre > 0.0 && walls.fit_at(t) {
+            if f_pre > 0.0 && fit_on {
                 for (&n, wk) in nodes.iter().zip(wt) {
                     let a = walls.pre_fit[n as usize];
                     let f = [wk[0] * f_pre * a[0], wk[0] * f_pre * a[1]];

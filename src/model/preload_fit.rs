@@ -24,7 +24,7 @@
 use super::Particles;
 use super::grid::Grid;
 use super::shape::Shape;
-use super::walls::{Walls, half_width, preload_force, wall_depth, wall_penetration};
+use super::walls::{Walls, contact_spring, face_weight, half_width, wall_depth};
 
 /// Nodes whose preload weight W_I = Σ_p P_p N_Ip is below this share of
 /// the largest get no correction (a guard against dividing by zero; the
@@ -94,20 +94,12 @@ pub fn preload_fit(
             if !wl.active_at(0.0) {
                 continue;
             }
-            let d = wall_depth(p.x[i], lp, wl);
-            let pre = preload_force(
-                walls.preload_of(i, k),
-                s,
-                wl.normal,
-                lp,
-                p.mass[i],
-                gravity,
-                d,
-            );
-            let spring = wl.stiffness * wall_penetration(p.x[i], lp, wl) * 2.0 * lp + pre;
+            let (spring, pre) =
+                contact_spring(walls, i, k, p.x[i], p.mass[i], p.rho[i], s, gravity);
             if spring <= 0.0 || pre <= 0.0 {
                 continue;
             }
+            let d = wall_depth(p.x[i], lp, wl);
             for (&n, wk) in nodes[..count].iter().zip(&w[..count]) {
                 weight[n as usize] += pre * wk[0];
             }
@@ -126,7 +118,7 @@ pub fn preload_fit(
                 }
             } else {
                 for (&n, wk) in nodes[..count].iter().zip(&w[..count]) {
-                    let face = wk[0] - d * (wl.normal[0] * wk[1] + wl.normal[1] * wk[2]);
+                    let face = face_weight(wk, wl.normal, d);
                     pre_force[n as usize][0] += pre * face * wl.normal[0];
                     pre_force[n as usize][1] += pre * face * wl.normal[1];
                 }

@@ -288,6 +288,54 @@ pub fn preload_force(
     2.0 * lp * traction + mass * weight * depth / (2.0 * lp)
 }
 
+/// The weight of a node at the wall's line, from the particle's [N, ∇N]
+/// `wk` and the distance `d` (m, `wall_depth`) from its centre to the
+/// line along the normal `n`: N − d n·∇N, first order in d (exact for
+/// linear shapes while the line is in the particle's cell). They sum to
+/// one, as N does.
+#[inline]
+pub fn face_weight(wk: &[f64; 3], n: [f64; 2], d: f64) -> f64 {
+    wk[0] - d * (n[0] * wk[1] + n[1] * wk[2])
+}
+
+/// The contact's normal spring force (N per unit thickness) of particle
+/// `p` (at `x`, mass `m` kg, density `rho` kg/m³, stress `stress` Pa) on
+/// wall `k` before damping: the penalty k pen 2 l_p (pen from
+/// `wall_penetration`, negative once the domain is clear of the contact
+/// line) plus the particle's preload (`preload_force` under the full
+/// `gravity`, zero unless it started flush and compressed against the
+/// wall), and that preload. The particle is in contact while the sum is
+/// positive. Shared by the CPU stages and `preload_fit`; WGSL twin
+/// `contact_spring` in shaders/shared/wall_spring.wgsl.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn contact_spring(
+    walls: &Walls,
+    p: usize,
+    k: usize,
+    x: [f64; 2],
+    m: f64,
+    rho: f64,
+    stress: [f64; 3],
+    gravity: [f64; 2],
+) -> (f64, f64) {
+    let w = &walls.list[k];
+    let lp = half_width(m, rho);
+    let pre = preload_force(
+        walls.preload_of(p, k),
+        stress,
+        w.normal,
+        lp,
+        m,
+        gravity,
+        wall_depth(x, lp, w),
+    );
+    (
+        w.stiffness * wall_penetration(x, lp, w) * 2.0 * lp + pre,
+        pre,
+    )
+}
+
 /// How far (m) the centre of a particle at `x` (half-width `lp`, m) is in
 /// front of the wall's line, clamped to [0, l_p (|n_x| + |n_y|)]: the
 /// distance along −n from the centre to where the wall's traction acts.
