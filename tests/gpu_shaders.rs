@@ -550,6 +550,7 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("LAST_STEP_REL", f(lme_mpm::model::time_step::LAST_STEP_REL)),
         ("MLS_SUPPORT", f(lme_mpm::cpu::mls::SUPPORT_CELLS)),
         ("WALL_DAMPING", f(lme_mpm::model::walls::WALL_DAMPING)),
+        ("PRELOAD_HOLD", f(lme_mpm::model::walls::PRELOAD_HOLD)),
         ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
         (
             "LINE_WEIGHT_EPS",

@@ -18,7 +18,8 @@ use lme_mpm::study::granular::GRANULAR_H;
 /// The experiments' tolerance the issue accepts: within 25 % of 1.2 a.
 const RUN_OUT_REL: f64 = 0.25;
 /// The FLIP deposit's kinetic energy at 2 s over the PIC one's: measured
-/// 57 (7.7 against 0.13 J/m, 2026-11-27) since the case's B-splines have
+/// 32 (5.3 against 0.17 J/m, 2026-11-29, since `PRELOAD_HOLD`; 57, 7.7
+/// against 0.13, on 2026-11-27) since the case's B-splines have
 /// their knots on the grid lines (`bspline_knots = "cells"`, so the column
 /// starts in balance behind its gate; 650 before, 5.8 against 8.8e-3,
 /// on the `midpoints` layout). Both PIC figures are below 1e-5 of m g H,

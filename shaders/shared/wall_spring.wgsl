@@ -5,8 +5,10 @@
 // of particle p on wall k before damping, the penalty k pen 2 l_p (pen:
 // how far its domain reaches past the contact line, negative once clear)
 // plus, with WALL_PRELOAD, the preload of a particle that started flush
-// with the wall and compressed across it: 2 l_p (min(τ0, −σ_nn) +
-// ρ max(0, −g·n) d), its normal stress now (capped by the initial τ0) and the
+// with the wall and compressed across it:
+// 2 l_p (min(τ0, −σ_nn / PRELOAD_HOLD) + ρ max(0, −g·n) d), its initial
+// traction (followed down by its normal stress once that has lost more
+// than 1 − PRELOAD_HOLD of it) and the
 // weight of its material between its centre and the line (d:
 // `wall_depth`), times 2 l_p. In contact while positive.
 // CPU twins: `contact_spring` in src/cpu/grid_update.rs and
@@ -21,6 +23,11 @@
 fn wall_depth(x: vec2<f32>, lp: f32, w: Wall) -> f32 {
     return clamp(dot(x - w.point, w.normal), 0.0, lp * (abs(w.normal.x) + abs(w.normal.y)));
 }
+
+// The share of τ0 the normal stress may lose before the preload follows
+// it down (`PRELOAD_HOLD` in src/model/walls.rs: at min(τ0, −σ_nn) a body
+// at rest sat on the kink and grew from round-off).
+const PRELOAD_HOLD: f32 = 0.99;
 
 // Round-off allowance of `line_weights_positive` (f32 weights of O(1)).
 // Keep in sync with src/cpu/grid_update.rs.
@@ -71,7 +78,7 @@ fn contact_spring(p: u32, k: u32, w: Wall, x: vec2<f32>, lp: f32) -> vec2<f32> {
         let n = w.normal;
         let snn = stress[3u * p] * n.x * n.x + 2.0 * stress[3u * p + 2u] * n.x * n.y
             + stress[3u * p + 1u] * n.y * n.y;
-        let traction = min(tau0, max(-snn, 0.0));
+        let traction = min(tau0, max(-snn, 0.0) / PRELOAD_HOLD);
         let weight = max(-dot(params.gravity, n), 0.0);
         pre = 2.0 * lp * traction + mass[p] * weight * wall_depth(x, lp, w) / (2.0 * lp);
     }
