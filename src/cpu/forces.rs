@@ -3,6 +3,7 @@
 //! GPU twin: `shaders/forces.wgsl`.
 
 use super::{scatter::Scatter, stage_inputs::ShapeCache};
+use crate::model::node_force;
 
 /// `body(p)` is particle p's body force per unit mass at this step (m/s²):
 /// gravity, plus a manufactured solution's source term when there is one.
@@ -38,7 +39,8 @@ pub fn add_particle_forces(
     let (nodes, w) = cache.particle(p);
     for (&node, wk) in nodes.iter().zip(w) {
         let acc = &mut acc[node as usize];
-        acc[0] += -vol * (s[0] * wk[1] + s[2] * wk[2]) + wk[0] * mb[0];
-        acc[1] += -vol * (s[2] * wk[1] + s[1] * wk[2]) + wk[0] * mb[1];
+        let f = node_force(vol, s, wk, mb);
+        acc[0] += f[0];
+        acc[1] += f[1];
     }
 }

@@ -21,7 +21,7 @@ pub use constraint_points::ConstraintPoint;
 pub use contact::Contacts;
 pub use grid::Grid;
 pub use loads::{AlignedVibration, ExternalForces, Gravity};
-pub use particles::Particles;
+pub use particles::{Particles, node_force};
 pub use walls::{Wall, Walls};
 
 use crate::error::SceneError;

@@ -5,6 +5,18 @@
 use crate::model::material::PlasticState;
 use crate::scene::seed::Seed;
 
+/// A particle's force on one node (N per unit thickness), paper eq. 14:
+/// −V_p σ_p ∇N_I + N_I m_p b, with `wk` = [N_I, ∂N_I/∂x, ∂N_I/∂y], `vol`
+/// V_p (m² per unit thickness), `s` [σ_xx, σ_yy, σ_xy] (Pa) and `mb`
+/// m_p b (N). The one formula of `cpu::forces` and `model::preload_fit`.
+#[inline(always)]
+pub fn node_force(vol: f64, s: [f64; 3], wk: &[f64; 3], mb: [f64; 2]) -> [f64; 2] {
+    [
+        -vol * (s[0] * wk[1] + s[2] * wk[2]) + wk[0] * mb[0],
+        -vol * (s[2] * wk[1] + s[1] * wk[2]) + wk[0] * mb[1],
+    ]
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct Particles {
     /// Position (m).

@@ -21,10 +21,10 @@
 //! where the body leaves the wall or unloads, and follows a particle that
 //! slides along it.
 
-use super::Particles;
 use super::grid::Grid;
 use super::shape::Shape;
 use super::walls::{Walls, contact_spring, face_weight, half_width, wall_depth};
+use super::{Particles, node_force};
 
 /// Nodes whose preload weight W_I = Σ_p P_p N_Ip is below this share of
 /// the largest get no correction (a guard against dividing by zero; the
@@ -81,10 +81,12 @@ pub fn preload_fit(
         // f_int + f_ext, as `cpu::forces`.
         let vol = p.mass[i] / p.rho[i];
         let s = p.stress[i];
+        let mg = [p.mass[i] * gravity[0], p.mass[i] * gravity[1]];
         for (&n, wk) in nodes[..count].iter().zip(&w[..count]) {
             let f = &mut force[n as usize];
-            f[0] += -vol * (s[0] * wk[1] + s[2] * wk[2]) + wk[0] * p.mass[i] * gravity[0];
-            f[1] += -vol * (s[2] * wk[1] + s[1] * wk[2]) + wk[0] * p.mass[i] * gravity[1];
+            let fi = node_force(vol, s, wk, mg);
+            f[0] += fi[0];
+            f[1] += fi[1];
         }
         // The preloads at the start and their nodal force, as
         // `cpu::grid_update::wall_touch` puts them (B-splines: their basis

@@ -10,8 +10,9 @@
 
 use super::column::{METHODS, height, run_out};
 use super::runner::{Job, JobResult};
-use super::{backend_slug, sig, table};
+use super::{backend_slug, image, sig, table};
 use crate::cases::granular_case;
+use crate::chart::{LineChart, Series};
 use crate::error::Result;
 use crate::simulation::BackendChoice;
 use std::fmt::Write;
@@ -74,12 +75,72 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     out
 }
 
-pub fn report(results: &[JobResult], _dir: &Path, _quick: bool) -> Result<(String, Vec<PathBuf>)> {
+pub fn report(results: &[JobResult], dir: &Path, _quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let main = super::main_backend(results);
     let runs = super::on_backend(results, &main);
     let mut md = String::new();
     table_and_findings(&mut md, &runs);
-    Ok((md, Vec::new()))
+    let charts = run_out_chart(&runs, dir)?;
+    if !charts.is_empty() {
+        md.push_str(&image(
+            "run-out against the aspect ratio, beside the experiments' 1.2 a",
+            "study-granular-run-out.png",
+        ));
+    }
+    Ok((md, charts))
+}
+
+/// The run-out ratio (L_f − L_0)/L_0 of every completed run against the
+/// aspect ratio a: a line per method with 1 % PIC, markers only for pure
+/// FLIP, beside the experiments' 1.2 a and its ±25 % band.
+fn run_out_chart(runs: &[&JobResult], dir: &Path) -> Result<Vec<PathBuf>> {
+    let (w, h) = (GRANULAR.0, GRANULAR_H);
+    let mut c = LineChart::new(
+        "Cohesionless collapse: run-out against the aspect ratio",
+        "a = H/W",
+        "(L_f − L_0)/L_0",
+    );
+    for (k, (m, _, _)) in METHODS.iter().enumerate() {
+        for pic in GRANULAR_PIC {
+            let mut pts: Vec<(f64, f64)> = runs
+                .iter()
+                .filter(|r| r.job.tag_value("method") == Some(*m) && r.completed())
+                .filter(|r| r.job.tag_value("pic").and_then(|v| v.parse::<f64>().ok()) == Some(pic))
+                .filter_map(|r| {
+                    let a: f64 = r.job.tag_value("a")?.parse().ok()?;
+                    let p = r.data()?.final_particles.as_ref()?;
+                    Some((a, (run_out(p, h) - w) / w))
+                })
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
+            pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            c.series.push(if pic > 0.0 {
+                Series::line(format!("{m}, {} % PIC", 100.0 * pic), pts, k).markers()
+            } else {
+                Series::line(format!("{m}, pure FLIP"), pts, k).scatter()
+            });
+        }
+    }
+    if c.series.is_empty() {
+        return Ok(Vec::new());
+    }
+    let a: Vec<f64> = vec![0.0, GRANULAR_ASPECTS.iter().copied().fold(0.0, f64::max)];
+    for (label, f, color) in [
+        ("experiments, 1.2 a", 1.0, 7),
+        ("± 25 %", 1.25, 8),
+        ("", 0.75, 8),
+    ] {
+        let s = Series::line(label, a.iter().map(|&x| (x, f * 1.2 * x)).collect(), color);
+        c.series.push(s.dashed());
+    }
+    c.place_legend();
+    c.size = (900, 520);
+    c.save(&dir.join("study-granular-run-out"))?;
+    Ok(["study-granular-run-out.png", "study-granular-run-out.svg"]
+        .map(|f| dir.join(f))
+        .to_vec())
 }
 
 /// The cohesionless variant's table: per method, aspect ratio and PIC
