@@ -868,3 +868,24 @@ fn a_second_signal_long_after_the_first_ends_a_long_step_with_the_folder_saying_
     );
     no_tmp_files(&out);
 }
+
+/// summary.json's times read back as the f64 that was written: serde_json
+/// parses floats to the nearest f64 only with its `float_roundtrip`
+/// feature (Cargo.toml). Without it this value came back 1 ulp off, and
+/// the SIGTERM test above failed about one run in six, its summary's t
+/// one ulp from its CSVs' last t.
+#[test]
+fn summary_floats_read_back_exactly() {
+    for text in ["3.3633438819843678e-6", "3.4029123262524866e-6", "0.1"] {
+        let want: f64 = text.parse().unwrap();
+        let got: f64 = serde_json::from_str(text).unwrap();
+        assert_eq!(got.to_bits(), want.to_bits(), "{text}");
+        let json = serde_json::json!({ "t": want }).to_string();
+        let back: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(
+            back["t"].as_f64().unwrap().to_bits(),
+            want.to_bits(),
+            "{json}"
+        );
+    }
+}
