@@ -321,7 +321,12 @@ impl LineChart {
                             .draw_series(LineSeries::new(pts.clone(), style))
                             .map_err(|e| e.to_string())?
                     };
-                    if !s.label.is_empty() {
+                    if s.scatter && !s.label.is_empty() {
+                        // Markers only: a marker, as drawn.
+                        legend.label(s.label.as_str()).legend(move |(x, y)| {
+                            EmptyElement::at((x, y)) + Circle::new((9, 0), 3, color.filled())
+                        });
+                    } else if !s.label.is_empty() {
                         // A dashed series shows two short strokes, a solid one a line.
                         let gap = if s.dashed { 11 } else { 7 };
                         legend.label(s.label.as_str()).legend(move |(x, y)| {

@@ -407,48 +407,116 @@ sample_interval = 0.1
 "#;
 
 /// The disk's centre displacement at 0.5 s within 5 % of the exact
-/// rolling distance (a = (2/3) g sin θ; issue 23's bound at R/h = 10).
-/// Measured 3.37 % on the friction wall and 2.61 % on the stick wall
-/// (2026-11-29, k = 0.025 M/h); 4.52 % and 5.21 % at k = 0.03 M/h
-/// (2026-11-25, walls at the contact points, the friction on the wall's
-/// line sized with the weights it acts with); 5.17 % and 5.68 % with the friction at the
-/// particles' centres; 4.71 % and 3.95 % on the line sized with the
-/// particle's weights, whose stick loop rang (the disk's mean friction
-/// halved, its centre at 1.99 m/s against the exact 1.64) and crept under
-/// a slab (docs/methods.md, "Walls"); 6.65 % and 2.21 % when it stopped
-/// the nodal velocity's (unstable under NPC), 17.5 % and 18.1 % with the
-/// node rule, 49.6 % when every node behind the wall under the disk was
-/// held.
+/// rolling distance at R/h = 10 (a = (2/3) g sin θ; issue 23's bound),
+/// for linear, bspline2 and LME (γ = 2.8) on both floors and both laws.
+/// Measured (2026-11-29, k = 0.025 M/h; docs/methods.md, "Where the disk
+/// stands"), friction / stick: aligned linear 3.37 / 2.61 %, bspline2
+/// 2.33 / 2.99 %, LME 1.63 / 3.16 %; inclined 2.13 / 2.97, 1.27 / 1.99,
+/// 1.25 / 2.16 %. At k = 0.03 M/h the aligned linear disk rolled 4.52
+/// and 5.21 % short (2026-11-25, walls at the contact points, the
+/// friction on the wall's line sized with the weights it acts with);
+/// 5.17 % and 5.68 % with the friction at the particles' centres; 4.71 %
+/// and 3.95 % on the line sized with the particle's weights, whose stick
+/// loop rang (the disk's mean friction halved, its centre at 1.99 m/s
+/// against the exact 1.64) and crept under a slab (docs/methods.md,
+/// "Walls"); 6.65 % and 2.21 % when it stopped the nodal velocity's
+/// (unstable under NPC), 17.5 % and 18.1 % with the node rule, 49.6 %
+/// when every node behind the wall under the disk was held.
 const DISK_R10_BOUND: f64 = 0.05;
-/// The stick wall rolls the disk about as far as the friction wall, within
-/// this much (both ought to roll without slip). Measured: stick 0.76
-/// points ahead of friction (0.69 behind at k = 0.03 M/h).
+/// Issue 23's bound at R/h = 20 (the rolling disk case's own grid).
+/// Measured (2026-11-29), friction / stick: aligned linear 1.02 / 1.94 %,
+/// bspline2 0.52 / 0.25 %, LME 0.52 / 0.13 %; inclined 0.71 / 1.99,
+/// 0.77 / 1.55, 0.03 / 2.13 %.
+const DISK_R20_BOUND: f64 = 0.03;
+/// The stick wall rolls the linear disk on the aligned floor about as far
+/// as the friction wall, within this much (both ought to roll without
+/// slip). Measured: stick 0.76 points ahead of friction (0.69 behind at
+/// k = 0.03 M/h). LME's stick lags its friction by 1.53 points there.
 const DISK_STICK_SLACK: f64 = 0.01;
 
-#[test]
-fn disk_rolls_on_friction_and_stick_walls_on_a_grid_line() {
-    let rolled = |text: &str| {
-        let scene = scene_of(text, &[]);
-        let model = Model::new(&scene).unwrap();
-        let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
-        match sim.score().unwrap() {
-            Some(Errors::Rolling(e)) => e,
-            other => panic!("not a rolling score: {other:?}"),
-        }
+/// The disk rolled to 0.5 s on the CPU: `floor` "aligned" (a level wall
+/// on a grid line, gravity tilted 30°) or "inclined"
+/// (`cases/rolling_disk.toml`, a 30° wall), R = 0.5 m over `h`, `shape`
+/// (LME at γ = 2.8), `law` "friction" (μ = 0.5) or "stick".
+fn rolled_disk(
+    floor: &str,
+    h: f64,
+    shape: &str,
+    law: &str,
+) -> lme_mpm::exact::rolling::RollingErrors {
+    let text = match floor {
+        "aligned" => DISK_ON_A_GRID_LINE.to_string(),
+        _ => std::fs::read_to_string(common::case("rolling_disk.toml")).unwrap(),
     };
-    let friction = rolled(DISK_ON_A_GRID_LINE);
     // `friction` is refused on a stick wall, and an override cannot remove
     // a key: the stick wall's scene text.
-    let stick = rolled(&DISK_ON_A_GRID_LINE.replace(
-        "contact = \"friction\"\nfriction = 0.5",
-        "contact = \"stick\"",
-    ));
-    println!("friction {friction:?}\nstick {stick:?}");
-    for (law, e) in [("friction", &friction), ("stick", &stick)] {
-        assert!(e.u_x_rel_error < DISK_R10_BOUND, "{law}: {e:?}");
+    let text = if law == "stick" {
+        let t = text.replace(
+            "contact = \"friction\"\nfriction = 0.5",
+            "contact = \"stick\"",
+        );
+        assert!(t != text, "no friction wall to make stick");
+        t
+    } else {
+        text
+    };
+    let sets = [
+        format!("grid.h={h}"),
+        format!("solver.shape={shape}"),
+        "solver.lme_gamma=2.8".to_string(),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let scene = scene_of(&text, &sets);
+    let model = Model::new(&scene).unwrap();
+    let (mut sim, _) = run(&scene, Box::new(CpuBackend::new(model)));
+    match sim.score().unwrap() {
+        Some(Errors::Rolling(e)) => e,
+        other => panic!("not a rolling score: {other:?}"),
     }
-    assert!(
-        stick.u_x_rel_error < friction.u_x_rel_error + DISK_STICK_SLACK,
-        "stick {stick:?} against friction {friction:?}"
-    );
+}
+
+/// Issue 23's rolling matrix at `h` (R/h = 0.5 / h): every shape, floor
+/// and law within `bound`; the linear disk's stick wall on the aligned
+/// floor within `DISK_STICK_SLACK` of its friction wall.
+fn disk_matrix(h: f64, bound: f64) {
+    let mut failed = Vec::new();
+    for floor in ["aligned", "inclined"] {
+        for shape in ["linear", "bspline2", "lme"] {
+            let [friction, stick] =
+                ["friction", "stick"].map(|law| rolled_disk(floor, h, shape, law));
+            println!(
+                "R/h {}: {floor} {shape}: friction {:.2} %, stick {:.2} % short",
+                0.5 / h,
+                100.0 * friction.u_x_rel_error,
+                100.0 * stick.u_x_rel_error
+            );
+            for (law, e) in [("friction", &friction), ("stick", &stick)] {
+                if e.u_x_rel_error >= bound {
+                    failed.push(format!("{floor} {shape} {law}: {e:?}"));
+                }
+            }
+            if floor == "aligned"
+                && shape == "linear"
+                && stick.u_x_rel_error >= friction.u_x_rel_error + DISK_STICK_SLACK
+            {
+                failed.push(format!("stick {stick:?} against friction {friction:?}"));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
+#[test]
+fn disk_rolls_within_five_percent_at_ten_cells_per_radius() {
+    disk_matrix(0.05, DISK_R10_BOUND);
+}
+
+/// The same at R/h = 20: 12 runs, about 8 minutes on one core, so run
+/// on demand (`cargo test --release --test suite -- --ignored
+/// disk_rolls_within_three`); `study disk` runs the inclined friction
+/// case at R/h = 20 for four shapes and three time steps.
+#[test]
+#[ignore]
+fn disk_rolls_within_three_percent_at_twenty_cells_per_radius() {
+    disk_matrix(0.025, DISK_R20_BOUND);
 }
