@@ -511,7 +511,8 @@ fn disk_rolls_within_five_percent_at_ten_cells_per_radius() {
     disk_matrix(0.05, DISK_R10_BOUND);
 }
 
-/// The same at R/h = 20: 12 runs, about 8 minutes on one core, so run
+/// The same at R/h = 20: 12 runs, 9 minutes on one core (520 s on a
+/// loaded 2-core machine, 2026-11-29), so run
 /// on demand (`cargo test --release --test suite -- --ignored
 /// disk_rolls_within_three`); `study disk` runs the inclined friction
 /// case at R/h = 20 for four shapes and three time steps.
