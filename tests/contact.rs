@@ -242,15 +242,16 @@ fn frictionless_disks_bounce_apart_head_on() {
         c.onset, c.max_overlap, l.v, l.omega, r.v, r.omega, c.momentum_drift
     );
     // Contact starts when the domains meet: within a tenth of a cell of
-    // closing (2 m/s) before 0.025 s, not a cell early. Measured 0.02405.
+    // closing (2 m/s) before 0.025 s, not a cell early. Measured 0.02506
+    // (ring-seeded disks; 0.02405 on the lattice).
     let onset = c.onset.expect("the disks never touched");
     assert!(
         (0.025 - 0.1 * 0.025 / 2.0..0.0275).contains(&onset),
         "{onset}"
     );
-    // Measured 0.0034 m (h = 0.025).
+    // Measured 0.0001 m (h = 0.025).
     assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
-    // The exchange conserves momentum: measured 3e-15 of one disk's.
+    // The exchange conserves momentum: measured 3.6e-15 of one disk's.
     assert!(c.momentum_drift < 1e-12, "{}", c.momentum_drift);
     // They bounce apart along x, without spin or sideways motion.
     assert!(l.v[0] < -0.5 && r.v[0] > 0.5, "{:?} {:?}", l.v, r.v);
@@ -259,54 +260,131 @@ fn frictionless_disks_bounce_apart_head_on() {
     }
 }
 
-#[test]
-fn frictionless_disks_off_centre_against_one_shared_field() {
-    let c = collide(&common::scene("contact_disks.toml", &[]));
-    let one = collide(&without_contact("contact_disks.toml", "impact", &[]));
+/// The off-centre collision with both disks shifted along x by `dx` (m)
+/// on a grid of cell `h` (m), with or without the contact pair, and with
+/// the disks' particles on `layout` ("rings" as in the case, or "lattice").
+fn off_centre(dx: f64, h: f64, pair: bool, layout: &str) -> Collision {
+    let sets = [
+        format!("bodies.left.disks=[[{}, 0.5, 0.2]]", 0.3 + dx),
+        format!(
+            "bodies.right.disks=[[{}, 0.7, 0.2]]",
+            0.696_410_161_513_775_4 + dx
+        ),
+        format!("grid.h={h}"),
+        format!("bodies.left.disk_layout=\"{layout}\""),
+        format!("bodies.right.disk_layout=\"{layout}\""),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    if pair {
+        collide(&common::scene("contact_disks.toml", &sets))
+    } else {
+        collide(&without_contact("contact_disks.toml", "impact", &sets))
+    }
+}
+
+/// ω R of both disks over the impact speed (1 m/s), and v·t, v·u.
+fn spins(c: &Collision) -> [f64; 2] {
+    [c.end[0].omega * 0.2, c.end[1].omega * 0.2]
+}
+
+fn print_collision(what: &str, c: &Collision) {
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
-    for (name, c) in [("contact pair", &c), ("one field", &one)] {
-        let [l, r] = [c.end[0], c.end[1]];
-        println!(
-            "off-centre, {name}: left v.u {:.3} v.t {:.3} omega R {:.3}; right v.u {:.3} v.t {:.3} \
-             omega R {:.3} (exact frictionless: v.t -0.5 / 0.5, omega 0); max overlap {:.4} m; \
-             momentum drift {:.1e}",
-            dot(l.v, U),
-            dot(l.v, T),
-            l.omega * 0.2,
-            dot(r.v, U),
-            dot(r.v, T),
-            r.omega * 0.2,
-            c.max_overlap,
-            c.momentum_drift
-        );
+    let [l, r] = [c.end[0], c.end[1]];
+    println!(
+        "{what}: omega R {:.3} / {:.3}, v.t {:.3} / {:.3} (exact -0.5 / 0.5, omega 0), v.u {:.3} / \
+         {:.3}, max overlap {:.4} m, momentum drift {:.1e}",
+        l.omega * 0.2,
+        r.omega * 0.2,
+        dot(l.v, T),
+        dot(r.v, T),
+        dot(l.v, U),
+        dot(r.v, U),
+        c.max_overlap,
+        c.momentum_drift
+    );
+}
+
+/// Shifts of both disks along x, in cells, for the placement sweeps: the
+/// collision's position relative to the grid (and the rings' to the
+/// grid's lines) changes, the physics does not.
+const PLACEMENTS: [f64; 8] = [0.0, 0.123, 0.246, 0.369, 0.492, 0.615, 0.738, 0.861];
+
+#[test]
+fn frictionless_disks_off_centre_do_not_spin_up() {
+    // R/h = 8, the case's cell, at eight placements on the grid: the pair
+    // against one shared field (2026-11-29: pair |omega R| at most 0.064,
+    // mean 0.027 of the impact speed; one field 0.46-0.47 at the first two).
+    let h = 0.025;
+    let (mut worst, mut sum) = (0.0f64, 0.0);
+    for (k, cells) in PLACEMENTS.iter().enumerate() {
+        let c = off_centre(cells * h, h, true, "rings");
+        print_collision(&format!("pair, R/h 8, shift {cells} h"), &c);
+        // The exchange conserves momentum: measured 2.6e-15 to 3.8e-15.
+        assert!(c.momentum_drift < 1e-12, "{}", c.momentum_drift);
+        assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
+        for w in spins(&c) {
+            worst = worst.max(w.abs());
+            sum += w.abs();
+        }
+        // They bounce apart (v.u -0.53 to -0.57 / +0.53 to +0.57: the
+        // exchange is inelastic, docs/methods.md).
+        let sep = (c.end[1].v[0] - c.end[0].v[0]) * U[0] + (c.end[1].v[1] - c.end[0].v[1]) * U[1];
+        assert!(sep > 1.0, "{sep}");
+        if k < 2 {
+            let one = off_centre(cells * h, h, false, "rings");
+            print_collision(&format!("one field, R/h 8, shift {cells} h"), &one);
+            for (p, o) in spins(&c).into_iter().zip(spins(&one)) {
+                assert!(o.abs() > 0.3 && o.abs() > 5.0 * p.abs(), "{p} {o}");
+            }
+        }
     }
-    assert!(c.momentum_drift < 1e-12, "{}", c.momentum_drift);
-    assert!(c.max_overlap < 0.025, "{}", c.max_overlap);
-    let sep = |c: &Collision| dot(c.end[1].v, U) - dot(c.end[0].v, U);
-    assert!(sep(&c) > 0.5, "{}", sep(&c));
-    // The issue's "neither spins up" is not met in full: with the
-    // logistic-regression normals omega R = 0.025 / 0.187 of the impact
-    // speed and v.t = -0.468 / 0.468 (exact -0.5 / 0.5), against 0.39 /
-    // 0.48 and -0.30 / 0.30 with the larger volume's gradient normal and
-    // 0.24 / 0.38 with one shared field (2026-11-25; with the exact line
-    // of centres as the normal, 0.05). What is asserted: the pair spins
-    // each disk less than the shared field does, and keeps more of the
-    // tangential velocity. docs/methods.md, "Contact between bodies".
-    for i in 0..2 {
-        let (pair, shared) = (c.end[i], one.end[i]);
-        assert!(
-            pair.omega.abs() < shared.omega.abs(),
-            "disk {i}: omega {} against one field's {}",
-            pair.omega,
-            shared.omega
-        );
-        assert!(
-            dot(pair.v, T).abs() > dot(shared.v, T).abs(),
-            "disk {i}: v.t {:?} against one field's {:?}",
-            pair.v,
-            shared.v
-        );
+    let mean = sum / (2 * PLACEMENTS.len()) as f64;
+    println!("R/h 8: largest |omega R| {worst:.3}, mean {mean:.3}");
+    assert!(worst < 0.08 && mean < 0.05, "{worst} {mean}");
+}
+
+#[test]
+fn frictionless_disks_spin_falls_with_the_cell() {
+    // R/h = 16 at two of the placements above: the spin left at R/h 8 is
+    // the discretisation's (2026-11-29: |omega R| 0.007 / 0.016 and
+    // 0.022 / 0.003, against 0.024 / 0.021 and 0.062 / 0.064 at R/h 8).
+    for cells in [0.0, 0.246] {
+        let h = 0.0125;
+        let c = off_centre(cells * 0.025, h, true, "rings");
+        print_collision(&format!("pair, R/h 16, shift {cells} h(8)"), &c);
+        // 8.1e-10 at the first placement, all of it after the disks have
+        // parted (7.8e-15 up to 0.06 s, contact ends by 0.045 s): a
+        // vibrating particle that reaches a node with weight below
+        // MASS_EPS_REL leaves that node at rest in `predict`, so it reads
+        // a one-step strain whose force lands on a node `correct` skips
+        // (docs/methods.md, "Contact between bodies"). Not the exchange.
+        assert!(c.momentum_drift < 1e-8, "{}", c.momentum_drift);
+        for w in spins(&c) {
+            assert!(w.abs() < 0.03, "{w}");
+        }
     }
+}
+
+#[test]
+fn lattice_seeded_disks_are_rough_at_the_particle_scale() {
+    // The same collision with the disks' particles on the cell lattice:
+    // their edges are staircases of the particle spacing, which interlock
+    // as the disks slide, and the pair spins them (2026-11-29, the case's
+    // placement: 0.064 / 0.222, v.t -0.449 / 0.449; over eight placements
+    // up to 0.38), where ring-seeded disks stay below 0.07. The spin is the
+    // seeding's, not the exchange's: see docs/methods.md, "Contact
+    // between bodies".
+    let h = 0.025;
+    let lattice = off_centre(0.0, h, true, "lattice");
+    let rings = off_centre(0.0, h, true, "rings");
+    print_collision("pair, lattice-seeded", &lattice);
+    print_collision("pair, ring-seeded", &rings);
+    let largest = |c: &Collision| spins(c).into_iter().fold(0.0f64, |a, w| a.max(w.abs()));
+    assert!(largest(&lattice) > 0.15, "{}", largest(&lattice));
+    assert!(largest(&rings) < 0.5 * largest(&lattice));
+    // Lattice seeding conserves momentum to round-off (no particle sits
+    // on a node's edge).
+    assert!(lattice.momentum_drift < 1e-12, "{}", lattice.momentum_drift);
 }
 
 #[test]

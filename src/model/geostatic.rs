@@ -91,6 +91,7 @@ mod tests {
             ppc: 2,
             velocity: [0.0; 2],
             layout: None,
+            disk_layout: Default::default(),
             rects,
             disks,
             polygons,

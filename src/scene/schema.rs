@@ -153,6 +153,20 @@ impl From<MaterialSpec> for toml::Table {
     }
 }
 
+/// Where a body's disks put their particles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiskLayout {
+    /// The cell's points (`layout`) that fall inside the disk: the disk's
+    /// edge is a staircase of the particle lattice.
+    #[default]
+    Lattice,
+    /// Concentric rings, spacing h/ppc across and along them, each
+    /// particle its ring's area over the ring's count: round at the
+    /// particle scale, mass exact.
+    Rings,
+}
+
 /// How particles are placed inside each grid cell.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -176,6 +190,9 @@ pub struct BodySpec {
     pub velocity: [f64; 2],
     /// Particle layout. Default: `uniform` for uGIMP, `gauss` otherwise.
     pub layout: Option<Layout>,
+    /// Where the body's disks put their particles. Default `lattice`.
+    #[serde(default)]
+    pub disk_layout: DiskLayout,
     /// Rectangles `[xmin, ymin, xmax, ymax]` (m).
     #[serde(default)]
     pub rects: Vec<[f64; 4]>,

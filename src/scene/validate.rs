@@ -497,6 +497,12 @@ fn check_bodies(file: &SceneFile) -> Result<(), SceneError> {
                 ));
             }
         }
+        if b.disk_layout == DiskLayout::Rings && b.disks.is_empty() {
+            return Err(SceneError::invalid(
+                key("disk_layout"),
+                "is `rings`, which places the particles of disks, but the body has no disk",
+            ));
+        }
         for (i, poly) in b.polygons.iter().enumerate() {
             for p in poly {
                 coord(&format!("bodies.{bname}.polygons[{i}]"), p)?;
