@@ -5,10 +5,12 @@
 //! - Block on a slab (`cases/contact_block.toml`), μ = 0, 0.2, 0.4, 0.7:
 //!   the block's velocity relative to the slab against
 //!   g (sin θ − μ cos θ) R(t) while it slides, at rest for μ > tan θ.
-//! - Two disks colliding (`cases/contact_disks.toml`), head-on and
-//!   off-centre, frictionless: contact onset against the time the surfaces
-//!   meet, the largest overlap, the spin (none, exactly), the tangential
-//!   velocity (kept), momentum.
+//! - Two disks colliding (`cases/contact_disks.toml`, seeded on rings),
+//!   head-on and off-centre, frictionless: contact onset against the time
+//!   the surfaces meet, the largest overlap, the spin (none, exactly), the
+//!   tangential velocity (kept), momentum; in the full study also the
+//!   off-centre pair at R/h = 16 and with lattice-seeded disks at R/h = 8
+//!   and 16, whose staircase edges spin them.
 //! - A disk rolling on an elastic slab (`cases/contact_rolling.toml`) at
 //!   R/h = 10, 20 (and 40 in the full study): the centre's displacement
 //!   against ½ (2/3) g sin θ t².
@@ -149,6 +151,8 @@ const TANGENT: [f64; 2] = [-0.5, 0.866_025_403_784_438_6];
 const DISK_R: f64 = 0.2;
 /// When the disks' surfaces meet: 0.05 m apart, closing at 2 m/s (s).
 const DISKS_MEET: f64 = 0.025;
+/// The disks' cell in `cases/contact_disks.toml` (m): R/h = 8.
+const DISKS_H: f64 = 0.025;
 /// The head-on variant: the right disk on the left one's line.
 const HEAD_ON: &str = "bodies.right.disks=[[0.75, 0.5, 0.2]]";
 /// The rolling disk's radius (m) and the cell sizes of its grid study.
@@ -189,34 +193,51 @@ pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
         if !quick {
             out.push(j);
         }
-        let geometries: &[(&str, &[&str])] = if quick {
-            &[("off-centre", &[])]
+        // (geometry, fields, disks' seeding, cell): the case on both
+        // geometries, then the off-centre pair on a finer grid and with
+        // lattice-seeded disks.
+        let disks: &[(&str, &str, &str, f64)] = if quick {
+            &[
+                ("off-centre", "pair", "rings", DISKS_H),
+                ("off-centre", "one", "rings", DISKS_H),
+            ]
         } else {
-            &[("head-on", &[HEAD_ON]), ("off-centre", &[])]
+            &[
+                ("head-on", "pair", "rings", DISKS_H),
+                ("head-on", "one", "rings", DISKS_H),
+                ("off-centre", "pair", "rings", DISKS_H),
+                ("off-centre", "one", "rings", DISKS_H),
+                ("off-centre", "pair", "rings", DISKS_H / 2.0),
+                ("off-centre", "pair", "lattice", DISKS_H),
+                ("off-centre", "pair", "lattice", DISKS_H / 2.0),
+            ]
         };
-        for (geometry, sets) in geometries {
-            for fields in ["pair", "one"] {
-                let text = if fields == "pair" {
-                    CONTACT_DISKS.to_string()
-                } else {
-                    one_field(CONTACT_DISKS, "impact")
-                };
-                let mut j = Job::new(
-                    format!("{s}-disks-{geometry}-{fields}"),
-                    text,
-                    "contact_disks",
-                )
-                .set("output.sample_interval=0.0005")
-                .on(b)
-                .tag("case", "disks")
-                .tag("geometry", geometry)
-                .tag("fields", fields);
-                for set in *sets {
-                    j = j.set(*set);
-                }
-                j.snapshot_times = every(0.0025, 0.1);
-                out.push(j);
+        for &(geometry, fields, seeding, h) in disks {
+            let text = if fields == "pair" {
+                CONTACT_DISKS.to_string()
+            } else {
+                one_field(CONTACT_DISKS, "impact")
+            };
+            let mut j = Job::new(
+                format!("{s}-disks-{geometry}-{fields}-{seeding}-h{h}"),
+                text,
+                "contact_disks",
+            )
+            .set("output.sample_interval=0.0005")
+            .set(format!("grid.h={h}"))
+            .set(format!("bodies.left.disk_layout=\"{seeding}\""))
+            .set(format!("bodies.right.disk_layout=\"{seeding}\""))
+            .on(b)
+            .tag("case", "disks")
+            .tag("geometry", geometry)
+            .tag("fields", fields)
+            .tag("seeding", seeding)
+            .tag("h", h);
+            if geometry == "head-on" {
+                j = j.set(HEAD_ON);
             }
+            j.snapshot_times = every(0.0025, 0.1);
+            out.push(j);
         }
         let hs: &[f64] = if quick {
             &[0.05]
@@ -592,16 +613,21 @@ fn disks_section(mine: &[&JobResult], dir: &Path, md: &mut String) -> Result<Vec
         md,
         "**Two disks colliding** (`cases/contact_disks.toml`): elastic disks (R = 0.2 m, E = 10 MPa, \
          ρ = 1000 kg/m³) approach at 1 m/s each, 0.05 m apart, so their surfaces meet at {DISKS_MEET} s; \
-         h = 0.025 m, linear, NPC; frictionless pair `impact`. Off-centre, the line of centres at impact is \
+         linear, NPC; frictionless pair `impact`. Off-centre, the line of centres at impact is \
          30° off x. Exact (frictionless): the forces pass through the centres, so neither disk spins \
-         (ω R = 0) and each keeps its velocity along the contact tangent (v·t = ∓0.5 m/s off-centre); total \
-         momentum is kept. Onset: the first sample (every 0.5 ms) with a non-zero pair reaction. \
+         (ω R = 0) and each keeps its velocity along the contact tangent (v·t = ∓0.5 m/s off-centre, for \
+         rigid disks; deformable ones slide on while the line of centres turns); total \
+         momentum is kept. The case seeds its disks on rings (`disk_layout = \"rings\"`, round at the \
+         particle scale); `lattice` is the cell's points inside the disk, whose edge is a staircase. \
+         Onset: the first sample (every 0.5 ms) with a non-zero pair reaction. \
          Overlap: how far one body's particle domains reach into the other's along the line of centres \
-         (snapshots every 2.5 ms). Momentum drift: the largest change of Σ m v from the first snapshot, over one disk's momentum.\n"
+         (snapshots every 2.5 ms), in cells of the run. Momentum drift: the largest change of Σ m v from the first snapshot, over one disk's momentum.\n"
     );
     let header: Vec<String> = [
         "geometry",
         "fields",
+        "disks",
+        "R/h",
         "onset (s)",
         "largest overlap (cells)",
         "ω R left / right (m/s)",
@@ -614,56 +640,59 @@ fn disks_section(mine: &[&JobResult], dir: &Path, md: &mut String) -> Result<Vec
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     let mut rows = Vec::new();
     let mut c = LineChart::new(
-        "Off-centre disks: spin of the left disk",
+        "Off-centre disks: spin of the right disk",
         "t (s)",
-        "ω R of the left disk (m/s)",
+        "ω R of the right disk (m/s)",
     );
-    let h_cell = 0.025;
     for (k, r) in tagged(mine, &[("case", "disks")]).into_iter().enumerate() {
         let geometry = r.job.tag_value("geometry").unwrap_or("");
         let fields = r.job.tag_value("fields").unwrap_or("");
+        let seeding = r.job.tag_value("seeding").unwrap_or("");
+        let h = r
+            .job
+            .tag_value("h")
+            .and_then(|h| h.parse::<f64>().ok())
+            .unwrap_or(DISKS_H);
         let (u, t) = if geometry == "head-on" {
             ([1.0, 0.0], [0.0, 1.0])
         } else {
             (LINE, TANGENT)
         };
-        let row = match collision(r) {
+        let mut row = vec![
+            geometry.to_string(),
+            fields.to_string(),
+            seeding.to_string(),
+            format!("{}", (DISK_R / h).round()),
+        ];
+        match collision(r) {
             Some(col) if col.end.len() >= 2 => {
                 let [l, rt] = [col.end[0], col.end[1]];
-                vec![
-                    geometry.to_string(),
-                    fields.to_string(),
+                row.extend([
                     col.onset.map_or("-".into(), sig),
-                    sig(col.max_overlap / h_cell),
+                    sig(col.max_overlap / h),
                     format!("{} / {}", sig(l.omega * DISK_R), sig(rt.omega * DISK_R)),
                     format!("{} / {}", sig(dot(l.v, t)), sig(dot(rt.v, t))),
                     sig(dot(rt.v, u) - dot(l.v, u)),
                     format!("{:.1e}", col.momentum_drift),
-                ]
+                ]);
             }
-            _ => vec![
-                geometry.to_string(),
-                fields.to_string(),
-                super::failure_text(r),
-                "-".into(),
-                "-".into(),
-                "-".into(),
-                "-".into(),
-                "-".into(),
-            ],
-        };
+            _ => {
+                row.push(super::failure_text(r));
+                row.extend(std::iter::repeat_n("-".to_string(), 5));
+            }
+        }
         rows.push(row);
         if geometry == "off-centre" {
             let pts = history(r)
                 .iter()
-                .map(|(t, b)| (*t, b[0].omega * DISK_R))
+                .map(|(t, b)| (*t, b[1].omega * DISK_R))
                 .collect();
             let label = if fields == "pair" {
-                "contact pair (frictionless)"
+                format!("pair, {seeding}, R/h {}", (DISK_R / h).round())
             } else {
-                "one shared field"
+                format!("one shared field, {seeding}")
             };
-            c.series.push(Series::line(label, pts, k));
+            c.series.push(Series::line(&label, pts, k));
         }
     }
     c.series
