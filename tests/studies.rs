@@ -581,15 +581,15 @@ fn contact_quick_measures_collisions_and_rolling() {
     );
     println!("rolling R/h 10: pair {p:.4}, one field {o:.4} of the exact distance");
     assert!(o < 0.05, "{o}");
-    // Not issue 24's 5 %: measured 0.841 (−15.9 %; −8.5 % at R/h 20), the
-    // nodal exchange's rolling resistance (docs/verification.md, "Contact
-    // between bodies"). The bound holds the figure; a fix shows up here.
+    // Measured 0.943 (−5.7 %) with the disk on rings, as the case seeds
+    // it; issue 24's 5 % holds at the case's R/h = 20 (−1.67 %,
+    // tests/contact.rs). On the lattice it was 0.841.
     assert!(p > ROLLING_R10_MIN, "{p}");
 }
 
 /// The rolling disk on a slab at R/h = 10 covers at least this share of
-/// the exact distance: measured 0.841 (2026-11-25).
-const ROLLING_R10_MIN: f64 = 0.82;
+/// the exact distance: measured 0.943 (2026-11-29, ring-seeded disk).
+const ROLLING_R10_MIN: f64 = 0.93;
 /// `study gmm --quick`: GMM-LME and GMM-MLS on the cantilever at h = 0.5,
 /// 0.25, 0.125 (milliseconds each), with the orders, Richardson limits and
 /// the paper's ordering of the two bases in the section; and the rolling

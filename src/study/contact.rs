@@ -710,7 +710,7 @@ fn rolling_section(mine: &[&JobResult], dir: &Path, md: &mut String) -> Result<V
     let _ = writeln!(
         md,
         "**A disk rolling on an elastic body** (`cases/contact_rolling.toml`): the implicit-MPM paper's \
-         hyperelastic disk (R = {ROLL_R} m, ρ = 7800 kg/m³, E = 200 MPa) on a linear-elastic slab 0.25 m thick \
+         hyperelastic disk (R = {ROLL_R} m, ρ = 7800 kg/m³, E = 200 MPa, seeded on rings) on a linear-elastic slab 0.25 m thick \
          (the same E and ρ) held by a stick floor, gravity 9.81 m/s² tilted by 30° at once, pair `rolling` \
          with μ = 0.5 (rolling without slip needs μ ≥ tan 30° / 3 = 0.19), linear, NPC, CFL 0.3. Exact: the \
          centre moves ½ a t² with a = (2/3) g sin 30° = {} m/s² ({} m at 0.5 s).\n",
