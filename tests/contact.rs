@@ -381,11 +381,10 @@ fn frictionless_disks_spin_falls_with_the_cell() {
         let c = off_centre(cells * 0.025, h, true, "rings");
         print_collision(&format!("pair, R/h 16, shift {cells} h(8)"), &c);
         // 8.1e-10 at the first placement, all of it after the disks have
-        // parted (7.8e-15 up to 0.06 s, contact ends by 0.045 s): a
-        // vibrating particle that reaches a node with weight below
-        // MASS_EPS_REL leaves that node at rest in `predict`, so it reads
-        // a one-step strain whose force lands on a node `correct` skips
-        // (docs/methods.md, "Contact between bodies"). Not the exchange.
+        // parted (7.8e-15 up to 0.06 s, contact ends by 0.045 s), so not
+        // the exchange; likely a vibrating particle that reaches a node
+        // with weight below MASS_EPS_REL, which `predict` leaves at rest
+        // (docs/methods.md, "Contact between bodies"; not traced further).
         assert!(c.momentum_drift < 1e-8, "{}", c.momentum_drift);
         for w in spins(&c) {
             assert!(w.abs() < 0.03, "{w}");
