@@ -132,6 +132,12 @@ pub fn disk_rings(d: &[f64; 3], s: f64) -> Vec<([f64; 2], f64)> {
     out
 }
 
+/// Whether `x` already belongs to a rectangle or to an earlier disk or
+/// polygon (seeded once only).
+fn claimed(rects: &[[f64; 4]], curved: &[Curved], x: [f64; 2]) -> bool {
+    rects.iter().any(|r| inside_rect(r, x)) || curved.iter().any(|c| c.contains(x))
+}
+
 /// Lattice coordinate of `v` on an axis through `anchor` with spacing `h`,
 /// snapped to the nearest integer when within round-off of it.
 fn lattice(v: f64, anchor: f64, h: f64) -> f64 {
@@ -203,9 +209,7 @@ pub fn seed_particles(scene: &Scene, anchor: [f64; 2], h: f64) -> Vec<Seed> {
         for shape in shapes {
             if let (Curved::Disk(d), DiskLayout::Rings) = (&shape, body.disk_layout) {
                 for (x, volume) in disk_rings(d, h / body.ppc as f64) {
-                    let claimed = all_rects.iter().any(|r| inside_rect(r, x))
-                        || curved.iter().any(|c| c.contains(x));
-                    if !claimed {
+                    if !claimed(&all_rects, &curved, x) {
                         let cell = [
                             lattice(x[1], anchor[1], h).floor() as i64,
                             lattice(x[0], anchor[0], h).floor() as i64,
@@ -238,9 +242,7 @@ pub fn seed_particles(scene: &Scene, anchor: [f64; 2], h: f64) -> Vec<Seed> {
                     for &(sy, wy) in &pts {
                         for &(sx, wx) in &pts {
                             let x = [x0 + sx * h, y0 + sy * h];
-                            let claimed = all_rects.iter().any(|r| inside_rect(r, x))
-                                || curved.iter().any(|c| c.contains(x));
-                            if shape.contains(x) && !claimed {
+                            if shape.contains(x) && !claimed(&all_rects, &curved, x) {
                                 seeds.push((
                                     [ky, kx],
                                     Seed {
