@@ -110,6 +110,7 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
         )));
     }
     let ck = Checkpoint::read(&ck_path)?;
+    same_run(&folder, &ck)?;
     let origin = ck_path.display().to_string();
     let scene = Scene::from_str(&ck.scene_toml, &origin, &ck.scene_name, overrides)?;
     if ck.t >= scene.solver().t_end {
@@ -122,7 +123,11 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     // A later t_end goes through the preflight like a new run.
     let plan = preflight(&scene, opts)?;
     let mut sim = Simulation::new(&plan.scene, &spec(opts))?;
-    let nodes = sim.backend_ref().model().grid.n_nodes();
+    // Every field's nodes: a scene with contact pairs has one grid per
+    // field (`Model::n_fields`). The step clears them before it scatters,
+    // so zeros continue the run exactly; only their count must fit.
+    let model = sim.backend_ref().model();
+    let nodes = model.grid.n_nodes() * model.n_fields();
     let state = State {
         particles: ck.particles.clone(),
         mv: vec![[0.0; 3]; nodes],
@@ -151,6 +156,45 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     writer.flush()?;
     writer.write_pvd()?;
     execute(&mut sim, writer, Some(ck.cursor), start, opts, &plan)
+}
+
+/// Refuses a checkpoint that is not of the run the folder holds (one copied
+/// in from another run's folder), naming both: its scene name must be the
+/// name summary.json gives, and its scene the folder's scene.resolved.toml
+/// but for the keys a resume may change. A folder with neither file (an
+/// older layout) is taken on the checkpoint's word.
+fn same_run(folder: &Folder, ck: &Checkpoint) -> Result<()> {
+    let read = |name: &str| std::fs::read_to_string(folder.path(name)).ok();
+    let mismatch = |what: String| {
+        Err(Error::Checkpoint(format!(
+            "{}: the checkpoint is of a run of scene '{}', and this folder holds another run \
+             ({what}); resume the folder the checkpoint was written in, or start the scene \
+             anew with `lme-mpm run`",
+            folder.path(checkpoint::FILE).display(),
+            ck.scene_name
+        )))
+    };
+    if let Some(text) = read("summary.json") {
+        let name = serde_json::from_str::<serde_json::Value>(&text)
+            .ok()
+            .and_then(|v| v["scene"].as_str().map(str::to_string));
+        if let Some(name) = name.filter(|n| *n != ck.scene_name) {
+            return mismatch(format!("its summary.json names scene '{name}'"));
+        }
+    }
+    let Some(text) = read("scene.resolved.toml") else {
+        return Ok(());
+    };
+    let parse = |t: &str| t.parse::<toml::Table>().ok().map(toml::Value::Table);
+    let (Some(here), Some(theirs)) = (parse(&text), parse(&ck.scene_toml)) else {
+        return mismatch("its scene.resolved.toml does not parse".into());
+    };
+    let mut skip = RESUME_KEYS.to_vec();
+    skip.push("output.sample_interval");
+    match crate::scene::first_difference(&here, &theirs, &skip, ("the folder", "the checkpoint")) {
+        Some(d) => mismatch(format!("scene.resolved.toml differs: {d}")),
+        None => Ok(()),
+    }
 }
 
 fn spec(opts: &RunOptions) -> BackendSpec {

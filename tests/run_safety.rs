@@ -889,3 +889,147 @@ fn summary_floats_read_back_exactly() {
         );
     }
 }
+
+/// Fails on the first line at which `got` and `want` differ (a whole
+/// particles.csv is too long for an assertion message).
+fn same_text(got: &str, want: &str, what: &str) {
+    let (a, b): (Vec<&str>, Vec<&str>) = (got.lines().collect(), want.lines().collect());
+    if let Some(k) = (0..a.len().max(b.len())).find(|&k| a.get(k) != b.get(k)) {
+        panic!(
+            "{what}: line {k} differs ({} and {} lines):\n got  {:?}\n want {:?}",
+            a.len(),
+            b.len(),
+            a.get(k),
+            b.get(k)
+        );
+    }
+}
+
+/// `case` run to `t_end` with one checkpoint at half-time (none at the end)
+/// and resumed from it; and run to half-time, then extended to `t_end`:
+/// both must give the uninterrupted run's particles and probes byte for
+/// byte. Before the checkpoint held every field, resume refused every
+/// scene with a contact pair ("the state holds 1600 particles and 3233
+/// nodes, the scene 1600 and 9699").
+fn contact_case_resumes_bit_for_bit(case: &str, name: &str, t_end: f64) {
+    let end = format!("solver.t_end={t_end}");
+    let half = format!("solver.t_end={}", t_end / 2.0);
+    let every = format!("output.checkpoint_interval={}", t_end / 2.0);
+    let csv = "output.particles_csv=true";
+    let whole = tmp(&format!("{name}-whole"));
+    let o = run(case, &whole, &[&end, csv]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (particles, probes) = (
+        read(&whole.join("particles.csv")),
+        read(&whole.join("probes.csv")),
+    );
+
+    let cut = tmp(&format!("{name}-cut"));
+    let o = run(
+        case,
+        &cut,
+        &[&end, csv, &every, "output.final_checkpoint=false"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = resume(&cut, &[]);
+    assert!(o.status.success(), "{case}: resume failed: {}", stderr(&o));
+    // The checkpoint is taken at the first step boundary past half-time.
+    let from = summary(&cut)["resumed_from"].as_f64().unwrap();
+    assert!(
+        (t_end / 2.0..0.6 * t_end).contains(&from),
+        "{case}: resumed from {from}"
+    );
+    same_text(
+        &read(&cut.join("probes.csv")),
+        &probes,
+        &format!("{case} resumed: probes"),
+    );
+    same_text(
+        &read(&cut.join("particles.csv")),
+        &particles,
+        &format!("{case} resumed: particles"),
+    );
+
+    // Extended: run to half-time (its last step shortened to land there),
+    // then on to t_end. That shortened step makes it another run than the
+    // uninterrupted one (its steps fall elsewhere in the impact), so it
+    // cannot match it byte for byte; it must go on from where it stopped
+    // and end near the same energy. The bound is 5 %: the disks' exchange
+    // takes about a fifth of their energy (docs/methods.md), and where the
+    // steps fall moves that loss by 2.8 % of the total (measured here on
+    // 2026-12-01); the footing's totals, almost all the footing's own
+    // kinetic energy, end 1.4e-11 apart.
+    let extended = tmp(&format!("{name}-extended"));
+    let o = run(case, &extended, &[&half, csv]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rows = read(&extended.join("energy.csv")).lines().count();
+    let o = resume(&extended, &[&end]);
+    assert!(o.status.success(), "{case}: extend failed: {}", stderr(&o));
+    let s = summary(&extended);
+    assert_eq!(s["t"].as_f64(), Some(t_end), "{s}");
+    assert!(read(&extended.join("energy.csv")).lines().count() > rows);
+    let total = |d: &Path| -> f64 {
+        let text = read(&d.join("energy.csv"));
+        let last = text.lines().last().unwrap();
+        last.rsplit(',').next().unwrap().parse().unwrap()
+    };
+    let (a, b) = (total(&extended), total(&whole));
+    assert!(
+        (a - b).abs() <= 0.05 * b.abs(),
+        "{case}: extended run ends at total energy {a} J, the uninterrupted one at {b} J"
+    );
+}
+
+#[test]
+fn a_contact_run_resumes_and_extends_bit_for_bit() {
+    // The disks meet at about 0.025 s: the checkpoint at 0.02 s is just
+    // before, and the resumed part holds the whole impact.
+    contact_case_resumes_bit_for_bit("contact_disks.toml", "contact-disks", 0.04);
+}
+
+#[test]
+fn the_footing_resumes_and_extends_bit_for_bit() {
+    // Soil and footing are a contact pair (3 fields' nodes on the grid).
+    contact_case_resumes_bit_for_bit("footing.toml", "footing", 0.02);
+}
+
+#[test]
+fn a_checkpoint_copied_from_another_run_is_refused_naming_both() {
+    // Before: resume took it (exit 0) and the folder then held two scenes'
+    // files.
+    let bar = tmp("copied-bar");
+    let o = run("dyka_bar.toml", &bar, &["solver.t_end=4e-6"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let disks = tmp("copied-disks");
+    let o = run("contact_disks.toml", &disks, &["solver.t_end=0.002"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before: Vec<(PathBuf, String)> = ["probes.csv", "summary.json", "energy.csv"]
+        .iter()
+        .map(|f| (disks.join(f), read(&disks.join(f))))
+        .collect();
+    std::fs::copy(bar.join("checkpoint.lmeck"), disks.join("checkpoint.lmeck")).unwrap();
+    let o = resume(&disks, &["solver.t_end=0.004"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("'dyka_bar'") && err.contains("'contact_disks'"),
+        "names neither scene: {err}"
+    );
+    for (path, text) in &before {
+        assert_eq!(&read(path), text, "{} was touched", path.display());
+    }
+
+    // The same scene with another setting is another run too.
+    let finer = tmp("copied-finer");
+    let o = run(
+        "dyka_bar.toml",
+        &finer,
+        &["solver.t_end=4e-6", "solver.cfl=0.2"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::copy(bar.join("checkpoint.lmeck"), finer.join("checkpoint.lmeck")).unwrap();
+    let o = resume(&finer, &["solver.t_end=6e-6"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("solver.cfl"), "does not name the key: {err}");
+}

@@ -76,3 +76,50 @@ fn read_capped(path: &Path, cap: u64) -> Result<String, SceneError> {
     }
     String::from_utf8(bytes).map_err(|e| err(format!("is not UTF-8 text: {e}")))
 }
+
+/// The first key at which two scenes as TOML differ, in words, naming each
+/// side by its label ("grid.h = 0.01 in the folder, 0.005 in the plan");
+/// keys in `skip` (dotted) are passed over, on either side.
+pub fn first_difference(
+    got: &toml::Value,
+    want: &toml::Value,
+    skip: &[&str],
+    labels: (&str, &str),
+) -> Option<String> {
+    difference_at(got, want, "", skip, labels)
+}
+
+fn difference_at(
+    got: &toml::Value,
+    want: &toml::Value,
+    at: &str,
+    skip: &[&str],
+    (l1, l2): (&str, &str),
+) -> Option<String> {
+    let key = |k: &str| {
+        if at.is_empty() {
+            k.to_string()
+        } else {
+            format!("{at}.{k}")
+        }
+    };
+    match (got, want) {
+        (toml::Value::Table(a), toml::Value::Table(b)) => {
+            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let dotted = key(k);
+                if skip.contains(&dotted.as_str()) {
+                    return None;
+                }
+                match (a.get(k), b.get(k)) {
+                    (Some(x), Some(y)) => difference_at(x, y, &dotted, skip, (l1, l2)),
+                    (Some(x), None) => Some(format!("{dotted} = {x} in {l1}, unset in {l2}")),
+                    (None, Some(y)) => Some(format!("{dotted} unset in {l1}, {y} in {l2}")),
+                    (None, None) => None,
+                }
+            })
+        }
+        (a, b) if a == b => None,
+        (a, b) => Some(format!("{at} = {a} in {l1}, {b} in {l2}")),
+    }
+}

@@ -75,7 +75,18 @@ pub fn mismatch(plan: &Plan, run: &PlannedRun, dir: &Path) -> Option<String> {
         Ok(v) => v,
         Err(e) => return Some(format!("the plan's scene for it no longer loads: {e}")),
     };
-    first_difference(&got, &expected, "").map(|d| format!("its scene.resolved.toml differs: {d}"))
+    // A resumed run writes the default sample interval it ran with: the
+    // folder may set it where the plan does not.
+    let planned = expected
+        .get("output")
+        .and_then(|o| o.get("sample_interval"));
+    let skip: &[&str] = if planned.is_none() {
+        &["output.sample_interval"]
+    } else {
+        &[]
+    };
+    crate::scene::first_difference(&got, &expected, skip, ("the folder", "the plan"))
+        .map(|d| format!("its scene.resolved.toml differs: {d}"))
 }
 
 /// The resolved scene `plan` gives `run`, as `lme-mpm run` writes it to
@@ -102,38 +113,9 @@ fn resolved(plan: &Plan, run: &PlannedRun) -> Result<toml::Value> {
     Ok(toml::Value::Table(table))
 }
 
-/// The first key at which `got` (the folder's) and `want` (the plan's)
-/// differ, in words.
-fn first_difference(got: &toml::Value, want: &toml::Value, at: &str) -> Option<String> {
-    let key = |k: &str| {
-        if at.is_empty() {
-            k.to_string()
-        } else {
-            format!("{at}.{k}")
-        }
-    };
-    match (got, want) {
-        (toml::Value::Table(a), toml::Value::Table(b)) => {
-            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
-            keys.into_iter().find_map(|k| match (a.get(k), b.get(k)) {
-                (Some(x), Some(y)) => first_difference(x, y, &key(k)),
-                // A resumed run writes the default it ran with.
-                (Some(_), None) if key(k) == "output.sample_interval" => None,
-                (Some(x), None) => {
-                    Some(format!("{} = {x} in the folder, unset in the plan", key(k)))
-                }
-                (None, Some(y)) => Some(format!("{} unset in the folder, {y} in the plan", key(k))),
-                (None, None) => None,
-            })
-        }
-        (a, b) if a == b => None,
-        (a, b) => Some(format!("{at} = {a} in the folder, {b} in the plan")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::scene::first_difference;
 
     #[test]
     fn the_first_difference_is_named_by_its_dotted_key() {
@@ -144,8 +126,9 @@ mod tests {
             .parse()
             .unwrap();
         let (a, b) = (toml::Value::Table(a), toml::Value::Table(b));
-        assert_eq!(first_difference(&a, &a, ""), None);
-        let d = first_difference(&a, &b, "").unwrap();
+        let labels = ("the folder", "the plan");
+        assert_eq!(first_difference(&a, &a, &[], labels), None);
+        let d = first_difference(&a, &b, &[], labels).unwrap();
         assert!(d.starts_with("grid.h = 0.01 in the folder, 0.005"), "{d}");
     }
 }
