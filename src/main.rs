@@ -336,6 +336,9 @@ fn main() -> ExitCode {
             for w in &plan.warnings {
                 lme_mpm::say!("warning: {w}");
             }
+            for c in &plan.scene.chosen {
+                lme_mpm::say!("note: {c}");
+            }
             match lme_mpm::model::Model::new(&plan.scene) {
                 Ok(model) => {
                     let text = lme_mpm::run::describe(&plan.scene, &model)

@@ -80,6 +80,11 @@ fn preflight(scene: &Scene, opts: &RunOptions) -> Result<crate::preflight::Plan>
     for w in &plan.warnings {
         crate::say!("warning: {w}");
     }
+    if opts.verbose {
+        for c in &plan.scene.chosen {
+            crate::say!("note: {c}");
+        }
+    }
     Ok(plan)
 }
 

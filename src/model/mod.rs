@@ -376,7 +376,7 @@ impl Model {
             mls: f.solver.mls,
             mls_support: f.solver.mls_support,
             mls_scope: f.solver.mls_scope,
-            pic_fraction: f.solver.pic_fraction,
+            pic_fraction: f.solver.pic_fraction.unwrap_or(0.0),
             local_damping: f.solver.local_damping,
             cell_average_volumetric: f.solver.volumetric_strain
                 == crate::scene::VolumetricStrain::CellAverage,

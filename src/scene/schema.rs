@@ -585,9 +585,10 @@ pub struct SolverSpec {
     pub bspline_knots: Option<BsplineKnots>,
     /// Share α of PIC in the particle velocity update, in [0, 1]:
     /// v_p ← (1 − α) v_FLIP + α v_PIC (explicit integrators). Default 0
-    /// (pure FLIP).
-    #[serde(default)]
-    pub pic_fraction: f64,
+    /// (pure FLIP), but 0.01 for a cohesionless granular scene
+    /// (`defaults::pic_fraction`), which the checked scene then sets.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pic_fraction: Option<f64>,
     /// Cundall's non-viscous local damping α, in [0, 1): each component of
     /// the unbalanced nodal force loses α |f| sign(v) (explicit
     /// integrators). Default 0 (none).
@@ -792,6 +793,9 @@ pub struct Scene {
     pub margin: f64,
     /// `output.sample_interval`, resolved (s).
     pub sample_interval: f64,
+    /// Defaults chosen from what the scene models (`scene::defaults`), in
+    /// words, for `check` and the run's log.
+    pub chosen: Vec<String>,
 }
 
 impl Scene {

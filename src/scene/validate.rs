@@ -92,11 +92,17 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
                 * s.t_end
         }
     };
+    let mut chosen = Vec::new();
+    if let Some((pic, why)) = super::defaults::pic_fraction(&file) {
+        file.solver.pic_fraction = Some(pic);
+        chosen.push(why);
+    }
     Ok(Scene {
         name,
         file,
         margin,
         sample_interval,
+        chosen,
     })
 }
 
@@ -146,14 +152,12 @@ fn check_solver(file: &SceneFile) -> Result<(), SceneError> {
 /// both explicit only (the implicit step has no FLIP update and no
 /// unbalanced nodal force to damp).
 fn check_dissipation(s: &SolverSpec) -> Result<(), SceneError> {
-    finite("solver.pic_fraction", s.pic_fraction)?;
-    if !(0.0..=1.0).contains(&s.pic_fraction) {
+    let pic_fraction = s.pic_fraction.unwrap_or(0.0);
+    finite("solver.pic_fraction", pic_fraction)?;
+    if !(0.0..=1.0).contains(&pic_fraction) {
         return Err(SceneError::invalid(
             "solver.pic_fraction",
-            format!(
-                "must be in [0, 1] (0 = FLIP, 1 = PIC), got {}",
-                s.pic_fraction
-            ),
+            format!("must be in [0, 1] (0 = FLIP, 1 = PIC), got {pic_fraction}"),
         ));
     }
     finite("solver.local_damping", s.local_damping)?;
@@ -168,7 +172,7 @@ fn check_dissipation(s: &SolverSpec) -> Result<(), SceneError> {
     }
     if s.integrator == IntegratorKind::Implicit {
         for (key, v) in [
-            ("solver.pic_fraction", s.pic_fraction),
+            ("solver.pic_fraction", pic_fraction),
             ("solver.local_damping", s.local_damping),
         ] {
             if v != 0.0 {
