@@ -50,6 +50,8 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
     let mms = common::case("aligned_vibration.toml");
     let slump =
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
+    // 300 bytes: more than a folder name holds (255).
+    let long_name = format!("name={}", "n".repeat(300));
     let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
         (
             "malformed toml",
@@ -114,6 +116,30 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
             dyka.clone(),
             vec!["solver.shape"],
             "expected dotted.key=value",
+        ),
+        (
+            "a name longer than a folder name may be",
+            dyka.clone(),
+            vec![long_name.as_str()],
+            "`name` must be a plain folder name",
+        ),
+        (
+            "a name holding NUL",
+            scene_file(
+                &tmp("s-nul"),
+                &dyka_text().replace("name = \"dyka_bar\"", "name = \"a\\u0000b\""),
+            ),
+            vec![],
+            "`name` must be a plain folder name",
+        ),
+        (
+            "a name holding a newline",
+            scene_file(
+                &tmp("s-newline"),
+                &dyka_text().replace("name = \"dyka_bar\"", "name = \"a\\nb\""),
+            ),
+            vec![],
+            "`name` must be a plain folder name",
         ),
         (
             "--set into a value",
@@ -898,4 +924,32 @@ fn small_input_holes_exit_2_naming_what_is_wrong() {
         "{err}"
     );
     assert!(!out.exists());
+}
+
+/// Issue 51: `bench --seconds nan` measured no step and reported 0
+/// particle-steps/s; 0 particles measured 16 under another count.
+#[test]
+fn bench_refuses_times_and_counts_it_cannot_measure() {
+    let out = tmp("bench-bad");
+    for (flag, v) in [
+        ("--seconds", "nan"),
+        ("--seconds", "inf"),
+        ("--seconds", "0"),
+        ("--seconds", "-1"),
+        ("--seconds", "1e9"),
+        ("--particles", "0"),
+        ("--particles", "2000,15"),
+    ] {
+        let o = bin()
+            .args(["bench", "--backend", "cpu", "--cases", "linear"])
+            .arg(format!("{flag}={v}"))
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{flag} {v}: {err}");
+        assert!(err.contains(flag), "{flag} {v}: {err}");
+        assert!(!out.exists(), "{flag} {v}: wrote {}", out.display());
+    }
 }

@@ -57,12 +57,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         .name
         .clone()
         .unwrap_or_else(|| default_name.to_string());
-    if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
-        return Err(SceneError::invalid(
-            "name",
-            format!("must be a plain folder name (no slashes), got {name:?}"),
-        ));
-    }
+    folder_name(&name)?;
 
     check_solver(&file)?;
     check_gmm(&file)?;
@@ -98,6 +93,46 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         margin,
         sample_interval,
     })
+}
+
+/// The longest `name`, in bytes: a folder name's limit on Linux and macOS
+/// (NAME_MAX), less the `.tmp` that atomic writes append beside it.
+pub const NAME_MAX_BYTES: usize = 255 - ".tmp".len();
+
+/// `name` is the run's folder (`out/<name>`): a name a folder can hold,
+/// checked here so that `check` refuses what `run` could not create.
+fn folder_name(name: &str) -> Result<(), SceneError> {
+    let why = if name.is_empty() || name == "." || name == ".." {
+        Some("is not a folder name".to_string())
+    } else if let Some(c) = name
+        .chars()
+        .find(|c| matches!(c, '/' | '\\') || c.is_control())
+    {
+        Some(format!(
+            "holds {c:?}; a folder name holds no slash, backslash, NUL or other control character"
+        ))
+    } else if name.len() > NAME_MAX_BYTES {
+        Some(format!(
+            "is {} bytes long; a folder name holds at most {NAME_MAX_BYTES}",
+            name.len()
+        ))
+    } else {
+        None
+    };
+    match why {
+        Some(why) => Err(SceneError::invalid(
+            "name",
+            format!(
+                "must be a plain folder name (outputs go to out/<name>): {name:?} {why}",
+                name = if name.len() > 40 {
+                    format!("{}…", name.chars().take(40).collect::<String>())
+                } else {
+                    name.to_string()
+                }
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// `[solver]`: times, Courant number, integrator and shape parameters.
