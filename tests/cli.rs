@@ -953,3 +953,60 @@ fn bench_refuses_times_and_counts_it_cannot_measure() {
         assert!(!out.exists(), "{flag} {v}: wrote {}", out.display());
     }
 }
+
+/// Issue 51: a key that no setting of the scene reads is refused (exit 2)
+/// naming it and what would make it apply, as `bspline_knots` and
+/// `pic_fraction` already were; with that setting it is taken.
+#[test]
+fn keys_that_do_not_apply_are_refused_naming_what_would_apply_them() {
+    let dyka = common::case("dyka_bar.toml");
+    let rolling = common::case("contact_rolling.toml");
+    let cantilever = common::case("cantilever.toml");
+    let check = |scene: &Path, sets: &[&str]| {
+        let mut c = bin();
+        c.arg("check").arg(scene);
+        for s in sets {
+            c.arg("--set").arg(s);
+        }
+        c.output().unwrap()
+    };
+    #[rustfmt::skip]
+    let cases: [(&Path, &str, &str, &[&str]); 9] = [
+        (&rolling, "gravity.ramp_period=0.2", "gravity.ramp = \"sine\"", &["gravity.ramp=sine"]),
+        (&dyka, "solver.mls_support=2", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
+        (&dyka, "solver.mls_scope=force", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
+        (&dyka, "solver.newmark_beta=0.3", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
+        (&dyka, "solver.newton_max_iter=5", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
+        (&dyka, "solver.npc_gamma=0.6", "integrator = \"npc\"", &[]),
+        (&cantilever, "solver.gmm_basis=mls", "method = \"gmm\"", &["solver.method=gmm"]),
+        (&cantilever, "solver.load_steps=3", "solver.static = true", &[]),
+        (&cantilever, "solver.gmm_dilation=1.0", "gmm_basis = \"mls\"", &["solver.method=gmm", "solver.gmm_basis=mls"]),
+    ];
+    for (scene, set, needs, apply) in cases {
+        // Under settings that do not read it (dyka runs NPC; its npc_gamma
+        // is refused under FE).
+        let mut sets = vec![set];
+        if set.starts_with("solver.npc_gamma") {
+            sets.push("solver.integrator=fe");
+        }
+        if set.starts_with("solver.load_steps") {
+            sets.push("solver.static=false");
+        }
+        let o = check(scene, &sets);
+        let err = stderr(&o);
+        let key = set.split('=').next().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(
+            err.contains(&format!("`{key}` has no effect")) && err.contains(needs),
+            "{set}: {err}"
+        );
+        // And taken where it applies.
+        let mut sets: Vec<&str> = apply.to_vec();
+        sets.push(set);
+        if set.starts_with("solver.load_steps") {
+            sets.push("solver.static=true");
+        }
+        let o = check(scene, &sets);
+        assert!(o.status.success(), "{set} with {apply:?}: {}", stderr(&o));
+    }
+}
