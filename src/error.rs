@@ -39,6 +39,11 @@ pub enum Error {
     #[error("GPU error: {0}")]
     Gpu(String),
 
+    /// A command's flag has a value outside what it allows; the message
+    /// names the flag, the value and the range.
+    #[error("{0}")]
+    Usage(String),
+
     /// `bench --peer`: the peer's command failed or printed no measurement.
     #[error("bench: {0}")]
     Bench(String),
@@ -49,7 +54,7 @@ impl Error {
     /// 1 for anything else (0 = completed and 3 = unstable are run results).
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Scene(_) | Error::Checkpoint(_) | Error::Folder(_) => 2,
+            Error::Scene(_) | Error::Checkpoint(_) | Error::Folder(_) | Error::Usage(_) => 2,
             _ => 1,
         }
     }

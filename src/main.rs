@@ -162,14 +162,18 @@ struct RenderArgs {
     /// strain; plastic materials), displacement (m, from the start).
     #[arg(long, value_enum, default_value_t = lme_mpm::output::render::Field::Speed)]
     field: lme_mpm::output::render::Field,
-    /// Frames per second of the animation.
-    #[arg(long, default_value_t = 10.0)]
+    /// Frames per second of the animation, 0.1 to 50 (a GIF's delays are
+    /// whole hundredths of a second, 2 to 1000).
+    #[arg(long, default_value_t = 10.0, value_parser = lme_mpm::output::render::parse_fps)]
     fps: f64,
-    /// Image width in pixels (the height follows the frame's shape).
-    #[arg(long, default_value_t = 800)]
+    /// Image width in pixels, 320 to 4096 (the height follows the frame's
+    /// shape, at most about 1.3 times the width). Before drawing the rest,
+    /// render says what the frames will take on disk and in time, from the
+    /// first.
+    #[arg(long, default_value_t = 800, value_parser = lme_mpm::output::render::parse_width)]
     width: u32,
-    /// Draw every N-th snapshot (the last one always).
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    /// Draw every N-th snapshot (the last one always), N at least 1.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = lme_mpm::output::render::parse_every)]
     every: usize,
     /// Output folder. Default: DIR/render.
     #[arg(long)]

@@ -243,10 +243,17 @@ fn finish(
     schedule.stop = opts.stop.clone();
     schedule.final_checkpoint = scene.file.output.final_checkpoint;
     let t_drive = Instant::now();
-    writer.started = Some((t_drive, sim.backend_ref().time(), steps0));
-    if writer.lines.is_some() {
-        // A log says when stepping begins, after the set-up.
-        writer.progress_line(sim.backend_ref().time(), scene.solver().t_end, steps0);
+    let t0 = sim.backend_ref().time();
+    writer.started = Some((t_drive, t0, steps0));
+    // Stepping time is counted from here: the I/O of a resume's set-up (the
+    // CSV files rewritten up to the checkpoint) came before it and is not
+    // subtracted from it.
+    writer.io_seconds = 0.0;
+    if let Some((_, at)) = writer.lines {
+        // A log says when stepping begins, after the set-up; the tenth it
+        // begins in (a resume's, past 0) is said then and not again.
+        writer.progress_line(t0, scene.solver().t_end, steps0);
+        writer.lines = Some((tenth_of(t0, scene.solver().t_end), at));
     }
     let driven = sim.drive_from(schedule, writer, cursor);
     writer.finish_progress();
@@ -626,13 +633,18 @@ impl Observer for Writer {
             }
         }
         if let Some((tenth, at)) = self.lines {
-            let now = ((t / t_end * 10.0).floor() as u64).min(10);
+            let now = tenth_of(t, t_end);
             if now > tenth || at.elapsed() > LINE_EVERY {
                 self.progress_line(t, t_end, steps);
                 self.lines = Some((now.max(tenth), Instant::now()));
             }
         }
     }
+}
+
+/// The tenth of `t_end` that `t` has reached, 0 to 10.
+fn tenth_of(t: f64, t_end: f64) -> u64 {
+    ((t / t_end * 10.0).floor() as u64).min(10)
 }
 
 /// Text that `lme-mpm check` prints: what the scene will run.

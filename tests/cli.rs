@@ -50,6 +50,8 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
     let mms = common::case("aligned_vibration.toml");
     let slump =
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/soil_slump.toml");
+    // 300 bytes: more than a folder name holds (255).
+    let long_name = format!("name={}", "n".repeat(300));
     let cases: Vec<(&str, PathBuf, Vec<&str>, &str)> = vec![
         (
             "malformed toml",
@@ -114,6 +116,30 @@ fn bad_input_exits_2_with_a_clear_message_and_writes_nothing() {
             dyka.clone(),
             vec!["solver.shape"],
             "expected dotted.key=value",
+        ),
+        (
+            "a name longer than a folder name may be",
+            dyka.clone(),
+            vec![long_name.as_str()],
+            "`name` must be a plain folder name",
+        ),
+        (
+            "a name holding NUL",
+            scene_file(
+                &tmp("s-nul"),
+                &dyka_text().replace("name = \"dyka_bar\"", "name = \"a\\u0000b\""),
+            ),
+            vec![],
+            "`name` must be a plain folder name",
+        ),
+        (
+            "a name holding a newline",
+            scene_file(
+                &tmp("s-newline"),
+                &dyka_text().replace("name = \"dyka_bar\"", "name = \"a\\nb\""),
+            ),
+            vec![],
+            "`name` must be a plain folder name",
         ),
         (
             "--set into a value",
@@ -898,4 +924,89 @@ fn small_input_holes_exit_2_naming_what_is_wrong() {
         "{err}"
     );
     assert!(!out.exists());
+}
+
+/// Issue 51: `bench --seconds nan` measured no step and reported 0
+/// particle-steps/s; 0 particles measured 16 under another count.
+#[test]
+fn bench_refuses_times_and_counts_it_cannot_measure() {
+    let out = tmp("bench-bad");
+    for (flag, v) in [
+        ("--seconds", "nan"),
+        ("--seconds", "inf"),
+        ("--seconds", "0"),
+        ("--seconds", "-1"),
+        ("--seconds", "1e9"),
+        ("--particles", "0"),
+        ("--particles", "2000,15"),
+    ] {
+        let o = bin()
+            .args(["bench", "--backend", "cpu", "--cases", "linear"])
+            .arg(format!("{flag}={v}"))
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{flag} {v}: {err}");
+        assert!(err.contains(flag), "{flag} {v}: {err}");
+        assert!(!out.exists(), "{flag} {v}: wrote {}", out.display());
+    }
+}
+
+/// Issue 51: a key that no setting of the scene reads is refused (exit 2)
+/// naming it and what would make it apply, as `bspline_knots` and
+/// `pic_fraction` already were; with that setting it is taken.
+#[test]
+fn keys_that_do_not_apply_are_refused_naming_what_would_apply_them() {
+    let dyka = common::case("dyka_bar.toml");
+    let rolling = common::case("contact_rolling.toml");
+    let cantilever = common::case("cantilever.toml");
+    let check = |scene: &Path, sets: &[&str]| {
+        let mut c = bin();
+        c.arg("check").arg(scene);
+        for s in sets {
+            c.arg("--set").arg(s);
+        }
+        c.output().unwrap()
+    };
+    #[rustfmt::skip]
+    let cases: [(&Path, &str, &str, &[&str]); 9] = [
+        (&rolling, "gravity.ramp_period=0.2", "gravity.ramp = \"sine\"", &["gravity.ramp=sine"]),
+        (&dyka, "solver.mls_support=2", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
+        (&dyka, "solver.mls_scope=force", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
+        (&dyka, "solver.newmark_beta=0.3", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
+        (&dyka, "solver.newton_max_iter=5", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
+        (&dyka, "solver.npc_gamma=0.6", "integrator = \"npc\"", &[]),
+        (&cantilever, "solver.gmm_basis=mls", "method = \"gmm\"", &["solver.method=gmm"]),
+        (&cantilever, "solver.load_steps=3", "solver.static = true", &[]),
+        (&cantilever, "solver.gmm_dilation=1.0", "gmm_basis = \"mls\"", &["solver.method=gmm", "solver.gmm_basis=mls"]),
+    ];
+    for (scene, set, needs, apply) in cases {
+        // Under settings that do not read it (dyka runs NPC; its npc_gamma
+        // is refused under FE).
+        let mut sets = vec![set];
+        if set.starts_with("solver.npc_gamma") {
+            sets.push("solver.integrator=fe");
+        }
+        if set.starts_with("solver.load_steps") {
+            sets.push("solver.static=false");
+        }
+        let o = check(scene, &sets);
+        let err = stderr(&o);
+        let key = set.split('=').next().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(
+            err.contains(&format!("`{key}` has no effect")) && err.contains(needs),
+            "{set}: {err}"
+        );
+        // And taken where it applies.
+        let mut sets: Vec<&str> = apply.to_vec();
+        sets.push(set);
+        if set.starts_with("solver.load_steps") {
+            sets.push("solver.static=true");
+        }
+        let o = check(scene, &sets);
+        assert!(o.status.success(), "{set} with {apply:?}: {}", stderr(&o));
+    }
 }

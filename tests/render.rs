@@ -288,3 +288,126 @@ fn study_and_bench_report_progress_off_a_terminal() {
     let _ = std::fs::remove_dir_all(out);
     let _ = std::fs::remove_dir_all(bench);
 }
+
+/// Pixels of exactly the shading behind a wall (`render::WALL_FILL`,
+/// 215 grey) in rows `rows` and columns `cols` of an RGB image `w` wide.
+fn wall_shade(rgb: &[u8], w: u32, rows: std::ops::Range<u32>, cols: std::ops::Range<u32>) -> usize {
+    rows.flat_map(|y| cols.clone().map(move |x| 3 * (y * w + x) as usize))
+        .filter(|&k| rgb[k..k + 3] == [215, 215, 215])
+        .count()
+}
+
+/// Issue 51: `--width 100000` panicked in plotters (exit 101), 0 and the
+/// other degenerate sizes and rates were taken without a word, nothing
+/// said how much a render would write, and a gate was drawn after it had
+/// gone. Now every size and rate is bounded (exit 2 naming the flag, the
+/// value and the range), the first frame gives an estimate of the rest,
+/// and walls are drawn only while they act.
+#[test]
+fn render_bounds_its_sizes_estimates_its_output_and_draws_a_gate_until_it_goes() {
+    let run = tmp("gate");
+    let o = bin()
+        .arg("run")
+        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/gate_release.toml"))
+        .args([
+            "--backend",
+            "cpu",
+            "--set",
+            "solver.t_end=0.2",
+            "--set",
+            "output.vtk_interval=0.05",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    for (flag, v, range) in [
+        ("--width", "100000", "320..=4096"),
+        ("--width", "0", "320..=4096"),
+        ("--width", "319", "320..=4096"),
+        ("--width", "99999999999", "320..=4096"),
+        ("--fps", "0", "0.1..=50"),
+        ("--fps", "nan", "0.1..=50"),
+        ("--fps", "inf", "0.1..=50"),
+        ("--fps", "51", "0.1..=50"),
+        ("--every", "0", "at least 1"),
+    ] {
+        let o = bin()
+            .arg("render")
+            .arg(&run)
+            .arg(format!("{flag}={v}"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flag} {v}: {err}");
+        assert!(
+            err.contains(flag) && err.contains(v) && err.contains(range),
+            "{flag} {v}: {err}"
+        );
+        assert!(!run.join("render").exists(), "{flag} {v}: drew something");
+    }
+    // The library refuses them too, naming the flag.
+    let opts = lme_mpm::output::render::RenderOptions {
+        width: 100_000,
+        ..Default::default()
+    };
+    let e = lme_mpm::output::render::render(&run, &opts).unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("--width"), "{e}");
+
+    // The estimate is said before the frames are drawn, and holds.
+    let o = bin()
+        .arg("render")
+        .arg(&run)
+        .args(["--width", "480"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let said = err.lines().position(|l| l.contains("frames of 480 x"));
+    let outputs = err.lines().position(|l| l.starts_with("outputs:"));
+    assert!(
+        matches!((said, outputs), (Some(a), Some(b)) if a < b),
+        "{err}"
+    );
+    let opts = lme_mpm::output::render::RenderOptions {
+        width: 480,
+        out: Some(run.join("lib")),
+        say_estimate: false,
+        ..Default::default()
+    };
+    let r = lme_mpm::output::render::render(&run, &opts).unwrap();
+    assert!(r.frames.len() >= 4, "{} frames", r.frames.len());
+    assert_eq!(r.estimate.frames, r.frames.len());
+    let png_bytes: u64 = r
+        .frames
+        .iter()
+        .map(|f| std::fs::metadata(f).unwrap().len())
+        .sum();
+    let est = r.estimate.png_bytes();
+    assert!(
+        (0.5 * est..=2.0 * est).contains(&(png_bytes as f64)),
+        "PNG frames: {png_bytes} bytes written, {est} estimated"
+    );
+    let gif_bytes = std::fs::metadata(&r.gif).unwrap().len() as f64;
+    assert!(gif_bytes <= r.estimate.gif_bytes_at_most(), "{gif_bytes}");
+
+    // The gate (x = 0.4, removed at 0.1 s) shades x > 0.4 while it acts:
+    // the upper right of the plot, where no particle reaches. The floor
+    // shades only the bottom, the back wall the left.
+    let (first, (w, h)) = png(&r.frames[0]);
+    let (last, size) = png(r.frames.last().unwrap());
+    assert_eq!(size, (w, h));
+    let (rows, cols) = (40..h / 2, w / 2..w - 130);
+    let before = wall_shade(&first, w, rows.clone(), cols.clone());
+    let after = wall_shade(&last, w, rows, cols);
+    assert!(before > 1000, "the gate's side at t = 0: {before} pixels");
+    assert_eq!(after, 0, "the gate drawn after its removal");
+    // The other walls still are: the floor's side at the bottom.
+    let floor = wall_shade(&last, w, h / 2..h, w / 2..w - 130);
+    assert!(floor > 100, "the floor's side: {floor} pixels");
+    let _ = std::fs::remove_dir_all(run);
+}

@@ -429,6 +429,77 @@ fn progress_lines_on_a_pipe_unless_quiet() {
     assert!(!stderr(&quiet).contains("progress:"));
 }
 
+/// Each progress line's percent and rate (particle-steps/s).
+fn progress_of(err: &str) -> Vec<(String, f64)> {
+    err.lines()
+        .filter(|l| l.starts_with("progress:"))
+        .map(|l| {
+            let percent = l["progress:".len()..].split('%').next().unwrap().trim();
+            let words: Vec<&str> = l.split_whitespace().collect();
+            let at = words.iter().position(|w| w.starts_with("particle-steps/s"));
+            let rate = at.and_then(|i| words[i - 1].parse::<f64>().ok());
+            (
+                percent.to_string(),
+                rate.unwrap_or_else(|| panic!("no rate in {l}")),
+            )
+        })
+        .collect()
+}
+
+/// Issue 51: a resumed run repeated its first progress line (the tenth it
+/// starts in) and counted the I/O of its set-up against its stepping time,
+/// reporting 5.9e12 particle-steps/s. Its lines now count only the steps
+/// this process took over the time it stepped.
+#[test]
+fn a_resumed_runs_progress_counts_its_own_steps_and_repeats_no_line() {
+    let out = tmp("progress-resume");
+    let first = bin()
+        .args(["run", "--backend", "cpu", "--out"])
+        .arg(&out)
+        .arg(common::case("dyka_bar.toml"))
+        .args(["--set", "solver.t_end=1e-5"])
+        .output()
+        .unwrap();
+    assert!(first.status.success(), "{}", stderr(&first));
+    let before = progress_of(&stderr(&first));
+    let fastest = before.iter().map(|p| p.1).fold(0.0, f64::max);
+    assert!(fastest > 0.0, "{}", stderr(&first));
+    let rate0 = summary(&out)["particle_steps_per_second"].as_f64().unwrap();
+
+    let o = bin()
+        .args(["resume", "--backend", "cpu"])
+        .arg(&out)
+        .args(["--set", "solver.t_end=2e-5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let after = progress_of(&stderr(&o));
+    assert!(after.len() >= 5, "{}", stderr(&o));
+    assert_eq!(after[0].0, "50", "{}", stderr(&o));
+    assert_eq!(after.last().unwrap().0, "100", "{}", stderr(&o));
+    // One line a tenth: the one it starts in said once, at the start.
+    let mut tenths: Vec<u32> = after
+        .iter()
+        .map(|p| p.0.parse::<u32>().unwrap() / 10)
+        .collect();
+    tenths.dedup();
+    assert_eq!(tenths.len(), after.len(), "a tenth repeats: {}", stderr(&o));
+    // The same scene on the same machine: the same order of speed (10x
+    // leaves room for a loaded machine; the bug was 1e6x and more).
+    for (percent, rate) in &after {
+        assert!(
+            *rate <= 10.0 * fastest,
+            "{percent} %: {rate:e} particle-steps/s against at most {fastest:e} before: {}",
+            stderr(&o)
+        );
+    }
+    let rate1 = summary(&out)["particle_steps_per_second"].as_f64().unwrap();
+    assert!(
+        rate1 <= 10.0 * rate0,
+        "summary: {rate1:e} against {rate0:e}"
+    );
+}
+
 // ---- issue 25: a run never dies without a word ----
 
 /// Starts a CPU run with progress lines on a pipe and waits for its first

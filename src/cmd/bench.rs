@@ -15,8 +15,9 @@ pub struct BenchArgs {
     /// GPU adapter (part of its name); an error with --backend cpu.
     #[arg(long)]
     adapter: Option<String>,
-    /// Particle counts, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![10_000usize, 100_000, 1_000_000])]
+    /// Particle counts, comma-separated, each at least 16 (the bench
+    /// square's smallest: 2 × 2 cells of 2 × 2 particles).
+    #[arg(long, value_delimiter = ',', value_parser = parse_particles, default_values_t = vec![10_000usize, 100_000, 1_000_000])]
     particles: Vec<usize>,
     /// Cases, comma-separated: linear, ugimp, lme-g2, lme-g3, lme-g4, and
     /// lme-g3-stored (GPU: LME weights stored per slot instead of recomputed),
@@ -27,8 +28,9 @@ pub struct BenchArgs {
     /// default).
     #[arg(long, value_delimiter = ',', default_values_t = ["linear", "ugimp", "lme-g2", "lme-g3", "lme-g4"].map(String::from).to_vec())]
     cases: Vec<String>,
-    /// Seconds of stepping per point (after one warm-up step).
-    #[arg(long, default_value_t = 2.0)]
+    /// Seconds of stepping per point (after one warm-up step): more than 0,
+    /// at most 3600.
+    #[arg(long, default_value_t = 2.0, value_parser = parse_seconds)]
     seconds: f64,
     /// Folder for bench.csv.
     #[arg(long, default_value = "out/bench")]
@@ -46,6 +48,44 @@ pub struct BenchArgs {
     /// "../shared/bench/peer.sh vulkan" (Taichi's MLS-MPM, installed on first use).
     #[arg(long, value_name = "COMMAND")]
     peer: Option<String>,
+}
+
+/// The smallest particle count the bench square holds (`bench::scene`:
+/// at least 2 × 2 cells of 2 × 2 particles); a smaller request would
+/// measure this many under another name.
+const MIN_PARTICLES: usize = 16;
+/// The longest `--seconds` per point: an hour.
+const MAX_SECONDS: f64 = 3600.0;
+
+/// `--seconds`: a finite time in (0, MAX_SECONDS]. NaN or 0 measured no
+/// step and reported 0 particle-steps/s; infinity ran to the step cap.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of seconds"))?;
+    if v.is_finite() && v > 0.0 && v <= MAX_SECONDS {
+        Ok(v)
+    } else {
+        Err(format!(
+            "`{s}` is not a number of seconds in (0, {MAX_SECONDS}] (the stepping time of each point)"
+        ))
+    }
+}
+
+/// One `--particles` count: at least MIN_PARTICLES.
+fn parse_particles(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a particle count"))?;
+    if n >= MIN_PARTICLES {
+        Ok(n)
+    } else {
+        Err(format!(
+            "{n} particles: the bench square holds at least {MIN_PARTICLES} (2 x 2 cells of 2 x 2 particles)"
+        ))
+    }
 }
 
 /// `--backend` of `lme-mpm bench`.

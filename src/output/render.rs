@@ -3,9 +3,9 @@
 //! an MP4 when `ffmpeg` is on the PATH), in `DIR/render/` unless told
 //! otherwise. Each particle is drawn as its domain (a square of its
 //! current area) coloured by the chosen field on one colour scale for the
-//! whole run, with a colour bar, the time, the walls (their line, the side
-//! behind it shaded) and the prescribed-velocity regions, on one fixed
-//! frame that holds every snapshot's particles.
+//! whole run, with a colour bar, the time, the walls acting at that time
+//! (their line, the side behind it shaded) and the prescribed-velocity
+//! regions, on one fixed frame that holds every snapshot's particles.
 //!
 //! The particles are rasterised straight into the image buffer; plotters
 //! draws the axes, colour bar, walls and text around them. The GIF uses a
@@ -71,6 +71,9 @@ pub struct RenderOptions {
     pub out: Option<PathBuf>,
     /// Every how many snapshots a frame (default 1; the last is always drawn).
     pub every: usize,
+    /// Print the estimate of the output's size and time to stderr once the
+    /// first frame is drawn (default true).
+    pub say_estimate: bool,
 }
 
 impl Default for RenderOptions {
@@ -81,7 +84,79 @@ impl Default for RenderOptions {
             width: 800,
             out: None,
             every: 1,
+            say_estimate: true,
         }
+    }
+}
+
+/// The image widths `render` draws (pixels): below 320 the axes, colour
+/// bar and title leave no room for the particles; above 4096 one frame
+/// is over 60 MB of pixels, and plotters' buffer and the GIF's 16-bit
+/// sizes end not far beyond.
+pub const WIDTH: std::ops::RangeInclusive<u32> = 320..=4096;
+/// Frames per second of the animation: a GIF's delay is a whole number
+/// of hundredths of a second from 2 (50 frames/s) to 1000 (10 s a frame,
+/// 0.1 frames/s).
+pub const FPS: std::ops::RangeInclusive<f64> = 0.1..=50.0;
+
+/// `--width`: a number of pixels in `WIDTH`.
+pub fn parse_width(s: &str) -> std::result::Result<u32, String> {
+    let v: u64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a width in pixels"))?;
+    match u32::try_from(v) {
+        Ok(w) if WIDTH.contains(&w) => Ok(w),
+        _ => Err(format!(
+            "{v} pixels: the width must be in {}..={} pixels",
+            WIDTH.start(),
+            WIDTH.end()
+        )),
+    }
+}
+
+/// `--fps`: a finite rate in `FPS`.
+pub fn parse_fps(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of frames per second"))?;
+    if FPS.contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v} frames/s: the rate must be in {}..={} frames per second",
+            FPS.start(),
+            FPS.end()
+        ))
+    }
+}
+
+/// `--every`: a whole number, at least 1.
+pub fn parse_every(s: &str) -> std::result::Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "`{s}`: draw every N-th snapshot, N a whole number of at least 1"
+        )),
+    }
+}
+
+impl RenderOptions {
+    /// The options' values against the ranges above, each failure naming
+    /// its flag (exit 2).
+    fn check(&self) -> Result<()> {
+        let bad = |flag: &str, why: String| Err(Error::Usage(format!("--{flag}: {why}")));
+        if !WIDTH.contains(&self.width) {
+            return bad("width", parse_width(&self.width.to_string()).unwrap_err());
+        }
+        if !FPS.contains(&self.fps) {
+            return bad("fps", parse_fps(&self.fps.to_string()).unwrap_err());
+        }
+        if self.every == 0 {
+            return bad("every", parse_every("0").unwrap_err());
+        }
+        Ok(())
     }
 }
 
@@ -98,6 +173,8 @@ pub struct Rendered {
     pub range: (f64, f64),
     /// Whether values above the scale's top were drawn at its colour.
     pub clipped: bool,
+    /// What the first frame said of the whole render's size and time.
+    pub estimate: Estimate,
 }
 
 /// One snapshot, reduced to what a frame draws.
@@ -107,6 +184,12 @@ struct Snapshot {
     value: Vec<f32>,
     /// Side of each particle's square (m).
     side: Vec<f32>,
+}
+
+/// Whether wall `w` acts at the snapshot time `t`: the rule of
+/// `model::walls::Wall::active_at` (a gate is drawn until it goes).
+fn acts(w: &crate::scene::schema::WallSpec, t: f64) -> bool {
+    w.appear_at <= t && w.remove_at.is_none_or(|r| t < r)
 }
 
 fn folder_error(msg: String) -> Error {
@@ -198,7 +281,7 @@ const BOTTOM_H: u32 = 46;
 const MARGIN: u32 = 10;
 
 fn layout(frame: Frame, width: u32) -> Layout {
-    let width = width.max(320);
+    let width = width.max(*WIDTH.start());
     let plot_w = f64::from(width - LEFT_W - BAR_W - 2 * MARGIN);
     let [mut x0, mut y0, mut x1, mut y1] = frame;
     let mut scale = plot_w / (x1 - x0);
@@ -333,13 +416,15 @@ fn wall_line(frame: Frame, point: [f64; 2], normal: [f64; 2]) -> Option<[(f64, f
     (on.len() >= 2).then(|| [on[0], on[on.len() - 1]])
 }
 
-/// Draws what surrounds the particles (`overlay` false: the background,
-/// axes, shaded wall sides, regions and colour bar; true: the wall lines,
-/// region outlines and the title), returning the plot area in pixels.
+/// Draws what surrounds the particles at time `t` (`overlay` false: the
+/// background, axes, shaded sides of the walls acting at `t`, regions and
+/// colour bar; true: those walls' lines, region outlines and the title),
+/// returning the plot area in pixels.
 fn chrome(
     buf: &mut [u8],
     l: &Layout,
     scene: &Scene,
+    t: f64,
     (range, clipped): ((f64, f64), bool),
     title: &str,
     overlay: bool,
@@ -361,7 +446,7 @@ fn chrome(
     let (px, py) = chart.plotting_area().get_pixel_range();
     let area = [px.start, py.start, px.end, py.end];
     if overlay {
-        for w in scene.file.walls.values() {
+        for w in scene.file.walls.values().filter(|w| acts(w, t)) {
             if let Some([a, b]) = wall_line(l.frame, w.point, w.normal) {
                 chart
                     .draw_series(std::iter::once(PathElement::new(
@@ -406,7 +491,7 @@ fn chrome(
         .light_line_style(RGBColor(245, 245, 245))
         .draw()
         .map_err(|x| e(&x))?;
-    for w in scene.file.walls.values() {
+    for w in scene.file.walls.values().filter(|w| acts(w, t)) {
         let poly = behind(l.frame, w.point, w.normal);
         if poly.len() >= 3 {
             chart
@@ -514,6 +599,7 @@ fn paint(
 
 /// Renders the snapshots of the run in `dir`.
 pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
+    opts.check()?;
     register_font();
     let scene_path = dir.join("scene.resolved.toml");
     let text = std::fs::read_to_string(&scene_path).map_err(|e| {
@@ -536,7 +622,7 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
         ))
     })?;
     let all = read_pvd(&pvd);
-    let every = opts.every.max(1);
+    let every = opts.every;
     let entries: Vec<(f64, String)> = all
         .iter()
         .enumerate()
@@ -628,38 +714,130 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
     let range = (lo, hi);
     let l = layout(frame, opts.width);
     let (w, h) = l.size;
-    let mut background = vec![255u8; (w * h * 3) as usize];
-    let area = chrome(&mut background, &l, &scene, (range, clipped), "", false)
-        .map_err(|e| Error::io("cannot draw", dir, std::io::Error::other(e)))?;
+    // One background per set of walls acting: a gate is drawn until its
+    // removal time and not after.
+    let mut backgrounds: std::collections::BTreeMap<Vec<bool>, (Vec<u8>, [i32; 4])> =
+        Default::default();
+    let acting = |t: f64| -> Vec<bool> { scene.file.walls.values().map(|w| acts(w, t)).collect() };
+    for s in &snaps {
+        if let std::collections::btree_map::Entry::Vacant(e) = backgrounds.entry(acting(s.t)) {
+            let mut buf = vec![255u8; (w * h * 3) as usize];
+            let area = chrome(&mut buf, &l, &scene, s.t, (range, clipped), "", false)
+                .map_err(|e| Error::io("cannot draw", dir, std::io::Error::other(e)))?;
+            e.insert((buf, area));
+        }
+    }
     let out = opts.out.clone().unwrap_or_else(|| dir.join("render"));
     std::fs::create_dir_all(&out).map_err(|e| Error::io("cannot create", &out, e))?;
     let palette = Palette::new();
     let slug = opts.field.slug();
-    let frames: Vec<(PathBuf, Vec<u8>)> = snaps
-        .par_iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let mut buf = background.clone();
-            paint(&mut buf, w, area, l.frame, s, range);
-            let title = format!("{}: {}, t = {} s", scene.name, opts.field.label(), num(s.t));
-            chrome(&mut buf, &l, &scene, (range, clipped), &title, true)
-                .map_err(|e| Error::io("cannot draw", dir, std::io::Error::other(e)))?;
-            let path = out.join(format!("{slug}_{k:05}.png"));
-            crate::output::write_atomic(&path, &crate::chart::png_bytes(&buf, l.size)?)?;
-            Ok((path, palette.index(&buf)))
-        })
-        .collect::<Result<_>>()?;
+    // Frame k: its PNG written, its size, and its palette indices for the GIF.
+    let draw = |k: usize, s: &Snapshot| -> Result<(PathBuf, usize, Vec<u8>)> {
+        let (background, area) = &backgrounds[&acting(s.t)];
+        let mut buf = background.clone();
+        paint(&mut buf, w, *area, l.frame, s, range);
+        let title = format!("{}: {}, t = {} s", scene.name, opts.field.label(), num(s.t));
+        chrome(&mut buf, &l, &scene, s.t, (range, clipped), &title, true)
+            .map_err(|e| Error::io("cannot draw", dir, std::io::Error::other(e)))?;
+        let path = out.join(format!("{slug}_{k:05}.png"));
+        let png = crate::chart::png_bytes(&buf, l.size)?;
+        crate::output::write_atomic(&path, &png)?;
+        Ok((path, png.len(), palette.index(&buf)))
+    };
+    // The first frame alone: from its size and time, what the whole render
+    // will write and take, said before the rest is drawn.
+    let first_start = std::time::Instant::now();
+    let first = draw(0, &snaps[0])?;
+    let estimate = Estimate {
+        frames: snaps.len(),
+        size: l.size,
+        first_png: first.1,
+        first_seconds: first_start.elapsed().as_secs_f64(),
+        threads: rayon::current_num_threads(),
+    };
+    if opts.say_estimate {
+        eprintln!("render: {}", estimate.text());
+    }
     let gif = out.join(format!("{slug}.gif"));
-    write_gif(&gif, &frames, &palette, l.size, opts.fps)?;
+    let mut anim = Gif::new(&gif, &palette, l.size, opts.fps, snaps.len())?;
+    let mut frames = vec![first.0];
+    anim.push(first.2)?;
+    // The rest a few frames at a time, in parallel, each batch handed to
+    // the GIF in order: the frames' pixels are held a batch at a time,
+    // never the whole run's.
+    let batch = 2 * estimate.threads.max(1);
+    for (c, chunk) in snaps[1..].chunks(batch).enumerate() {
+        let drawn: Vec<_> = chunk
+            .par_iter()
+            .enumerate()
+            .map(|(j, s)| draw(1 + c * batch + j, s))
+            .collect::<Result<_>>()?;
+        for (path, _, idx) in drawn {
+            frames.push(path);
+            anim.push(idx)?;
+        }
+    }
+    anim.finish()?;
     let mp4 = mp4(&out, slug, opts.fps);
     Ok(Rendered {
-        frames: frames.into_iter().map(|f| f.0).collect(),
+        frames,
         gif,
         mp4,
         particles: snaps.iter().map(|s| s.x.len()).max().unwrap_or(0),
         range,
         clipped,
+        estimate,
     })
+}
+
+/// What a render will write and take, from its first frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Estimate {
+    pub frames: usize,
+    /// Pixels of each frame (width, height).
+    pub size: (u32, u32),
+    /// Bytes of the first frame's PNG.
+    pub first_png: usize,
+    /// Seconds the first frame took to draw and write.
+    pub first_seconds: f64,
+    pub threads: usize,
+}
+
+impl Estimate {
+    /// Bytes of the PNG frames: frames × the first frame's.
+    pub fn png_bytes(&self) -> f64 {
+        self.frames as f64 * self.first_png as f64
+    }
+
+    /// The GIF's uncompressed size, one byte a pixel a frame: its LZW
+    /// frames of what changed come out smaller.
+    pub fn gif_bytes_at_most(&self) -> f64 {
+        self.frames as f64 * f64::from(self.size.0) * f64::from(self.size.1)
+    }
+
+    pub fn text(&self) -> String {
+        let (w, h) = self.size;
+        let seconds = self.first_seconds * self.frames as f64 / self.threads.max(1) as f64;
+        format!(
+            "{} frames of {w} x {h} px: about {} of PNG frames ({} each) and a GIF under {}, \
+             in about {:.0} s",
+            self.frames,
+            bytes(self.png_bytes()),
+            bytes(self.first_png as f64),
+            bytes(self.gif_bytes_at_most()),
+            seconds.max(1.0)
+        )
+    }
+}
+
+/// A size in bytes, KB, MB or GB (powers of 1000).
+fn bytes(b: f64) -> String {
+    match b {
+        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
+        b if b >= 1e3 => format!("{:.0} KB", b / 1e3),
+        b => format!("{b:.0} B"),
+    }
 }
 
 /// `lme-mpm render`: renders, says what it wrote and how long it took,
@@ -679,6 +857,7 @@ pub fn command(
         width,
         out,
         every,
+        say_estimate: true,
     };
     match render(dir, &opts) {
         Ok(r) => {
@@ -711,53 +890,89 @@ pub fn command(
     }
 }
 
-fn write_gif(
-    path: &Path,
-    frames: &[(PathBuf, Vec<u8>)],
-    palette: &Palette,
-    size: (u32, u32),
-    fps: f64,
-) -> Result<()> {
-    let e = |e: &dyn std::fmt::Display| {
-        Error::io("cannot write", path, std::io::Error::other(e.to_string()))
-    };
-    let flat: Vec<u8> = palette.rgb.iter().flatten().copied().collect();
-    let mut bytes = Vec::new();
-    {
-        let mut enc = gif::Encoder::new(&mut bytes, size.0 as u16, size.1 as u16, &flat)
-            .map_err(|x| e(&x))?;
-        enc.set_repeat(gif::Repeat::Infinite).map_err(|x| e(&x))?;
-        // GIF delays are in hundredths of a second.
-        let delay = (100.0 / fps.max(0.1)).round().clamp(2.0, 65535.0) as u16;
-        let w = size.0 as usize;
-        for (k, (_, idx)) in frames.iter().enumerate() {
-            // After the first frame, only the rectangle that changed (the
-            // rest stays on screen: disposal `Keep`).
-            let [x0, y0, x1, y1] = match k {
-                0 => [0, 0, w, size.1 as usize],
-                _ => changed(&frames[k - 1].1, idx, w),
-            };
-            let sub: Vec<u8> = (y0..y1)
-                .flat_map(|y| idx[y * w + x0..y * w + x1].iter().copied())
-                .collect();
-            let mut f = gif::Frame {
-                left: x0 as u16,
-                top: y0 as u16,
-                width: (x1 - x0) as u16,
-                height: (y1 - y0) as u16,
-                buffer: std::borrow::Cow::Owned(sub),
-                delay,
-                dispose: gif::DisposalMethod::Keep,
-                ..Default::default()
-            };
-            if k + 1 == frames.len() {
-                // Hold the last frame a second before the loop restarts.
-                f.delay = delay.max(100);
-            }
-            enc.write_frame(&f).map_err(|x| e(&x))?;
-        }
+/// The animated GIF, fed frame by frame (palette indices), holding only
+/// the last frame's indices and the encoded bytes.
+struct Gif<'a> {
+    path: &'a Path,
+    enc: gif::Encoder<Vec<u8>>,
+    last: Option<Vec<u8>>,
+    width: usize,
+    delay: u16,
+    frames: usize,
+    pushed: usize,
+}
+
+impl<'a> Gif<'a> {
+    fn new(
+        path: &'a Path,
+        palette: &Palette,
+        size: (u32, u32),
+        fps: f64,
+        frames: usize,
+    ) -> Result<Gif<'a>> {
+        let flat: Vec<u8> = palette.rgb.iter().flatten().copied().collect();
+        // `WIDTH` keeps both sizes within the GIF's 16 bits.
+        let (w, h) = (
+            u16::try_from(size.0).map_err(|_| gif_error(path, "too wide"))?,
+            u16::try_from(size.1).map_err(|_| gif_error(path, "too tall"))?,
+        );
+        let mut enc = gif::Encoder::new(Vec::new(), w, h, &flat).map_err(|x| gif_error(path, x))?;
+        enc.set_repeat(gif::Repeat::Infinite)
+            .map_err(|x| gif_error(path, x))?;
+        Ok(Gif {
+            path,
+            enc,
+            last: None,
+            width: size.0 as usize,
+            // GIF delays are in hundredths of a second.
+            delay: (100.0 / fps.max(0.1)).round().clamp(2.0, 65535.0) as u16,
+            frames,
+            pushed: 0,
+        })
     }
-    crate::output::write_atomic(path, &bytes)
+
+    fn push(&mut self, idx: Vec<u8>) -> Result<()> {
+        let w = self.width;
+        // After the first frame, only the rectangle that changed (the rest
+        // stays on screen: disposal `Keep`).
+        let [x0, y0, x1, y1] = match &self.last {
+            None => [0, 0, w, idx.len() / w],
+            Some(last) => changed(last, &idx, w),
+        };
+        let sub: Vec<u8> = (y0..y1)
+            .flat_map(|y| idx[y * w + x0..y * w + x1].iter().copied())
+            .collect();
+        let mut f = gif::Frame {
+            left: x0 as u16,
+            top: y0 as u16,
+            width: (x1 - x0) as u16,
+            height: (y1 - y0) as u16,
+            buffer: std::borrow::Cow::Owned(sub),
+            delay: self.delay,
+            dispose: gif::DisposalMethod::Keep,
+            ..Default::default()
+        };
+        self.pushed += 1;
+        if self.pushed == self.frames {
+            // Hold the last frame a second before the loop restarts.
+            f.delay = self.delay.max(100);
+        }
+        self.enc
+            .write_frame(&f)
+            .map_err(|x| gif_error(self.path, x))?;
+        self.last = Some(idx);
+        Ok(())
+    }
+
+    fn finish(self) -> Result<()> {
+        let path = self.path;
+        let bytes = self.enc.into_inner().map_err(|x| gif_error(path, x))?;
+        crate::output::write_atomic(path, &bytes)
+    }
+}
+
+fn gif_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::io("cannot write", path, std::io::Error::other(e.to_string()))
 }
 
 /// The smallest rectangle [x0, y0, x1, y1) holding every pixel where `a`

@@ -644,6 +644,14 @@ pub enum MlsScope {
     Force,
 }
 
+impl SolverSpec {
+    /// Every key at its default (`t_end` 1 s, which has none): what a
+    /// scene that does not set a key runs with.
+    pub fn defaults() -> SolverSpec {
+        toml::from_str("t_end = 1.0").expect("the solver's defaults deserialise")
+    }
+}
+
 fn default_gmm_search_radius() -> f64 {
     crate::limits::GMM_SEARCH_RADIUS_DEFAULT
 }

@@ -57,12 +57,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         .name
         .clone()
         .unwrap_or_else(|| default_name.to_string());
-    if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
-        return Err(SceneError::invalid(
-            "name",
-            format!("must be a plain folder name (no slashes), got {name:?}"),
-        ));
-    }
+    folder_name(&name)?;
 
     check_solver(&file)?;
     check_gmm(&file)?;
@@ -77,6 +72,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     let sample_interval = check_output(&file)?;
     check_manufactured_section(&mut file)?;
     check_solver_options(&file)?;
+    check_keys_apply(&file)?;
     if let Some(kind) = file.exact {
         check_exact(&file, kind)?;
     }
@@ -104,6 +100,46 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
         sample_interval,
         chosen,
     })
+}
+
+/// The longest `name`, in bytes: a folder name's limit on Linux and macOS
+/// (NAME_MAX), less the `.tmp` that atomic writes append beside it.
+pub const NAME_MAX_BYTES: usize = 255 - ".tmp".len();
+
+/// `name` is the run's folder (`out/<name>`): a name a folder can hold,
+/// checked here so that `check` refuses what `run` could not create.
+fn folder_name(name: &str) -> Result<(), SceneError> {
+    let why = if name.is_empty() || name == "." || name == ".." {
+        Some("is not a folder name".to_string())
+    } else if let Some(c) = name
+        .chars()
+        .find(|c| matches!(c, '/' | '\\') || c.is_control())
+    {
+        Some(format!(
+            "holds {c:?}; a folder name holds no slash, backslash, NUL or other control character"
+        ))
+    } else if name.len() > NAME_MAX_BYTES {
+        Some(format!(
+            "is {} bytes long; a folder name holds at most {NAME_MAX_BYTES}",
+            name.len()
+        ))
+    } else {
+        None
+    };
+    match why {
+        Some(why) => Err(SceneError::invalid(
+            "name",
+            format!(
+                "must be a plain folder name (outputs go to out/<name>): {name:?} {why}",
+                name = if name.len() > 40 {
+                    format!("{}…", name.chars().take(40).collect::<String>())
+                } else {
+                    name.to_string()
+                }
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// `[solver]`: times, Courant number, integrator and shape parameters.
@@ -954,6 +990,120 @@ fn check_solver_options(file: &SceneFile) -> Result<(), SceneError> {
         ));
     }
     Ok(())
+}
+
+/// One rule for keys that only some settings read: a key set under
+/// settings that never read it is refused, naming the key and what would
+/// make it apply, rather than ignored. "Set" is a value other than the
+/// key's default (the defaults are filled in on reading, and a resolved
+/// scene file holds them all), or any value of an optional key. Keys
+/// refused elsewhere by the same rule: `solver.pic_fraction`,
+/// `solver.local_damping`, `solver.volumetric_strain`, `solver.static`,
+/// `solver.bspline_knots`, the grid MLS keys with `method = "gmm"`, a
+/// wall's or contact pair's `friction`, a body's `k0`.
+fn check_keys_apply(file: &SceneFile) -> Result<(), SceneError> {
+    let d = SolverSpec::defaults();
+    let s = &file.solver;
+    let implicit = s.integrator == IntegratorKind::Implicit;
+    let npc = s.integrator == IntegratorKind::Npc;
+    let gmm = s.method == SolverMethod::Gmm;
+    const IMPLICIT: &str = "solver.integrator = \"implicit\"";
+    const NPC: &str = "solver.integrator = \"npc\"";
+    const MLS: &str = "solver.mls = true";
+    const GMM: &str = "solver.method = \"gmm\" (with integrator = \"implicit\")";
+    // (key, set, read under the scene's settings, what makes it read)
+    let keys: [(&str, bool, bool, &str); 16] = [
+        (
+            "gravity.ramp_period",
+            file.gravity
+                .as_ref()
+                .is_some_and(|g| g.ramp_period.is_some()),
+            file.gravity.as_ref().is_some_and(|g| g.ramp == Ramp::Sine),
+            "gravity.ramp = \"sine\"",
+        ),
+        (
+            "solver.mls_support",
+            s.mls_support != d.mls_support,
+            s.mls,
+            MLS,
+        ),
+        ("solver.mls_scope", s.mls_scope != d.mls_scope, s.mls, MLS),
+        ("solver.npc_gamma", s.npc_gamma != d.npc_gamma, npc, NPC),
+        (
+            "solver.npc_position",
+            s.npc_position != d.npc_position,
+            npc,
+            NPC,
+        ),
+        (
+            "solver.newmark_beta",
+            s.newmark_beta != d.newmark_beta,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.newmark_gamma",
+            s.newmark_gamma != d.newmark_gamma,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.newton_tol",
+            s.newton_tol != d.newton_tol,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.newton_max_iter",
+            s.newton_max_iter != d.newton_max_iter,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.newton_max_cuts",
+            s.newton_max_cuts != d.newton_max_cuts,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.newton_jacobian",
+            s.newton_jacobian != d.newton_jacobian,
+            implicit,
+            IMPLICIT,
+        ),
+        (
+            "solver.load_steps",
+            s.load_steps != d.load_steps,
+            implicit && s.static_analysis,
+            "solver.static = true (with integrator = \"implicit\")",
+        ),
+        (
+            "solver.implicit_start",
+            s.implicit_start != d.implicit_start,
+            implicit && !s.static_analysis,
+            "a dynamic implicit run (integrator = \"implicit\", static = false)",
+        ),
+        ("solver.gmm_basis", s.gmm_basis != d.gmm_basis, gmm, GMM),
+        (
+            "solver.gmm_search_radius",
+            s.gmm_search_radius != d.gmm_search_radius,
+            gmm,
+            GMM,
+        ),
+        (
+            "solver.gmm_dilation",
+            s.gmm_dilation != d.gmm_dilation,
+            gmm && s.gmm_basis == GmmBasis::Mls,
+            "solver.method = \"gmm\" with gmm_basis = \"mls\"",
+        ),
+    ];
+    match keys.iter().find(|(_, set, read, _)| *set && !*read) {
+        Some((key, _, _, needs)) => Err(SceneError::invalid(
+            *key,
+            format!("has no effect here: it is read only with {needs}; drop it, or set that"),
+        )),
+        None => Ok(()),
+    }
 }
 
 fn bname_key(bname: &str) -> String {
