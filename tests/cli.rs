@@ -899,3 +899,90 @@ fn small_input_holes_exit_2_naming_what_is_wrong() {
     );
     assert!(!out.exists());
 }
+
+/// Shapes of different bodies that overlap, whatever their kinds, exit 2
+/// naming both and where (the seeder would cut the overlap from one body
+/// in silence); the shipped contact cases, whose bodies are flush, pass.
+#[test]
+fn overlapping_bodies_exit_2_naming_both_and_where() {
+    let check = |case: &str, sets: &[&str]| {
+        let mut c = bin();
+        c.arg("check").arg(common::case(case));
+        for s in sets {
+            c.arg("--set").arg(s);
+        }
+        let o = c.output().unwrap();
+        (o.status.code(), stderr(&o))
+    };
+    // (what, case, --set, the two shapes named, where)
+    type Overlap<'a> = (&'a str, &'a str, Vec<&'a str>, [&'a str; 2], &'a str);
+    let cases: Vec<Overlap> = vec![
+        (
+            "disk sunk into a slab",
+            "contact_rolling.toml",
+            vec!["bodies.disk.disks=[[0.0, 0.65, 0.5]]"],
+            ["bodies.disk.disks[0]", "bodies.slab.rects[0]"],
+            "at (0.000000, 0.250000), 0.100000 m deep",
+        ),
+        (
+            "ring-seeded disks overlapping",
+            "contact_disks.toml",
+            vec!["bodies.right.disks=[[0.6, 0.5, 0.2]]"],
+            ["bodies.left.disks[0]", "bodies.right.disks[0]"],
+            "at (0.450000, 0.500000), 0.100000 m deep",
+        ),
+        (
+            "a disk wholly inside another body's",
+            "contact_disks.toml",
+            vec!["bodies.right.disks=[[0.3, 0.5, 0.1]]"],
+            ["bodies.left.disks[0]", "bodies.right.disks[0]"],
+            "0.200000 m deep",
+        ),
+        (
+            "a polygon inside another body's disk",
+            "contact_disks.toml",
+            vec!["bodies.right.polygons=[[[0.2, 0.4], [0.4, 0.4], [0.3, 0.6]]]"],
+            ["bodies.left.disks[0]", "bodies.right.polygons[0]"],
+            "at (0.300000, 0.500000)",
+        ),
+        (
+            "a polygon crossing another body's rectangle",
+            "footing.toml",
+            vec!["bodies.footing.polygons=[[[-0.2, 2.0], [0.2, 2.0], [0.0, 1.8]]]"],
+            ["bodies.footing.polygons[0]", "bodies.soil.rects[0]"],
+            "another body",
+        ),
+        (
+            "rectangles of two bodies",
+            "contact_block.toml",
+            vec!["bodies.block.rects=[[0.2, 0.4, 1.2, 0.9]]"],
+            ["bodies.block.rects[0]", "bodies.slab.rects[0]"],
+            "over [0.2, 0.4, 1.2, 0.5]",
+        ),
+    ];
+    for (what, case, sets, names, place) in &cases {
+        let (code, msg) = check(case, sets);
+        assert_eq!(code, Some(2), "{what}: {msg}");
+        for n in names {
+            assert!(msg.contains(n), "{what}: {msg}");
+        }
+        assert!(msg.contains(place), "{what}: {msg}");
+        assert!(msg.contains("may touch but not overlap"), "{what}: {msg}");
+    }
+    // Flush bodies (the rolling disk on its slab, the block and the footing
+    // on theirs) and a body's own overlapping shapes are accepted.
+    for case in [
+        "contact_block.toml",
+        "contact_disks.toml",
+        "contact_rolling.toml",
+        "footing.toml",
+    ] {
+        let (code, msg) = check(case, &[]);
+        assert_eq!(code, Some(0), "{case}: {msg}");
+    }
+    let (code, msg) = check(
+        "contact_disks.toml",
+        &["bodies.right.polygons=[[[0.6, 0.6], [0.8, 0.6], [0.7, 0.8]]]"],
+    );
+    assert_eq!(code, Some(0), "own shapes: {msg}");
+}

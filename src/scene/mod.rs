@@ -3,6 +3,7 @@
 //! value known to be in range; `model::Model::new` turns it into particles
 //! and a grid.
 
+pub mod overlap;
 pub mod overrides;
 pub mod schema;
 pub mod seed;
