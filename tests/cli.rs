@@ -986,3 +986,59 @@ fn overlapping_bodies_exit_2_naming_both_and_where() {
     );
     assert_eq!(code, Some(0), "own shapes: {msg}");
 }
+
+/// `check` says what a scene models: the contact pairs and the nodes each
+/// backend holds (one copy per field), walls and their laws, gravity and
+/// its ramp, initial stress, disk layouts, how far a prescribed region
+/// travels; units only where there are units.
+#[test]
+fn check_describes_what_the_scene_models() {
+    let check = |case: &str| {
+        let o = bin().arg("check").arg(common::case(case)).output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{case}: {}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let disks = check("contact_disks.toml");
+    for want in [
+        "nodes       3233 per field x 3 fields (one per body in a contact pair, one for the rest) = 9699, on the CPU and the GPU alike",
+        "contact     impact: left / right (slip (frictionless))",
+        "disks on rings at spacing h/ppc",
+        "gravity     none",
+        "3233 nodes x 3 fields",
+        "E = 10000000 Pa, nu = 0.3)",
+    ] {
+        assert!(disks.contains(want), "no `{want}` in\n{disks}");
+    }
+    let footing = check("footing.toml");
+    for want in [
+        "= 16059, on",
+        "5353 per field x 3 fields",
+        "contact     interface: ",
+    ] {
+        assert!(footing.contains(want), "no `{want}` in\n{footing}");
+    }
+    let block = check("contact_block.toml");
+    for want in [
+        "walls       floor (through (0, 0) m, normal (0, 1); stick;",
+        "contact     interface: block / slab (friction, mu = 0.2)",
+        "gravity     g = (4.905, -8.495709211) m/s^2, ramped (sine) to full at t = 0.1 s",
+    ] {
+        assert!(block.contains(want), "no `{want}` in\n{block}");
+    }
+    let clay = check("clay_biaxial.toml");
+    assert!(
+        clay.contains(
+            "platen (fixes y; 51 nodes; at v = (0, -0.02) m/s, ramped over 0.5 s, its region \
+             travels (0.000000, -0.095000) m by t_end (0.76 cells)"
+        ),
+        "{clay}"
+    );
+    // No key's value followed by the unit "1" (it printed "nu = 0.3 1").
+    for text in [&disks, &footing, &block, &clay] {
+        let line = text.lines().find(|l| l.starts_with("materials")).unwrap();
+        for kv in line.split([',', '(', ')']).filter(|kv| kv.contains(" = ")) {
+            let after = kv.split(" = ").nth(1).unwrap().trim();
+            assert!(!after.ends_with(" 1"), "`{kv}` has the unit 1 in\n{line}");
+        }
+    }
+}
