@@ -12,6 +12,7 @@
 // CPU twin: `exchange` in src/cpu/contact.rs.
 #include "shared/common.wgsl"
 #include "shared/contact.wgsl"
+#include "shared/constraint_region.wgsl"
 
 @group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
 #if CONSTRAINT_POINTS
@@ -25,12 +26,12 @@
 #include "shared/atomics.wgsl" ARR=reactions FN=reaction_add
 #endif
 
-// Whether some constraint fixes a component of node (i, j) (the CPU's
-// `fix[i] != 0`; grid_update.wgsl's `fix_bits` ≠ 0).
-fn node_fixed(i: u32, j: u32) -> bool {
+// Whether some constraint fixes a component of node (i, j) at time t (s)
+// (the CPU's `fix[i] != 0`; grid_update.wgsl's `fix_bits` ≠ 0).
+fn node_fixed(i: u32, j: u32, t: f32) -> bool {
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
-        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 && c.fix != 0u {
+        if c.fix != 0u && in_region(c, i, j, t) {
 #if CONSTRAINT_POINTS
             if freed(g, i, j) {
                 continue;
@@ -63,7 +64,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if sim.running == 0u || i >= params.n_nodes {
         return;
     }
-    if node_fixed(i % params.nx, i / params.nx) {
+    if node_fixed(i % params.nx, i / params.nx, sim.t + sim.t_lo + sim.dt) {
         return;
     }
 #if CORRECT

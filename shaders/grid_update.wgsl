@@ -14,8 +14,10 @@
 // With CONTACT, one invocation per node of every field (the constraints
 // act on each field's copy of their nodes); `contact_exchange.wgsl`
 // follows each entry point.
+// A group with a velocity moves its region with it (`in_region`).
 // CPU twin: src/cpu/grid_update.rs.
 #include "shared/common.wgsl"
+#include "shared/constraint_region.wgsl"
 
 @group(0) @binding({{B_CONSTRAINTS}}) var<storage, read> constraints: array<Constraint>;
 #if CONSTRAINT_POINTS
@@ -32,12 +34,12 @@
 @group(0) @binding({{B_NODE_ACC}}) var<storage, read_write> node_acc: array<f32>;
 #endif
 
-// Fixed directions of node (i, j): bit 1 = x, bit 2 = y.
-fn fix_bits(i: u32, j: u32) -> u32 {
+// Fixed directions of node (i, j) at time t (s): bit 1 = x, bit 2 = y.
+fn fix_bits(i: u32, j: u32, t: f32) -> u32 {
     var f = 0u;
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
-        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+        if in_region(c, i, j, t) {
 #if CONSTRAINT_POINTS
             if freed(g, i, j) {
                 continue;
@@ -56,7 +58,7 @@ fn prescribe(i: u32, j: u32, v_in: vec2<f32>, t: f32) -> vec2<f32> {
     var v = v_in;
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
-        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+        if in_region(c, i, j, t) {
 #if CONSTRAINT_POINTS
             if freed(g, i, j) {
                 continue;
@@ -96,6 +98,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
     let b = n * NODE_STRIDE;
     let m = node_acc[b];
+    // The step's end: where the regions are and their velocities taken.
+    let t = sim.t + sim.t_lo + sim.dt;
 #if CORRECT
     var f = vec2<f32>(node_acc[b + 3u], node_acc[b + 4u]);
 #if WALLS
@@ -103,7 +107,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 #endif
     for (var g = 0u; g < params.n_groups; g++) {
         let c = constraints[g];
-        if i >= c.i0 && i <= c.i1 && j >= c.j0 && j <= c.j1 {
+        if in_region(c, i, j, t) {
 #if CONSTRAINT_POINTS
             if freed(g, i, j) {
                 continue;
@@ -117,7 +121,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
-    let fix = fix_bits(i, j);
+    let fix = fix_bits(i, j, t);
     if (fix & 1u) != 0u {
         f.x = 0.0;
     }
@@ -139,14 +143,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var vel = vec2<f32>(0.0);
     if m > params.mass_eps {
         vel = vec2<f32>(node_acc[b + 1u], node_acc[b + 2u]) / m;
-        let fix = fix_bits(i, j);
+        let fix = fix_bits(i, j, t);
         if (fix & 1u) != 0u {
             vel.x = 0.0;
         }
         if (fix & 2u) != 0u {
             vel.y = 0.0;
         }
-        vel = prescribe(i, j, vel, sim.t + sim.t_lo + sim.dt);
+        vel = prescribe(i, j, vel, t);
     }
     node_acc[b + 1u] = vel.x;
     node_acc[b + 2u] = vel.y;

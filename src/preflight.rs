@@ -96,6 +96,9 @@ pub struct Estimate {
     pub particles: f64,
     pub nx: usize,
     pub ny: usize,
+    /// Copies of the nodes: 1, or with contact pairs 1 + the bodies in a
+    /// pair (`model::contact`), on either backend.
+    pub fields: f64,
     /// First time step (s).
     pub dt: f64,
     /// t_end / dt.
@@ -117,6 +120,7 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// Nodes of the grid (one field's).
     pub fn nodes(&self) -> f64 {
         self.nx as f64 * self.ny as f64
     }
@@ -315,6 +319,7 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         particles: n,
         nx,
         ny,
+        fields: contact_fields(scene).0,
         dt,
         steps,
         snapshots,
@@ -626,8 +631,17 @@ pub fn describe(est: &Estimate) -> String {
         Some((b, what)) => format!(" (limit {}: {what})", mib(b as f64)),
         None => " (no limit known)".to_string(),
     };
+    let fields = if est.fields > 1.0 {
+        format!(
+            " x {:.0} fields (one per body in a contact pair, one for the rest) = {:.0}",
+            est.fields,
+            est.fields * est.nodes()
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "estimate    {:.0} particles, {} x {} = {:.0} nodes, first dt = {:.4e} s, about {:.0} steps\n\
+        "estimate    {:.0} particles, {} x {} = {:.0} nodes{fields}, first dt = {:.4e} s, about {:.0} steps\n\
          estimate    peak memory {}{limit}\n\
          estimate    {:.3e} particle-steps, about {} at {:.1e} particle-steps/s (conservative)\n\
          estimate    {:.0} samples, {:.0} VTK snapshots\n",

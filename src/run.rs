@@ -738,8 +738,11 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
                 .keys
                 .iter()
                 .filter_map(|k| {
-                    m.get(k.name)
-                        .map(|v| format!("{} = {v} {}", k.name, k.unit))
+                    // Dimensionless keys ("1") without a unit.
+                    m.get(k.name).map(|v| match k.unit {
+                        "1" | "" | "-" => format!("{} = {v}", k.name),
+                        unit => format!("{} = {v} {unit}", k.name),
+                    })
                 })
                 .collect();
             format!(
@@ -769,10 +772,156 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             )
         }
     };
+    let f = &scene.file;
+    let backends = match model.integrator {
+        crate::model::Integrator::Implicit(_) => "the CPU (implicit)",
+        _ => "the CPU and the GPU alike",
+    };
+    // The nodes each backend holds: the grid's, once per contact field.
+    let fields = model.contact.as_ref().map_or(1, |c| c.n_fields);
+    let nodes = match &cloud {
+        Some(cl) => format!(
+            "{} of the GMM node cloud (from the grid's {}), on the CPU (implicit)",
+            cl.x.len(),
+            g.n_nodes()
+        ),
+        None if fields > 1 => format!(
+            "{} per field x {fields} fields (one per body in a contact pair, one for the rest) = {}, on {}",
+            g.n_nodes(),
+            g.n_nodes() * fields,
+            backends
+        ),
+        None => format!("{}, on {}", g.n_nodes(), backends),
+    };
+    let law = |contact: u32, mu: f64| match contact {
+        crate::model::walls::CONTACT_STICK => "stick".to_string(),
+        crate::model::walls::CONTACT_SLIP => "slip (frictionless)".to_string(),
+        _ => format!("friction, mu = {mu}"),
+    };
+    let walls = if model.walls.list.is_empty() {
+        "none".to_string()
+    } else {
+        model
+            .walls
+            .list
+            .iter()
+            .map(|w| {
+                let when = match (w.appear_at > 0.0, w.remove_at.is_finite()) {
+                    (false, false) => String::new(),
+                    (a, r) => format!(
+                        ", acting{}{}",
+                        if a {
+                            format!(" from {} s", w.appear_at)
+                        } else {
+                            String::new()
+                        },
+                        if r {
+                            format!(" until {} s", w.remove_at)
+                        } else {
+                            String::new()
+                        }
+                    ),
+                };
+                format!(
+                    "{} (through ({}, {}) m, normal ({}, {}); {}; {} nodes{when})",
+                    w.name,
+                    w.point[0],
+                    w.point[1],
+                    w.normal[0],
+                    w.normal[1],
+                    law(w.contact, w.mu),
+                    w.nodes.len()
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let contact = match &model.contact {
+        None => "none: bodies that touch share one velocity field".to_string(),
+        Some(c) => f
+            .contact
+            .iter()
+            .zip(&c.pairs)
+            .map(|((n, spec), p)| {
+                format!(
+                    "{n}: {} / {} ({})",
+                    spec.bodies[0],
+                    spec.bodies[1],
+                    law(p.law, p.mu)
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+    };
+    let gravity = match &f.gravity {
+        None => "none".to_string(),
+        Some(gr) => format!(
+            "g = ({}, {}) m/s^2, {}",
+            gr.g[0],
+            gr.g[1],
+            match gr.ramp {
+                crate::scene::Ramp::None => "full from t = 0".to_string(),
+                crate::scene::Ramp::Sine => format!(
+                    "ramped (sine) to full at t = {} s",
+                    0.5 * model.gravity.as_ref().map_or(0.0, |g| g.period)
+                ),
+            }
+        ),
+    };
+    let bodies = scene
+        .bodies()
+        .map(|(n, b)| {
+            let mut shapes = Vec::new();
+            let count = |k: usize, one: &str, many: &str| match k {
+                0 => None,
+                1 => Some(format!("1 {one}")),
+                k => Some(format!("{k} {many}")),
+            };
+            shapes.extend(count(b.rects.len(), "rectangle", "rectangles"));
+            shapes.extend(count(b.disks.len(), "disk", "disks"));
+            shapes.extend(count(b.polygons.len(), "polygon", "polygons"));
+            let layout = match scene.layout(b) {
+                crate::scene::Layout::Gauss => "gauss",
+                crate::scene::Layout::Uniform => "uniform",
+            };
+            let disks = if b.disks.is_empty() {
+                String::new()
+            } else {
+                match b.disk_layout {
+                    crate::scene::DiskLayout::Rings => {
+                        ", disks on rings at spacing h/ppc".to_string()
+                    }
+                    crate::scene::DiskLayout::Lattice => {
+                        ", disks on the lattice (its points inside them)".to_string()
+                    }
+                }
+            };
+            let stress = match b.initial_stress {
+                crate::scene::InitialStress::None => String::new(),
+                crate::scene::InitialStress::Geostatic => {
+                    let k0 = b.k0.unwrap_or_else(|| {
+                        crate::model::geostatic::default_k0(&f.materials[&b.material])
+                    });
+                    format!(", initial stress geostatic with k0 = {k0:.4}")
+                }
+            };
+            format!(
+                "{n} ({}, {}; ppc {}, {layout} points{disks}; v0 = ({}, {}) m/s{stress})",
+                shapes.join(", "),
+                b.material,
+                b.ppc,
+                b.velocity[0],
+                b.velocity[1]
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
     format!(
         "scene {name}: valid\n{desc}\
          particles   {np}\n\
          grid        {nx} x {ny} nodes, h = {h} m, from ({x0}, {y0}) to ({x1}, {y1}) m{pert}\n\
+         nodes       {nodes}\n\
+         bodies      {bodies}\n\
          materials   {materials}\n\
          shape       {shape}\n\
          integrator  {integrator}, {step_rule}\n\
@@ -780,6 +929,9 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
          work        about {work:.3e} particle-steps\n\
          memory      {bpp:.0} bytes per particle on the CPU path\n\
          constraints {nc}\n\
+         walls       {walls}\n\
+         contact     {contact}\n\
+         gravity     {gravity}\n\
          probes      {npr}\n\
          exact       {exact}\n",
         name = scene.name,
@@ -810,15 +962,45 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
             .groups
             .iter()
             .enumerate()
-            .map(|(k, c)| match &cloud {
-                Some(cl) => format!("{} ({} nodes of the GMM cloud)", c.name, cl.groups[k].len()),
-                None => format!("{} ({} nodes)", c.name, c.nodes.len()),
+            .map(|(k, c)| {
+                let held = match &cloud {
+                    Some(cl) => format!("{} nodes of the GMM cloud", cl.groups[k].len()),
+                    None => format!("{} nodes", c.nodes.len()),
+                };
+                let fixed = match c.fix {
+                    crate::model::FIX_X => "x",
+                    crate::model::FIX_Y => "y",
+                    _ => "xy",
+                };
+                let moving = if c.moves() {
+                    let d = c.travel(s.t_end);
+                    let ramp = if c.ramp_time > 0.0 {
+                        format!(", ramped over {} s", c.ramp_time)
+                    } else {
+                        String::new()
+                    };
+                    format!(
+                        "; at v = ({}, {}) m/s{ramp}, its region travels ({:.6}, {:.6}) m by t_end \
+                         ({:.2} cells), its nodes moving with it",
+                        if c.fix & crate::model::FIX_X != 0 {
+                            c.velocity[0]
+                        } else {
+                            0.0
+                        },
+                        if c.fix & crate::model::FIX_Y != 0 {
+                            c.velocity[1]
+                        } else {
+                            0.0
+                        },
+                        d[0],
+                        d[1],
+                        d[0].hypot(d[1]) / g.h
+                    )
+                } else {
+                    String::new()
+                };
+                format!("{} (fixes {fixed}; {held}{moving})", c.name)
             })
-            .chain(model.walls.list.iter().map(|w| format!(
-                "wall {} ({} nodes)",
-                w.name,
-                w.nodes.len()
-            )),)
             .collect::<Vec<_>>()
             .join(", "),
         npr = model

@@ -1008,5 +1008,145 @@ fn keys_that_do_not_apply_are_refused_naming_what_would_apply_them() {
         }
         let o = check(scene, &sets);
         assert!(o.status.success(), "{set} with {apply:?}: {}", stderr(&o));
+/// Shapes of different bodies that overlap, whatever their kinds, exit 2
+/// naming both and where (the seeder would cut the overlap from one body
+/// in silence); the shipped contact cases, whose bodies are flush, pass.
+#[test]
+fn overlapping_bodies_exit_2_naming_both_and_where() {
+    let check = |case: &str, sets: &[&str]| {
+        let mut c = bin();
+        c.arg("check").arg(common::case(case));
+        for s in sets {
+            c.arg("--set").arg(s);
+        }
+        let o = c.output().unwrap();
+        (o.status.code(), stderr(&o))
+    };
+    // (what, case, --set, the two shapes named, where)
+    type Overlap<'a> = (&'a str, &'a str, Vec<&'a str>, [&'a str; 2], &'a str);
+    let cases: Vec<Overlap> = vec![
+        (
+            "disk sunk into a slab",
+            "contact_rolling.toml",
+            vec!["bodies.disk.disks=[[0.0, 0.65, 0.5]]"],
+            ["bodies.disk.disks[0]", "bodies.slab.rects[0]"],
+            "at (0.000000, 0.250000), 0.100000 m deep",
+        ),
+        (
+            "ring-seeded disks overlapping",
+            "contact_disks.toml",
+            vec!["bodies.right.disks=[[0.6, 0.5, 0.2]]"],
+            ["bodies.left.disks[0]", "bodies.right.disks[0]"],
+            "at (0.450000, 0.500000), 0.100000 m deep",
+        ),
+        (
+            "a disk wholly inside another body's",
+            "contact_disks.toml",
+            vec!["bodies.right.disks=[[0.3, 0.5, 0.1]]"],
+            ["bodies.left.disks[0]", "bodies.right.disks[0]"],
+            "0.200000 m deep",
+        ),
+        (
+            "a polygon inside another body's disk",
+            "contact_disks.toml",
+            vec!["bodies.right.polygons=[[[0.2, 0.4], [0.4, 0.4], [0.3, 0.6]]]"],
+            ["bodies.left.disks[0]", "bodies.right.polygons[0]"],
+            "at (0.300000, 0.500000)",
+        ),
+        (
+            "a polygon crossing another body's rectangle",
+            "footing.toml",
+            vec!["bodies.footing.polygons=[[[-0.2, 2.0], [0.2, 2.0], [0.0, 1.8]]]"],
+            ["bodies.footing.polygons[0]", "bodies.soil.rects[0]"],
+            "another body",
+        ),
+        (
+            "rectangles of two bodies",
+            "contact_block.toml",
+            vec!["bodies.block.rects=[[0.2, 0.4, 1.2, 0.9]]"],
+            ["bodies.block.rects[0]", "bodies.slab.rects[0]"],
+            "over [0.2, 0.4, 1.2, 0.5]",
+        ),
+    ];
+    for (what, case, sets, names, place) in &cases {
+        let (code, msg) = check(case, sets);
+        assert_eq!(code, Some(2), "{what}: {msg}");
+        for n in names {
+            assert!(msg.contains(n), "{what}: {msg}");
+        }
+        assert!(msg.contains(place), "{what}: {msg}");
+        assert!(msg.contains("may touch but not overlap"), "{what}: {msg}");
+    }
+    // Flush bodies (the rolling disk on its slab, the block and the footing
+    // on theirs) and a body's own overlapping shapes are accepted.
+    for case in [
+        "contact_block.toml",
+        "contact_disks.toml",
+        "contact_rolling.toml",
+        "footing.toml",
+    ] {
+        let (code, msg) = check(case, &[]);
+        assert_eq!(code, Some(0), "{case}: {msg}");
+    }
+    let (code, msg) = check(
+        "contact_disks.toml",
+        &["bodies.right.polygons=[[[0.6, 0.6], [0.8, 0.6], [0.7, 0.8]]]"],
+    );
+    assert_eq!(code, Some(0), "own shapes: {msg}");
+}
+
+/// `check` says what a scene models: the contact pairs and the nodes each
+/// backend holds (one copy per field), walls and their laws, gravity and
+/// its ramp, initial stress, disk layouts, how far a prescribed region
+/// travels; units only where there are units.
+#[test]
+fn check_describes_what_the_scene_models() {
+    let check = |case: &str| {
+        let o = bin().arg("check").arg(common::case(case)).output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{case}: {}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let disks = check("contact_disks.toml");
+    for want in [
+        "nodes       3233 per field x 3 fields (one per body in a contact pair, one for the rest) = 9699, on the CPU and the GPU alike",
+        "contact     impact: left / right (slip (frictionless))",
+        "disks on rings at spacing h/ppc",
+        "gravity     none",
+        "3233 nodes x 3 fields",
+        "E = 10000000 Pa, nu = 0.3)",
+    ] {
+        assert!(disks.contains(want), "no `{want}` in\n{disks}");
+    }
+    let footing = check("footing.toml");
+    for want in [
+        "= 16059, on",
+        "5353 per field x 3 fields",
+        "contact     interface: ",
+    ] {
+        assert!(footing.contains(want), "no `{want}` in\n{footing}");
+    }
+    let block = check("contact_block.toml");
+    for want in [
+        "walls       floor (through (0, 0) m, normal (0, 1); stick;",
+        "contact     interface: block / slab (friction, mu = 0.2)",
+        "gravity     g = (4.905, -8.495709211) m/s^2, ramped (sine) to full at t = 0.1 s",
+    ] {
+        assert!(block.contains(want), "no `{want}` in\n{block}");
+    }
+    let clay = check("clay_biaxial.toml");
+    assert!(
+        clay.contains(
+            "platen (fixes y; 51 nodes; at v = (0, -0.02) m/s, ramped over 0.5 s, its region \
+             travels (0.000000, -0.095000) m by t_end (0.76 cells)"
+        ),
+        "{clay}"
+    );
+    // No key's value followed by the unit "1" (it printed "nu = 0.3 1").
+    for text in [&disks, &footing, &block, &clay] {
+        let line = text.lines().find(|l| l.starts_with("materials")).unwrap();
+        for kv in line.split([',', '(', ')']).filter(|kv| kv.contains(" = ")) {
+            let after = kv.split(" = ").nth(1).unwrap().trim();
+            assert!(!after.ends_with(" 1"), "`{kv}` has the unit 1 in\n{line}");
+        }
     }
 }

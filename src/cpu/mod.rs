@@ -428,6 +428,10 @@ impl CpuBackend {
                 );
             }
             Stage::GridPredict => {
+                // Moving regions go where their velocity has taken them by
+                // the step's end, the time their velocity is taken at.
+                let g = &m.grid;
+                m.constraints.move_to(self.t + self.dt, g.h, g.nx, g.ny);
                 if !m.walls.is_empty() {
                     grid_update::wall_touch(
                         &self.cache,

@@ -53,6 +53,10 @@ pub struct ConstraintGroup {
     pub velocity: [f64; 2],
     /// Time to reach `velocity` from 0, linearly (s); 0 = from the start.
     pub ramp_time: f64,
+    /// The region's nodes at t = 0 as a box of the lattice, `[i0, i1, j0,
+    /// j1]` (inclusive); a moving group's nodes are this box shifted by
+    /// `shift` (`Constraints::move_to`).
+    pub cells: [usize; 4],
 }
 
 impl ConstraintGroup {
@@ -66,6 +70,59 @@ impl ConstraintGroup {
     pub fn moves(&self) -> bool {
         (self.fix & FIX_X != 0 && self.velocity[0] != 0.0)
             || (self.fix & FIX_Y != 0 && self.velocity[1] != 0.0)
+    }
+
+    /// How far the region has moved by time `t` (m): the time integral of
+    /// `velocity_at` on the fixed components, zero on the free ones.
+    pub fn travel(&self, t: f64) -> [f64; 2] {
+        let s = if self.ramp_time > 0.0 && t < self.ramp_time {
+            t * t / (2.0 * self.ramp_time)
+        } else {
+            t - 0.5 * self.ramp_time
+        };
+        let along = |bit: u8, v: f64| if self.fix & bit != 0 { s * v } else { 0.0 };
+        [
+            along(FIX_X, self.velocity[0]),
+            along(FIX_Y, self.velocity[1]),
+        ]
+    }
+
+    /// The whole node spacings the region's nodes have moved by time `t`:
+    /// `travel` / h rounded to the nearest (halves up), as the WGSL twin
+    /// computes it (`shaders/grid_update.wgsl`, `shift`).
+    pub fn shift(&self, t: f64, h: f64) -> [i64; 2] {
+        let d = self.travel(t);
+        [
+            (d[0] / h + 0.5).floor() as i64,
+            (d[1] / h + 0.5).floor() as i64,
+        ]
+    }
+
+    /// The region's nodes at time `t` on a lattice of `nx` × `ny` nodes at
+    /// spacing `h`: the box at t = 0 shifted by `shift`, less what falls
+    /// off the grid; a side on the grid's edge stays there (a region
+    /// reaching the edge, often to ±inf, keeps reaching it).
+    pub fn nodes_at(&self, t: f64, h: f64, nx: usize, ny: usize) -> Vec<u32> {
+        let s = self.shift(t, h);
+        let side = |lo: usize, hi: usize, n: usize, s: i64| {
+            let a = if lo == 0 { 0 } else { lo as i64 + s };
+            let b = if hi + 1 == n {
+                n as i64 - 1
+            } else {
+                hi as i64 + s
+            };
+            (a.max(0), b.min(n as i64 - 1))
+        };
+        let [i0, i1, j0, j1] = self.cells;
+        let (a0, a1) = side(i0, i1, nx, s[0]);
+        let (b0, b1) = side(j0, j1, ny, s[1]);
+        let mut out = Vec::new();
+        for j in b0..=b1 {
+            for i in a0..=a1 {
+                out.push((j as usize * nx + i as usize) as u32);
+            }
+        }
+        out
     }
 }
 
@@ -104,6 +161,34 @@ impl Constraints {
         }
         self.points = placed.points;
         self.freed = placed.freed;
+    }
+
+    /// Moves the regions of the groups that prescribe a velocity to where
+    /// they are at time `t` (`ConstraintGroup::nodes_at`), so a platen
+    /// keeps pressing as the material it pushes moves, and rebuilds the
+    /// fixed bits when a region's nodes changed. Groups holding points
+    /// never move (`Model::new` refuses one that would).
+    pub fn move_to(&mut self, t: f64, h: f64, nx: usize, ny: usize) {
+        let mut changed = false;
+        for (k, g) in self.groups.iter_mut().enumerate() {
+            let points = self.freed.get(k).is_some_and(|f| !f.is_empty());
+            if !g.moves() || points {
+                continue;
+            }
+            let nodes = g.nodes_at(t, h, nx, ny);
+            if nodes != g.nodes {
+                g.nodes = nodes;
+                changed = true;
+            }
+        }
+        if changed {
+            self.fix.fill(0);
+            for group in &self.groups {
+                for &n in &group.nodes {
+                    self.fix[n as usize] |= group.fix;
+                }
+            }
+        }
     }
 }
 
@@ -332,6 +417,7 @@ impl Model {
             let placed = constraint_points::place(scene, &grid, &shape, &particles, &regions)?;
             constraints.hold_at(placed);
         }
+        moving_points(scene, &grid, &constraints)?;
         let mut walls = Walls::new(scene, &grid)?;
         let p_wave = materials
             .iter()
@@ -715,6 +801,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
             Fix::Xy => FIX_X | FIX_Y,
         };
         let mut nodes = Vec::new();
+        let mut cells = [usize::MAX, 0, usize::MAX, 0];
         for j in 0..grid.ny {
             for i in 0..grid.nx {
                 let p = grid.lattice_pos(i, j);
@@ -726,6 +813,12 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
                     let n = grid.index(i, j);
                     c.fix[n] |= bits;
                     nodes.push(n as u32);
+                    cells = [
+                        cells[0].min(i),
+                        cells[1].max(i),
+                        cells[2].min(j),
+                        cells[3].max(j),
+                    ];
                 }
             }
         }
@@ -748,9 +841,46 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
             fix: bits,
             velocity: spec.velocity,
             ramp_time: spec.ramp_time,
+            cells,
         });
     }
     Ok(c)
+}
+
+/// A moving group's region moves with its velocity by whole node
+/// spacings (`Constraints::move_to`); one that holds the body at points
+/// on its edge (`constraint_points`: weights fixed at t = 0) or one on
+/// GMM's node cloud (its groups are fixed when the cloud is built) cannot
+/// move, so it may travel less than half a spacing by `t_end`, and is
+/// refused otherwise.
+fn moving_points(scene: &Scene, grid: &Grid, c: &Constraints) -> Result<(), SceneError> {
+    let t_end = scene.file.solver.t_end;
+    let gmm = scene.file.solver.method == SolverMethod::Gmm;
+    for (k, g) in c.groups.iter().enumerate() {
+        let points = c.freed.get(k).is_some_and(|f| !f.is_empty());
+        if !g.moves() || !(points || gmm) || g.shift(t_end, grid.h) == [0, 0] {
+            continue;
+        }
+        let d = g.travel(t_end);
+        let why = if gmm {
+            "on GMM's node cloud (solver.method = \"gmm\") a constraint's nodes are chosen once, at t = 0"
+        } else {
+            "its region holds the body at points on its edge, placed once at t = 0 (an edge inside \
+             the grid beside the body, with this shape function; linear shapes on a node line do \
+             not need them)"
+        };
+        return Err(SceneError::invalid(
+            format!("constraints.{}.velocity", g.name),
+            format!(
+                "moves the region by ({:.6}, {:.6}) m by t_end = {t_end} s, half a node spacing \
+                 ({}) or more, but {why}: shorten the run or lower the velocity",
+                d[0],
+                d[1],
+                0.5 * grid.h
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Bodies with `initial_stress = "geostatic"`: σ_v from the overburden

@@ -4,6 +4,7 @@
 //! and a grid.
 
 pub mod defaults;
+pub mod overlap;
 pub mod overrides;
 pub mod schema;
 pub mod seed;

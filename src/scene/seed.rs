@@ -9,7 +9,8 @@
 //! with `disk_layout = "rings"` a disk's particles sit on concentric rings
 //! instead (`disk_rings`: round at the particle scale, mass exact). A point
 //! already inside a rectangle or an earlier disk or polygon is not seeded
-//! twice.
+//! twice; that happens within a body only, since `validate` refuses shapes
+//! of different bodies that overlap (`overlap`).
 
 use super::Scene;
 use super::schema::{DiskLayout, Layout};

@@ -600,6 +600,7 @@ fn check_bodies(file: &SceneFile) -> Result<(), SceneError> {
         ));
     }
     check_rect_overlaps(file)?;
+    check_body_overlaps(file)?;
     for (bname, b) in &file.bodies {
         check_initial_stress(file, bname, b)?;
     }
@@ -1127,9 +1128,90 @@ fn check_rect_overlaps(file: &SceneFile) -> Result<(), SceneError> {
             let ox = a[2].min(b[2]) - a[0].max(b[0]);
             let oy = a[3].min(b[3]) - a[1].max(b[1]);
             if ox > 0.0 && oy > 0.0 {
+                let over = [
+                    a[0].max(b[0]),
+                    a[1].max(b[1]),
+                    a[2].min(b[2]),
+                    a[3].min(b[3]),
+                ];
                 return Err(SceneError::invalid(
                     ka.clone(),
-                    format!("overlaps {kb}: rectangles may touch but not overlap"),
+                    format!(
+                        "overlaps {kb} over [{}, {}, {}, {}]: rectangles may touch but not overlap",
+                        over[0], over[1], over[2], over[3]
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Shapes of different bodies may touch but not overlap, whatever their
+/// kinds: the seeder gives a point inside both to the shape seeded first,
+/// so the other body would lose the overlap in silence. (Rectangles
+/// against rectangles are `check_rect_overlaps`'; a body's own disks and
+/// polygons may overlap each other and its rectangles: the first claims
+/// the points.)
+fn check_body_overlaps(file: &SceneFile) -> Result<(), SceneError> {
+    use super::overlap::{Shape, overlap};
+    let tol = 1e-9 * file.grid.h;
+    let mut shapes: Vec<(usize, String, Shape, [f64; 4])> = Vec::new();
+    for (bi, (n, b)) in file.bodies.iter().enumerate() {
+        let mut add = |kind: &str, i: usize, s: Shape| {
+            let bb = match &s {
+                Shape::Rect(r) => *r,
+                Shape::Disk(d) => [d[0] - d[2], d[1] - d[2], d[0] + d[2], d[1] + d[2]],
+                Shape::Polygon(p) => p.iter().fold(
+                    [
+                        f64::INFINITY,
+                        f64::INFINITY,
+                        f64::NEG_INFINITY,
+                        f64::NEG_INFINITY,
+                    ],
+                    |b, p| {
+                        [
+                            b[0].min(p[0]),
+                            b[1].min(p[1]),
+                            b[2].max(p[0]),
+                            b[3].max(p[1]),
+                        ]
+                    },
+                ),
+            };
+            shapes.push((bi, format!("bodies.{n}.{kind}[{i}]"), s, bb));
+        };
+        b.rects
+            .iter()
+            .enumerate()
+            .for_each(|(i, r)| add("rects", i, Shape::Rect(*r)));
+        b.disks
+            .iter()
+            .enumerate()
+            .for_each(|(i, d)| add("disks", i, Shape::Disk(*d)));
+        b.polygons
+            .iter()
+            .enumerate()
+            .for_each(|(i, p)| add("polygons", i, Shape::Polygon(p.clone())));
+    }
+    for (i, (ba, ka, a, bba)) in shapes.iter().enumerate() {
+        for (bb_, kb, b, bbb) in &shapes[i + 1..] {
+            let rects = matches!((a, b), (Shape::Rect(_), Shape::Rect(_)));
+            let apart = bba[2].min(bbb[2]) - bba[0].max(bbb[0]) <= tol
+                || bba[3].min(bbb[3]) - bba[1].max(bbb[1]) <= tol;
+            if ba == bb_ || rects || apart {
+                continue;
+            }
+            if let Some((x, depth)) = overlap(a, b, tol) {
+                let deep = depth.map_or(String::new(), |d| format!(", {d:.6} m deep"));
+                return Err(SceneError::invalid(
+                    ka.clone(),
+                    format!(
+                        "overlaps {kb}, a shape of another body, at ({:.6}, {:.6}){deep}: \
+                         shapes of different bodies may touch but not overlap (the overlap \
+                         would be cut from one of them)",
+                        x[0], x[1]
+                    ),
                 ));
             }
         }

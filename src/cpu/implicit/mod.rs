@@ -307,6 +307,12 @@ impl ImplicitBackend {
     fn initial_phase(&mut self) -> std::result::Result<(), Fault> {
         let clock = Instant::now();
         let m = &mut self.model;
+        // Moving regions where their velocity has taken them by the step's
+        // start (the dofs below hold their nodes through the step).
+        if matches!(self.nodes, Nodes::Grid) {
+            let g = &m.grid;
+            m.constraints.move_to(self.t, g.h, g.nx, g.ny);
+        }
         let p = &mut m.particles;
         match &mut self.nodes {
             Nodes::Grid => {
