@@ -20,7 +20,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 #[derive(Parser)]
-#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC time integration, elastic, Neo-Hookean and Mohr-Coulomb/Drucker-Prager materials, walls and loads, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
+#[command(name = "lme-mpm", version, about = "2D Material Point Method: LME, uGIMP, linear and B-spline (optionally MLS) shape functions, FE/NPC/MUSL time integration and an implicit Newton step (CPU; also on a GMM node cloud), elastic, Neo-Hookean, Mohr-Coulomb/Drucker-Prager and modified Cam-clay materials, walls, contact between bodies and loads, on the CPU (f64) and the GPU (wgpu)", long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

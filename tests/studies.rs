@@ -58,6 +58,21 @@ fn run(name: StudyName) -> (Vec<JobResult>, String, PathBuf) {
     (r.results, r.markdown, dir)
 }
 
+/// Fails on a table in `md` with a header and no row: a quick sweep
+/// reports what it ran, and says what it left out.
+fn assert_no_empty_table(md: &str) {
+    let lines: Vec<&str> = md.lines().collect();
+    for (k, w) in lines.windows(2).enumerate() {
+        let separator = w[1].starts_with("|---");
+        let next_is_row = lines.get(k + 2).is_some_and(|l| l.starts_with('|'));
+        assert!(
+            !(w[0].starts_with('|') && separator && !next_is_row),
+            "an empty table: {}\n{md}",
+            w[0]
+        );
+    }
+}
+
 fn rms(r: &JobResult) -> Option<f64> {
     match r.data()?.errors.as_ref()? {
         Errors::Dyka(e) if r.completed() => Some(e.rms_velocity),
@@ -532,8 +547,21 @@ fn implicit_quick_compares_schemes_per_case() {
 #[test]
 fn contact_quick_measures_collisions_and_rolling() {
     use lme_mpm::study::contact::{collision, history};
-    let (results, md, _) = run(StudyName::Contact);
+    let (results, md, dir) = run(StudyName::Contact);
     assert!(md.contains("Two disks colliding") && md.contains("rolling on an elastic body"));
+    // The quick sweep runs no block and no footing: it says so, with no
+    // empty table or chart for them.
+    assert_no_empty_table(&md);
+    assert!(
+        !md.contains("**Block on a slab**") && !md.contains("study-contact-block"),
+        "{md}"
+    );
+    assert!(!dir.join("study-contact-block.png").exists());
+    assert!(
+        md.contains("Not run by the quick sweep: the block on a slab")
+            && md.contains("the strip footing"),
+        "{md}"
+    );
     let by = |label: &str| {
         results
             .iter()
@@ -628,5 +656,17 @@ fn gmm_quick_reports_orders_and_the_paper_ordering() {
         assert!(md.contains(&format!("- {m}: order")), "{md}");
     }
     assert!(md.contains("GMM-MLS is below at every h"), "{md}");
+    // The quick meshes and the disk's 0.03 s are not the acceptance's: no
+    // verdict on them.
+    assert!(
+        !md.contains("not met") && !md.contains("acceptance: below"),
+        "{md}"
+    );
+    assert!(
+        md.contains("not judged (the quick sweep stops at h = 0.125")
+            && md.contains("is judged by the full study"),
+        "{md}"
+    );
+    assert_no_empty_table(&md);
     assert!(md.contains("**Cost.**") && md.contains("| 0.250 |"), "{md}");
 }

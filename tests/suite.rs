@@ -13,6 +13,8 @@ mod common;
 mod benchmarks;
 #[path = "boundaries.rs"]
 mod boundaries;
+#[path = "cases.rs"]
+mod cases;
 #[path = "cli.rs"]
 mod cli;
 #[path = "constraint_points.rs"]

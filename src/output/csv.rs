@@ -63,9 +63,10 @@ pub fn energy(samples: &[Sample]) -> String {
     s
 }
 
-/// `t,constraint,rx,ry` (s, N per metre of thickness): force the support
-/// exerts on the body, summed over the constraint's nodes. `names` in
-/// `Constraints::groups` order.
+/// `t,constraint,rx,ry` (s, N per metre of thickness): the force each
+/// constraint and wall exerts on the body, and each contact pair's on its
+/// first body. `names` as `Model::reaction_names` gives them (constraints,
+/// walls, pairs), in the order of `Sample::reactions`.
 pub fn reactions(names: &[String], samples: &[Sample]) -> String {
     let mut s = String::from("t,constraint,rx,ry\n");
     for smp in samples {

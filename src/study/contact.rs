@@ -350,20 +350,47 @@ fn tagged<'a>(mine: &[&'a JobResult], tags: &[(&str, &str)]) -> Vec<&'a JobResul
         .collect()
 }
 
-pub fn report(results: &[JobResult], dir: &Path, _quick: bool) -> Result<(String, Vec<PathBuf>)> {
+pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
     let main = super::main_backend(results);
     let mine = super::on_backend(results, &main);
     let mut md = String::new();
     let mut charts = Vec::new();
-    charts.extend(block_section(&mine, dir, &mut md)?);
-    charts.extend(disks_section(&mine, dir, &mut md)?);
-    charts.extend(rolling_section(&mine, dir, &mut md)?);
+    // A case with no run here (the quick sweep leaves the long ones out)
+    // gets a line saying so, not an empty table and chart.
+    let mut left_out = Vec::new();
+    if tagged(&mine, &[("case", "block")]).is_empty() {
+        left_out.push(
+            "the block on a slab (`cases/contact_block.toml`, 26k steps; `tests/contact.rs` runs it)",
+        );
+    } else {
+        charts.extend(block_section(&mine, dir, &mut md)?);
+    }
+    if tagged(&mine, &[("case", "disks")]).is_empty() {
+        left_out.push("the colliding disks (`cases/contact_disks.toml`)");
+    } else {
+        charts.extend(disks_section(&mine, dir, &mut md)?);
+    }
+    if tagged(&mine, &[("case", "rolling")]).is_empty() {
+        left_out.push("the disk rolling on a slab (`cases/contact_rolling.toml`)");
+    } else {
+        charts.extend(rolling_section(&mine, dir, &mut md)?);
+    }
     let footing: Vec<&JobResult> = results
         .iter()
         .filter(|r| r.job.tag_value("case") == Some("footing"))
         .collect();
-    if !footing.is_empty() {
+    if footing.is_empty() {
+        left_out.push("the strip footing against Prandtl (`cases/footing.toml`)");
+    } else {
         charts.extend(footing_section(&footing, dir, &mut md)?);
+    }
+    if !left_out.is_empty() {
+        let _ = writeln!(
+            md,
+            "Not run {}: {}; `lme-mpm study contact` runs every case.\n",
+            if quick { "by the quick sweep" } else { "here" },
+            left_out.join(", ")
+        );
     }
     Ok((md, charts))
 }
