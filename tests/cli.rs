@@ -1008,6 +1008,9 @@ fn keys_that_do_not_apply_are_refused_naming_what_would_apply_them() {
         }
         let o = check(scene, &sets);
         assert!(o.status.success(), "{set} with {apply:?}: {}", stderr(&o));
+    }
+}
+
 /// Shapes of different bodies that overlap, whatever their kinds, exit 2
 /// naming both and where (the seeder would cut the overlap from one body
 /// in silence); the shipped contact cases, whose bodies are flush, pass.
