@@ -971,12 +971,13 @@ fn keys_that_do_not_apply_are_refused_naming_what_would_apply_them() {
         c.output().unwrap()
     };
     #[rustfmt::skip]
-    let cases: [(&Path, &str, &str, &[&str]); 9] = [
+    let cases: [(&Path, &str, &str, &[&str]); 10] = [
         (&rolling, "gravity.ramp_period=0.2", "gravity.ramp = \"sine\"", &["gravity.ramp=sine"]),
         (&dyka, "solver.mls_support=2", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
         (&dyka, "solver.mls_scope=force", "solver.mls = true", &["solver.mls=true", "solver.shape=bspline2"]),
         (&dyka, "solver.newmark_beta=0.3", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
         (&dyka, "solver.newton_max_iter=5", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
+        (&dyka, "solver.implicit_mass=lumped", "integrator = \"implicit\"", &["solver.integrator=implicit"]),
         (&dyka, "solver.npc_gamma=0.6", "integrator = \"npc\"", &[]),
         (&cantilever, "solver.gmm_basis=mls", "method = \"gmm\"", &["solver.method=gmm"]),
         (&cantilever, "solver.load_steps=3", "solver.static = true", &[]),

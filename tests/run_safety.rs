@@ -831,6 +831,7 @@ fn a_completed_run_can_be_extended_and_the_key_turns_it_off() {
 fn implicit_disk_resumes_bit_for_bit(name: &str, more: &[&str]) {
     let mut sets = vec![
         "solver.integrator=implicit",
+        "solver.implicit_mass=lumped",
         "grid.h=0.1",
         "solver.dt=0.005",
         "solver.t_end=0.04",

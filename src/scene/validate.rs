@@ -1013,7 +1013,7 @@ fn check_keys_apply(file: &SceneFile) -> Result<(), SceneError> {
     const MLS: &str = "solver.mls = true";
     const GMM: &str = "solver.method = \"gmm\" (with integrator = \"implicit\")";
     // (key, set, read under the scene's settings, what makes it read)
-    let keys: [(&str, bool, bool, &str); 16] = [
+    let keys: [(&str, bool, bool, &str); 17] = [
         (
             "gravity.ramp_period",
             file.gravity
@@ -1083,6 +1083,12 @@ fn check_keys_apply(file: &SceneFile) -> Result<(), SceneError> {
             s.implicit_start != d.implicit_start,
             implicit && !s.static_analysis,
             "a dynamic implicit run (integrator = \"implicit\", static = false)",
+        ),
+        (
+            "solver.implicit_mass",
+            s.implicit_mass != d.implicit_mass,
+            implicit,
+            IMPLICIT,
         ),
         ("solver.gmm_basis", s.gmm_basis != d.gmm_basis, gmm, GMM),
         (

@@ -535,7 +535,11 @@ fn disk_jobs(scheme: &str, (label, shape): (&'static str, &'static str), quick: 
             .tag("scheme", scheme);
         j.label = format!("disk-{scheme}-{label}-dt{}", k + 1);
         if scheme == "implicit" {
-            j = j.set("solver.integrator=implicit");
+            // Lumped: the consistent mass stalls Newton on the disk's rim
+            // (docs/methods.md, "Implicit integrator").
+            j = j
+                .set("solver.integrator=implicit")
+                .set("solver.implicit_mass=lumped");
         }
         out.push(j);
     }
