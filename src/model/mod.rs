@@ -57,6 +57,8 @@ pub struct ConstraintGroup {
     /// j1]` (inclusive); a moving group's nodes are this box shifted by
     /// `shift` (`Constraints::move_to`).
     pub cells: [usize; 4],
+    /// The `shift` its `nodes` stand at (whole spacings; [0, 0] at t = 0).
+    pub shifted: [i64; 2],
 }
 
 impl ConstraintGroup {
@@ -175,6 +177,12 @@ impl Constraints {
             if !g.moves() || points {
                 continue;
             }
+            // Only when it crosses a node line: no allocation per step.
+            let shift = g.shift(t, h);
+            if shift == g.shifted {
+                continue;
+            }
+            g.shifted = shift;
             let nodes = g.nodes_at(t, h, nx, ny);
             if nodes != g.nodes {
                 g.nodes = nodes;
@@ -842,6 +850,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
             velocity: spec.velocity,
             ramp_time: spec.ramp_time,
             cells,
+            shifted: [0, 0],
         });
     }
     Ok(c)
