@@ -199,3 +199,45 @@ fn cam_clay_is_labelled_by_its_preconsolidation_pressure() {
     assert!(said(&r).contains("--field p_c"), "{}", said(&r));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn a_reference_the_scene_cannot_have_is_refused_naming_exact() {
+    for (case, set, why) in [
+        ("sliding_block", "exact=energy", "remove gravity"),
+        ("contact_block", "exact=disk_impact", "one disk each"),
+        (
+            "rolling_disk",
+            "exact=contact_rolling",
+            "one [contact.<name>] pair",
+        ),
+        (
+            "footing",
+            "materials.clay.friction_angle=20",
+            "friction_angle = 0 (Tresca)",
+        ),
+        (
+            "column_collapse",
+            "bodies.column.rects=[[0.0,0.0,1.0,2.0]]",
+            "2 m x 4 m column",
+        ),
+        (
+            "granular_collapse",
+            "bodies.column.rects=[[0.5,0.0,1.5,2.0]]",
+            "from x = 0",
+        ),
+        ("plate_impact", "exact=critical_state", "modified_cam_clay"),
+    ] {
+        let o = bin()
+            .arg("check")
+            .arg(format!("{}/cases/{case}.toml", env!("CARGO_MANIFEST_DIR")))
+            .args(["--set", set])
+            .output()
+            .unwrap();
+        let e = said(&o);
+        assert_eq!(o.status.code(), Some(2), "{case} {set}: {e}");
+        assert!(
+            e.contains("`exact`") && e.contains(why),
+            "{case} {set}: {e}"
+        );
+    }
+}
