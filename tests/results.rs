@@ -184,11 +184,19 @@ fn cam_clay_is_labelled_by_its_preconsolidation_pressure() {
         .output()
         .unwrap();
     assert!(r.status.success(), "{}", said(&r));
+    let words = said(&r);
     assert!(
-        said(&r).contains("preconsolidation pressure p_c (Pa)"),
-        "{}",
-        said(&r)
+        words.contains("preconsolidation pressure p_c (Pa) from "),
+        "{words}"
     );
+    // The scale starts at the least p_c (about p′0 = 100 kPa), not at 0.
+    let from: f64 = words
+        .split(" from ")
+        .nth(1)
+        .and_then(|w| w.split_whitespace().next())
+        .and_then(|w| w.parse().ok())
+        .unwrap_or(0.0);
+    assert!(from > 0.9e5, "{words}");
     let r = bin()
         .arg("render")
         .arg(&out)

@@ -624,7 +624,9 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
     if !lo.is_finite() {
         (lo, hi) = (0.0, 1.0);
     }
-    if lo >= 0.0 && opts.field != Field::Pressure {
+    // Magnitudes start at zero; p_c (about p′0 and up) and the pressure
+    // keep their least value, so the scale spans what changes.
+    if lo >= 0.0 && !matches!(opts.field, Field::Pressure | Field::Pc) {
         lo = 0.0;
     }
     // A few outliers (a shear band's tip, a particle flung off) would
