@@ -414,6 +414,8 @@ pub struct ParticleImage {
     pub range: (f64, f64),
     /// Pixels per panel.
     pub panel_size: (u32, u32),
+    /// Draw each panel's axes, x (m) and y (m), with their ticks.
+    pub axes: bool,
 }
 
 impl ParticleImage {
@@ -444,7 +446,7 @@ impl ParticleImage {
             .titled(&self.title, ("sans-serif", 18))
             .map_err(|e| e.to_string())?;
         let (w, h) = root.dim_in_pixel();
-        let (plots, bar) = root.split_horizontally(w - 90);
+        let (plots, bar_area) = root.split_horizontally(w - 90);
         let cells = plots.split_evenly((rows, self.cols.max(1)));
         let (lo, hi) = self.range;
         let norm = |v: f64| ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
@@ -464,14 +466,29 @@ impl ParticleImage {
             // Same scale on both axes.
             let span = (x1 - x0).max(y1 - y0) * 1.04 + 1e-12;
             let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-            let mut chart = ChartBuilder::on(area)
-                .caption(&panel.title, ("sans-serif", 14))
-                .margin(6)
+            let mut builder = ChartBuilder::on(area);
+            builder.caption(&panel.title, ("sans-serif", 14)).margin(6);
+            if self.axes {
+                builder.x_label_area_size(34).y_label_area_size(52);
+            }
+            let mut chart = builder
                 .build_cartesian_2d(
                     cx - 0.5 * span..cx + 0.5 * span,
                     cy - 0.5 * span..cy + 0.5 * span,
                 )
                 .map_err(|e| e.to_string())?;
+            if self.axes {
+                chart
+                    .configure_mesh()
+                    .disable_mesh()
+                    .x_desc("x (m)")
+                    .y_desc("y (m)")
+                    .label_style(("sans-serif", 12))
+                    .x_labels(6)
+                    .y_labels(6)
+                    .draw()
+                    .map_err(|e| e.to_string())?;
+            }
             // Slightly larger than the spacing, so pixel rounding leaves no gaps.
             let half = 0.6 * panel.size;
             chart
@@ -486,7 +503,9 @@ impl ParticleImage {
         }
         // Colour bar.
         let steps = 100;
-        let bar = bar.margin(30, 30, 10, 40);
+        // The label above the bar, inside the bar's column (90 px), so it
+        // is never cut at the picture's edge.
+        let bar = bar_area.margin(36, 30, 10, 40);
         let (_, bh) = bar.dim_in_pixel();
         for k in 0..steps {
             let f = k as f64 / (steps - 1) as f64;
@@ -505,12 +524,9 @@ impl ParticleImage {
             style.clone(),
         ))
         .map_err(|e| e.to_string())?;
-        bar.draw(&Text::new(
-            self.value_label.clone(),
-            (0, bh as i32 + 8),
-            style,
-        ))
-        .map_err(|e| e.to_string())?;
+        bar_area
+            .draw(&Text::new(self.value_label.clone(), (6, 14), style))
+            .map_err(|e| e.to_string())?;
         let _ = h;
         Ok(())
     }

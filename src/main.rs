@@ -159,7 +159,8 @@ struct RenderArgs {
     dir: PathBuf,
     /// What colours the particles: speed (m/s), stress (von Mises, Pa),
     /// pressure (Pa, positive in compression), eps_p (equivalent plastic
-    /// strain; plastic materials), displacement (m, from the start).
+    /// strain; Mohr-Coulomb, Drucker-Prager), p_c (preconsolidation
+    /// pressure, Pa; modified Cam-clay), displacement (m, from the start).
     #[arg(long, value_enum, default_value_t = lme_mpm::output::render::Field::Speed)]
     field: lme_mpm::output::render::Field,
     /// Frames per second of the animation, 0.1 to 50 (a GIF's delays are

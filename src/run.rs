@@ -262,7 +262,7 @@ fn finish(
     let status = driven?;
     let wall = (t_drive.elapsed().as_secs_f64() - writer.io_seconds).max(1e-9);
 
-    let errors = sim.score()?;
+    let errors = sim.score_with(&writer.samples)?;
     let backend = sim.backend();
     let t = backend.time();
     let steps = backend.steps();

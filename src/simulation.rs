@@ -187,6 +187,13 @@ impl Simulation {
     /// Errors against the scene's exact solution at the time reached (None
     /// when the scene names none).
     pub fn score(&mut self) -> Result<Option<Errors>> {
+        self.score_with(&[])
+    }
+
+    /// `score` with the run's samples, for the references read over time
+    /// (the footing's peak, the energy at the start; without samples those
+    /// figures are NaN).
+    pub fn score_with(&mut self, samples: &[crate::backend::Sample]) -> Result<Option<Errors>> {
         let Some(kind) = self.scene.file.exact else {
             return Ok(None);
         };
@@ -201,6 +208,7 @@ impl Simulation {
             model,
             &model.particles,
             t,
+            samples,
         )))
     }
 

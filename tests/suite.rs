@@ -57,6 +57,8 @@ mod preflight;
 mod readme;
 #[path = "render.rs"]
 mod render;
+#[path = "results.rs"]
+mod results;
 #[path = "run_parity.rs"]
 mod run_parity;
 #[path = "run_safety.rs"]

@@ -30,9 +30,12 @@ pub enum Field {
     Stress,
     /// Pressure −(σxx + σyy + σzz)/3 (Pa; positive in compression).
     Pressure,
-    /// Equivalent plastic strain ε̄p (plastic materials only).
+    /// Equivalent plastic strain ε̄p (Mohr–Coulomb, Drucker–Prager).
     #[value(name = "eps_p")]
     EpsP,
+    /// Preconsolidation pressure p_c (Pa; modified Cam-clay).
+    #[value(name = "p_c")]
+    Pc,
     /// |x − X|, the distance from the initial position (m).
     Displacement,
 }
@@ -44,6 +47,7 @@ impl Field {
             Field::Stress => "stress",
             Field::Pressure => "pressure",
             Field::EpsP => "eps_p",
+            Field::Pc => "p_c",
             Field::Displacement => "displacement",
         }
     }
@@ -54,6 +58,7 @@ impl Field {
             Field::Stress => "von Mises stress (Pa)",
             Field::Pressure => "pressure (Pa)",
             Field::EpsP => "equivalent plastic strain",
+            Field::Pc => "preconsolidation pressure p_c (Pa)",
             Field::Displacement => "displacement (m)",
         }
     }
@@ -216,9 +221,26 @@ fn values(v: &Vtu, field: Field, path: &Path) -> Result<Vec<f32>> {
         Field::EpsP => v
             .get("plastic_strain_eq")
             .ok_or_else(|| {
+                let cam = if v.get("preconsolidation_pressure").is_some() {
+                    " (modified Cam-clay carries its preconsolidation pressure instead: \
+                     --field p_c)"
+                } else {
+                    ""
+                };
                 folder_error(format!(
-                    "{}: no plastic strain: --field eps_p needs a plastic material \
-                     (mohr_coulomb, drucker_prager)",
+                    "{}: no plastic strain: --field eps_p needs a mohr_coulomb or \
+                     drucker_prager material{cam}",
+                    path.display()
+                ))
+            })?
+            .0
+            .to_vec(),
+        Field::Pc => v
+            .get("preconsolidation_pressure")
+            .ok_or_else(|| {
+                folder_error(format!(
+                    "{}: no preconsolidation pressure: --field p_c needs a \
+                     modified_cam_clay material",
                     path.display()
                 ))
             })?
@@ -688,7 +710,9 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
     if !lo.is_finite() {
         (lo, hi) = (0.0, 1.0);
     }
-    if lo >= 0.0 && opts.field != Field::Pressure {
+    // Magnitudes start at zero; p_c (about p′0 and up) and the pressure
+    // keep their least value, so the scale spans what changes.
+    if lo >= 0.0 && !matches!(opts.field, Field::Pressure | Field::Pc) {
         lo = 0.0;
     }
     // A few outliers (a shear band's tip, a particle flung off) would

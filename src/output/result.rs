@@ -122,6 +122,106 @@ pub fn text(s: &Summary) -> Option<String> {
                 pct(e.rel_error_timoshenko)
             ),
         },
+        Errors::ContactSliding(e) if e.acceleration_exact > 0.0 => format!(
+            "slide on the slab {} m against g (sin θ − μ cos θ) t²/2 = {} m exact (a = {} m/s², \
+             t² / 2 taken as ∫R over the gravity's ramp): {} off; relative velocity {} m/s against \
+             {} m/s.",
+            num(e.slide),
+            num(e.slide_exact),
+            num(e.acceleration_exact),
+            pct(e.slide_rel_error),
+            num(e.velocity),
+            num(e.velocity_exact)
+        ),
+        Errors::ContactSliding(e) => format!(
+            "the block should stay at rest on the slab (tan θ ≤ μ): it slid {} m, {} of the \
+             frictionless slide.",
+            num(e.slide),
+            pct(e.slide_rel_error)
+        ),
+        Errors::ContactRolling(e) => format!(
+            "the disk's centre rolled {} m against (2/3) g sin θ t²/2 = {} m exact: {} off \
+             (slip at the contact {} m/s, 0 rolling without slip).",
+            num(e.distance),
+            num(e.distance_exact),
+            pct(e.distance_rel_error),
+            num(e.slip)
+        ),
+        Errors::DiskImpact(e) => format!(
+            "momentum kept within {} of one disk's (exact: all of it); spin ω R {} / {} m/s \
+             (exact 0: frictionless forces pass through the centres); velocity along the \
+             contact tangent {} / {} m/s against {} / {} m/s at the start (kept by rigid disks); \
+             separating at {} m/s after approaching at {} m/s.",
+            pct(e.momentum_drift),
+            num(e.spin_first),
+            num(e.spin_second),
+            num(e.tangential_first),
+            num(e.tangential_second),
+            num(e.tangential_first_start),
+            num(e.tangential_second_start),
+            num(e.separating),
+            num(e.approaching)
+        ),
+        Errors::Footing(e) => format!(
+            "peak bearing pressure q/c = {} at {} mm of settlement against Prandtl's 2 + π = {}: \
+             {}{} (q/c {} at the end).",
+            num(e.q_peak_over_c),
+            num(1e3 * e.settlement_at_peak),
+            num(e.q_exact_over_c),
+            if e.q_rel_error >= 0.0 { "+" } else { "" },
+            pct(e.q_rel_error),
+            num(e.q_end_over_c)
+        ),
+        Errors::CriticalState(e) => format!(
+            "stress ratio q/p′ = {} (p′ = {} kPa, q = {} kPa) at {} axial strain against the \
+             critical state's M = {}: {} of the way; drained plane strain reaches q = M p′ only \
+             near 100 % axial strain (docs/methods.md, \"Modified Cam-clay\").",
+            num(e.stress_ratio),
+            num(1e-3 * e.p),
+            num(1e-3 * e.q),
+            pct(e.axial_strain),
+            num(e.m),
+            pct(e.ratio_over_m)
+        ),
+        Errors::ColumnCollapse(e) => format!(
+            "run-out {} m and height {} m at t = {} s against `lme-mpm study column`'s {}–{} m and \
+             {}–{} m at 2 s (four shapes, the paper's two meshes; the paper compares with SPH by \
+             pictures only): {}.",
+            num(e.run_out),
+            num(e.height),
+            num(s.t),
+            num(e.run_out_reference_low),
+            num(e.run_out_reference_high),
+            num(e.height_reference_low),
+            num(e.height_reference_high),
+            if e.run_out_rel_error == 0.0 && e.height_rel_error == 0.0 {
+                "both inside".to_string()
+            } else {
+                format!(
+                    "run-out {} and height {} outside",
+                    pct(e.run_out_rel_error),
+                    pct(e.height_rel_error)
+                )
+            }
+        ),
+        Errors::GranularCollapse(e) => format!(
+            "run-out (L_f − W)/W = {} (L_f = {} m, height {} m) against the experiments' 1.2 a = {} \
+             (a = {}; Lajeunesse et al. 2005): {}{} off, the acceptance is 25 %.",
+            num(e.run_out_ratio),
+            num(e.run_out),
+            num(e.height),
+            num(e.run_out_ratio_reference),
+            num(e.aspect),
+            if e.run_out_rel_error >= 0.0 { "+" } else { "" },
+            pct(e.run_out_rel_error)
+        ),
+        Errors::Energy(e) => format!(
+            "kinetic + strain energy {} J/m at the end, {} of the {} J/m at the start (nothing \
+             does work: the rest went to the integrator's damping and the fixed nodes).",
+            num(e.kinetic + e.strain),
+            pct(e.kept),
+            num(e.energy_start)
+        ),
         Errors::Mms(e) => format!(
             "RMS error at t_end: displacement {}, velocity {}, stress {} of the exact field's \
              RMS (100 % = an error as large as the field); docs/verification.md gives every \
@@ -139,6 +239,8 @@ pub fn text(s: &Summary) -> Option<String> {
 struct History {
     title: String,
     y_label: String,
+    /// The x axis when it is not time (its unit in the label).
+    x_label: Option<String>,
     series: Vec<Series>,
 }
 
@@ -148,13 +250,32 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
     let probes = &model.probes;
     let x0 = |k: usize| model.particles.x0[probes[k].particle];
     let mut series = Vec::new();
-    let mut add = |label: String, num: Vec<(f64, f64)>, exact: Option<Vec<(f64, f64)>>| {
-        let color = series.len() / 2;
-        series.push(Series::line(label.clone(), num, color));
-        if let Some(e) = exact {
-            series.push(Series::line(format!("{label}, exact"), e, color).dashed());
+    let mut colors = 0;
+    let mut add =
+        |label: String, num: Vec<(f64, f64)>, exact: Option<Vec<(f64, f64)>>, style: Style| {
+            // One colour per quantity, its exact counterpart dashed beside it.
+            let color = colors;
+            colors += 1;
+            let s = Series::line(label.clone(), num, color);
+            series.push(match style {
+                Style::Solid => s,
+                Style::Dashed => s.dashed(),
+                Style::Markers => s.markers(),
+            });
+            if let Some(e) = exact {
+                series.push(Series::line(format!("{label}, exact"), e, color).dashed());
+            }
+        };
+    // The references read at the end, or over the samples without probes.
+    match scene.file.exact {
+        Some(ExactKind::Cantilever) => return cantilever(scene, model),
+        Some(ExactKind::PrandtlFooting) => return footing(scene, model, samples),
+        Some(ExactKind::CriticalState) => return critical_state(scene, model),
+        Some(k @ (ExactKind::ColumnCollapse | ExactKind::GranularCollapse)) => {
+            return collapse(scene, model, k);
         }
-    };
+        _ => {}
+    }
     let exact = if probes.is_empty() {
         None
     } else {
@@ -169,7 +290,7 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
                     .iter()
                     .map(|s| (s.t, bar.velocity_stress(x0(k)[0], s.t).0))
                     .collect();
-                add(p.name.clone(), n, Some(e));
+                add(p.name.clone(), n, Some(e), Style::Solid);
             }
             ("velocity at the probes", "velocity v_x (m/s)")
         }
@@ -184,7 +305,7 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
                     .iter()
                     .map(|s| (s.t, col.settlement(x0(k)[1], s.t)))
                     .collect();
-                add(p.name.clone(), n, Some(e));
+                add(p.name.clone(), n, Some(e), Style::Solid);
             }
             ("settlement at the probes", "settlement, down (m)")
         }
@@ -199,7 +320,7 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
                     .iter()
                     .map(|s| (s.t, disk.displacement(s.t)[0]))
                     .collect();
-                add(p.name.clone(), n, Some(e));
+                add(p.name.clone(), n, Some(e), Style::Solid);
             }
             ("displacement at the probes", "displacement u_x (m)")
         }
@@ -212,7 +333,7 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
                     .map(|s| (s.t, s.probes[k].v[0] * tg[0] + s.probes[k].v[1] * tg[1]))
                     .collect();
                 let e = samples.iter().map(|s| (s.t, block.velocity(s.t))).collect();
-                add(p.name.clone(), n, Some(e));
+                add(p.name.clone(), n, Some(e), Style::Solid);
             }
             ("velocity along the wall at the probes", "velocity (m/s)")
         }
@@ -228,36 +349,269 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
                             .iter()
                             .map(|s| (s.t, field.displacement(x0(k), s.t)[0]))
                             .collect();
-                        add(p.name.clone(), n, Some(e));
+                        add(p.name.clone(), n, Some(e), Style::Solid);
                     }
                     ("displacement at the probes", "displacement u_x (m)")
                 }
                 None => energy(samples, &mut add),
             }
         }
-        Some(ExactKind::Cantilever) => {
-            return cantilever(scene, model);
+        Some(ExactKind::ContactSliding) => {
+            let block = crate::exact::contact::sliding(scene);
+            let tg = block.tangent;
+            for (k, p) in probes.iter().enumerate() {
+                let n = samples
+                    .iter()
+                    .map(|s| {
+                        let u = [s.probes[k].x[0] - x0(k)[0], s.probes[k].x[1] - x0(k)[1]];
+                        (s.t, u[0] * tg[0] + u[1] * tg[1])
+                    })
+                    .collect();
+                let e = dense(samples, |t| crate::exact::contact::slide_exact(&block, t));
+                add(p.name.clone(), n, Some(e), Style::Solid);
+            }
+            (
+                "slide along the face at the probes",
+                "displacement along the face (m)",
+            )
         }
-        None => energy(samples, &mut add),
+        Some(ExactKind::ContactRolling) => {
+            let disk = crate::exact::contact::rolling(scene);
+            let a = disk.accel_along().max(f64::MIN_POSITIVE);
+            let dir = [disk.accel[0] / a, disk.accel[1] / a];
+            for (k, p) in probes.iter().enumerate() {
+                let n = samples
+                    .iter()
+                    .map(|s| {
+                        let u = [s.probes[k].x[0] - x0(k)[0], s.probes[k].x[1] - x0(k)[1]];
+                        (s.t, u[0] * dir[0] + u[1] * dir[1])
+                    })
+                    .collect();
+                let e = dense(samples, |t| 0.5 * a * t * t);
+                add(p.name.clone(), n, Some(e), Style::Solid);
+            }
+            (
+                "distance rolled at the probes",
+                "displacement along the face (m)",
+            )
+        }
+        Some(ExactKind::DiskImpact) => {
+            // Along the contact tangent at the start's line of centres,
+            // from the final particles' figures' geometry.
+            let e = crate::exact::contact::score_impact(scene, &model.particles);
+            let tg = impact_tangent(scene);
+            let start = [e.tangential_first_start, e.tangential_second_start];
+            for (k, p) in probes.iter().enumerate() {
+                let n = samples
+                    .iter()
+                    .map(|s| (s.t, s.probes[k].v[0] * tg[0] + s.probes[k].v[1] * tg[1]))
+                    .collect();
+                let v0 = start[k.min(1)];
+                let ex = samples.iter().map(|s| (s.t, v0)).collect();
+                add(p.name.clone(), n, Some(ex), Style::Solid);
+            }
+            (
+                "velocity along the contact tangent at the probes",
+                "velocity (m/s)",
+            )
+        }
+        Some(ExactKind::Energy) => {
+            let r = energy(samples, &mut add);
+            if let Some(first) = samples.first() {
+                let e0 = first.energy.kinetic + first.energy.strain;
+                let pts = samples.iter().map(|s| (s.t, e0)).collect();
+                series
+                    .push(Series::line("start's kinetic + strain (exact: kept)", pts, 7).dashed());
+            }
+            r
+        }
+        _ => energy(samples, &mut add),
     };
     History {
         title: title.to_string(),
         y_label: y_label.to_string(),
+        x_label: None,
         series,
     }
 }
 
+/// An exact curve at 200 times from the first sample's to the last's:
+/// smooth where the samples are few.
+fn dense(samples: &[Sample], f: impl Fn(f64) -> f64) -> Vec<(f64, f64)> {
+    let (t0, t1) = match (samples.first(), samples.last()) {
+        (Some(a), Some(b)) => (a.t, b.t),
+        _ => return Vec::new(),
+    };
+    (0..=200)
+        .map(|k| {
+            let t = t0 + (t1 - t0) * k as f64 / 200.0;
+            (t, f(t))
+        })
+        .collect()
+}
+
+/// The contact tangent at the line of centres where the disks meet.
+fn impact_tangent(scene: &Scene) -> [f64; 2] {
+    let u = crate::exact::contact::impact_line(scene);
+    [-u[1], u[0]]
+}
+
+/// The footing's q/c against settlement, with Prandtl's 2 + π.
+fn footing(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
+    let f = crate::exact::footing::Footing::from_scene(scene, model);
+    let curve: Vec<(f64, f64)> = samples
+        .iter()
+        .map(|s| (1e3 * f.settlement(s.t), f.q_over_c(s)))
+        .collect();
+    let end = curve.last().map_or(1.0, |p| p.0.max(1e-9));
+    History {
+        title: "bearing pressure against settlement".into(),
+        y_label: "q / c".into(),
+        x_label: Some("settlement (mm)".into()),
+        series: vec![
+            Series::line(
+                format!("the pair's reaction / (B c), B = {} m", num(f.width)),
+                curve,
+                0,
+            )
+            .markers(),
+            Series::line(
+                "Prandtl, 2 + π = 5.14",
+                vec![
+                    (0.0, crate::exact::footing::PRANDTL),
+                    (end, crate::exact::footing::PRANDTL),
+                ],
+                3,
+            )
+            .dashed(),
+        ],
+    }
+}
+
+/// The clay's final state in the p′–q plane, with the critical state line.
+fn critical_state(scene: &Scene, model: &Model) -> History {
+    let p = &model.particles;
+    let pts: Vec<(f64, f64)> = (0..p.len())
+        .step_by((p.len() / 4000).max(1))
+        .map(|i| {
+            let szz = p.plastic.get(i).map_or(0.0, |q| q[0]);
+            let (pp, q) = crate::exact::critical_state::p_q(p.stress[i], szz);
+            (1e-3 * pp, 1e-3 * q)
+        })
+        .collect();
+    let m = crate::exact::critical_state::m_of(scene);
+    let p_max = pts.iter().map(|q| q.0).fold(0.0, f64::max) * 1.1;
+    History {
+        title: "final stresses against the critical state line".into(),
+        y_label: "q = sqrt(3 J2) (kPa)".into(),
+        x_label: Some("p′ (kPa)".into()),
+        series: vec![
+            Series::line("particles at the end", pts, 0).scatter(),
+            Series::line(
+                format!("critical state line q = M p′, M = {}", num(m)),
+                vec![(0.0, 0.0), (p_max, m * p_max)],
+                3,
+            )
+            .dashed(),
+        ],
+    }
+}
+
+/// A collapse's final free surface, with its reference run-out.
+fn collapse(scene: &Scene, model: &Model, kind: ExactKind) -> History {
+    use crate::exact::collapse;
+    let (bb, h, spacing) = collapse::geometry(scene);
+    let p = &model.particles;
+    let mut series = vec![
+        Series::line(
+            "free surface at the end",
+            collapse::profile(p, h, spacing),
+            0,
+        ),
+        Series::line(
+            "column at the start",
+            vec![(bb[0], bb[3]), (bb[2], bb[3]), (bb[2], bb[1])],
+            7,
+        ),
+    ];
+    let top = bb[3] - bb[1];
+    if kind == ExactKind::ColumnCollapse {
+        let (lo, hi) = collapse::COLUMN_RUN_OUT;
+        let (ylo, yhi) = collapse::COLUMN_HEIGHT;
+        series.push(
+            Series::line(
+                format!("study column, 2 s: run-out {}–{} m", num(lo), num(hi)),
+                vec![(lo, 0.0), (lo, 0.5 * top), (hi, 0.5 * top), (hi, 0.0)],
+                3,
+            )
+            .dashed(),
+        );
+        series.push(
+            Series::line(
+                format!("height {}–{} m", num(ylo), num(yhi)),
+                vec![(0.0, ylo), (0.5, ylo), (0.5, yhi), (0.0, yhi)],
+                2,
+            )
+            .dashed(),
+        );
+    } else {
+        let w = bb[2] - bb[0];
+        let a = top / w;
+        let lf = bb[0] + w * (1.0 + collapse::RUN_OUT_SCALING * a);
+        series.push(
+            Series::line(
+                format!("experiments: L_f = W (1 + 1.2 a) = {} m", num(lf)),
+                vec![(lf, 0.0), (lf, 0.5 * top)],
+                3,
+            )
+            .dashed(),
+        );
+        for (k, f) in [0.75, 1.25].into_iter().enumerate() {
+            let x = bb[0] + w * (1.0 + f * collapse::RUN_OUT_SCALING * a);
+            let label = if k == 0 { "± 25 %" } else { "" };
+            series.push(Series::line(label, vec![(x, 0.0), (x, 0.25 * top)], 8).dashed());
+        }
+    }
+    History {
+        title: "deposit at the end".into(),
+        y_label: "height y (m)".into(),
+        x_label: Some("x (m)".into()),
+        series,
+    }
+}
+
+/// How an energy line is drawn.
+#[derive(Clone, Copy)]
+enum Style {
+    Solid,
+    Dashed,
+    Markers,
+}
+
 fn energy(
     samples: &[Sample],
-    add: &mut impl FnMut(String, Vec<(f64, f64)>, Option<Vec<(f64, f64)>>),
+    add: &mut impl FnMut(String, Vec<(f64, f64)>, Option<Vec<(f64, f64)>>, Style),
 ) -> (&'static str, &'static str) {
     let of = |f: fn(&Sample) -> f64| samples.iter().map(|s| (s.t, f(s))).collect::<Vec<_>>();
-    add("kinetic".into(), of(|s| s.energy.kinetic), None);
-    add("strain".into(), of(|s| s.energy.strain), None);
+    // Each its own colour and line style (solid, dashed, with markers),
+    // so they read apart where they overlap.
+    add(
+        "kinetic".into(),
+        of(|s| s.energy.kinetic),
+        None,
+        Style::Solid,
+    );
+    add(
+        "strain".into(),
+        of(|s| s.energy.strain),
+        None,
+        Style::Dashed,
+    );
     add(
         "kinetic + strain".into(),
         of(|s| s.energy.kinetic + s.energy.strain),
         None,
+        Style::Markers,
     );
     ("energy history", "energy (J per m of thickness)")
 }
@@ -291,21 +645,50 @@ fn cantilever(scene: &Scene, model: &Model) -> History {
     History {
         title: "deflection along the beam".into(),
         y_label: "deflection, down (m)".into(),
+        x_label: Some("x along the beam (m)".into()),
         series,
     }
 }
 
-/// The final particles, coloured by equivalent plastic strain when a
-/// material is plastic, else by displacement magnitude.
-fn particles_panel(model: &Model, summary: &Summary) -> ParticleImage {
+/// What colours the final particles: a plastic material's state where
+/// every plastic body has the same one (ε̄p for Mohr–Coulomb and
+/// Drucker–Prager, the preconsolidation pressure p_c for modified
+/// Cam-clay), else the displacement magnitude.
+#[derive(Clone, Copy, PartialEq)]
+enum Colour {
+    PlasticStrain,
+    Preconsolidation,
+    Displacement,
+}
+
+fn colour_of(model: &Model) -> Colour {
+    use crate::model::material::Material;
+    if model.particles.plastic.is_empty() {
+        return Colour::Displacement;
+    }
+    let plastic: Vec<bool> = model
+        .body_material
+        .iter()
+        .map(|&m| &model.materials[m as usize])
+        .filter(|m| m.needs_plastic_state())
+        .map(|m| matches!(m, Material::ModifiedCamClay(_)))
+        .collect();
+    if plastic.iter().all(|&c| c) {
+        Colour::Preconsolidation
+    } else if plastic.iter().all(|&c| !c) {
+        Colour::PlasticStrain
+    } else {
+        Colour::Displacement
+    }
+}
+
+/// The final particles, coloured as `colour_of` says.
+fn particles_panel(model: &Model, t: f64) -> ParticleImage {
     let p = &model.particles;
-    let plastic = !p.plastic.is_empty();
-    let value = |i: usize| {
-        if plastic {
-            p.plastic[i][1]
-        } else {
-            (p.x[i][0] - p.x0[i][0]).hypot(p.x[i][1] - p.x0[i][1])
-        }
+    let colour = colour_of(model);
+    let value = |i: usize| match colour {
+        Colour::PlasticStrain | Colour::Preconsolidation => p.plastic[i][1],
+        Colour::Displacement => (p.x[i][0] - p.x0[i][0]).hypot(p.x[i][1] - p.x0[i][1]),
     };
     let points: Vec<(f64, f64, f64)> = (0..p.len())
         .map(|i| (p.x[i][0], p.x[i][1], value(i)))
@@ -315,11 +698,12 @@ fn particles_panel(model: &Model, summary: &Summary) -> ParticleImage {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
             (a.min(q.2), b.max(q.2))
         });
-    // Both fields are magnitudes: the scale starts at zero.
-    let range = if lo.is_finite() && hi > 0.0 {
-        (0.0, hi)
-    } else {
-        (0.0, 1.0)
+    // Magnitudes start the scale at zero; p_c starts at its least.
+    let range = match colour {
+        Colour::Preconsolidation if lo.is_finite() && hi > lo => (lo, hi),
+        Colour::Preconsolidation if lo.is_finite() => (lo, lo + lo.abs().max(1.0)),
+        _ if lo.is_finite() && hi > 0.0 => (0.0, hi),
+        _ => (0.0, 1.0),
     };
     // The particles' side: the median of sqrt(volume), volume = m / ρ.
     let mut sides: Vec<f64> = (0..p.len())
@@ -330,19 +714,19 @@ fn particles_panel(model: &Model, summary: &Summary) -> ParticleImage {
     let size = sides.get(sides.len() / 2).copied().unwrap_or(0.0);
     ParticleImage {
         title: String::new(),
-        value_label: if plastic {
-            "ε̄p".into()
-        } else {
-            "|u| (m)".into()
+        value_label: match colour {
+            Colour::PlasticStrain => "ε̄p".into(),
+            Colour::Preconsolidation => "p_c (Pa)".into(),
+            Colour::Displacement => "|u| (m)".into(),
         },
         panels: vec![Panel {
             title: format!(
                 "particles at t = {} s, coloured by {}",
-                num(summary.t),
-                if plastic {
-                    "equivalent plastic strain"
-                } else {
-                    "displacement magnitude"
+                num(t),
+                match colour {
+                    Colour::PlasticStrain => "equivalent plastic strain",
+                    Colour::Preconsolidation => "preconsolidation pressure p_c",
+                    Colour::Displacement => "displacement magnitude",
                 }
             ),
             points,
@@ -351,6 +735,7 @@ fn particles_panel(model: &Model, summary: &Summary) -> ParticleImage {
         cols: 1,
         range,
         panel_size: (SIZE.0 - HISTORY_WIDTH - 90, SIZE.1 - 40),
+        axes: true,
     }
 }
 
@@ -363,10 +748,10 @@ pub fn picture(
 ) -> Result<Vec<u8>> {
     crate::chart::register_font();
     let mut h = history(scene, model, samples);
-    let static_beam = matches!(scene.file.exact, Some(ExactKind::Cantilever));
+    let not_time = h.x_label.is_some();
     // Times in the unit that keeps the tick labels plain decimals.
     let t_max = samples.last().map_or(0.0, |s| s.t);
-    let (unit, scale) = if static_beam || t_max >= 0.1 {
+    let (unit, scale) = if not_time || t_max >= 0.1 {
         ("s", 1.0)
     } else if t_max >= 1e-3 {
         ("ms", 1e3)
@@ -385,12 +770,12 @@ pub fn picture(
         format!("time t ({unit})"),
         h.y_label,
     );
-    if static_beam {
-        chart.x_label = "x along the beam (m)".into();
+    if let Some(x) = h.x_label {
+        chart.x_label = x;
     }
     chart.series = h.series;
     chart.place_legend();
-    let image = particles_panel(model, summary);
+    let image = particles_panel(model, summary.t);
     let mut buf = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
@@ -408,4 +793,126 @@ fn draw_error(e: String) -> Error {
         std::path::Path::new(FILE),
         std::io::Error::other(e),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::ProbeState;
+    use crate::model::energy::Energy;
+
+    fn model_of(text: &str) -> (Scene, Model) {
+        let scene = Scene::from_str(text, "case", "case", &[]).unwrap();
+        let model = Model::new(&scene).unwrap();
+        (scene, model)
+    }
+
+    /// Samples at rest, a growing reaction, and energies in a 2:1 ratio.
+    fn samples(model: &Model, n: usize) -> Vec<Sample> {
+        (0..n)
+            .map(|k| Sample {
+                t: 0.01 * k as f64,
+                probes: model
+                    .probes
+                    .iter()
+                    .map(|p| ProbeState {
+                        x: model.particles.x0[p.particle],
+                        v: [0.0; 2],
+                        stress: [0.0; 3],
+                    })
+                    .collect(),
+                energy: Energy {
+                    kinetic: 2.0 * k as f64,
+                    strain: k as f64,
+                    ..Default::default()
+                },
+                reactions: vec![[0.0, 1e3 * k as f64]; model.reaction_names().len()],
+                newton: None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_case_with_a_reference_draws_it_and_not_the_energy() {
+        use crate::cases::*;
+        for (text, title, reference) in [
+            (
+                FOOTING,
+                "bearing pressure against settlement",
+                "Prandtl, 2 + π = 5.14",
+            ),
+            (
+                CLAY_BIAXIAL,
+                "critical state line",
+                "critical state line q = M p′, M = 1.20",
+            ),
+            (
+                COLUMN_COLLAPSE,
+                "deposit at the end",
+                "study column, 2 s: run-out 4.85–5.06 m",
+            ),
+            (
+                GRANULAR_COLLAPSE,
+                "deposit at the end",
+                "experiments: L_f = W (1 + 1.2 a) = 3.40 m",
+            ),
+            (CONTACT_BLOCK, "slide along the face", "block, exact"),
+            (CONTACT_ROLLING, "distance rolled", "centre, exact"),
+            (CONTACT_DISKS, "contact tangent", "left_centre, exact"),
+        ] {
+            let (scene, model) = model_of(text);
+            let h = history(&scene, &model, &samples(&model, 5));
+            assert!(h.title.contains(title), "{}: {}", scene.name, h.title);
+            let r = h.series.iter().find(|s| s.label == reference);
+            assert!(
+                r.is_some_and(|s| s.dashed && !s.points.is_empty()),
+                "{}: no dashed {reference:?} in {:?}",
+                scene.name,
+                h.series.iter().map(|s| &s.label).collect::<Vec<_>>()
+            );
+            assert!(
+                !h.series.iter().any(|s| s.label == "kinetic"),
+                "{}",
+                scene.name
+            );
+        }
+    }
+
+    #[test]
+    fn the_energies_differ_in_colour_and_line_style() {
+        let text = crate::cases::PLATE_IMPACT.replace("exact = \"energy\"", "");
+        let (scene, model) = model_of(&text);
+        let h = history(&scene, &model, &samples(&model, 5));
+        let find = |l: &str| h.series.iter().find(|s| s.label == l).unwrap();
+        let (k, s, sum) = (find("kinetic"), find("strain"), find("kinetic + strain"));
+        assert!(k.color != s.color && s.color != sum.color && k.color != sum.color);
+        let style = |x: &Series| (x.dashed, x.markers);
+        assert!(style(k) != style(s) && style(s) != style(sum) && style(k) != style(sum));
+        // With `exact = "energy"` the start's energy is drawn beside them.
+        let (scene, model) = model_of(crate::cases::PLATE_IMPACT);
+        let h = history(&scene, &model, &samples(&model, 5));
+        assert!(
+            h.series
+                .iter()
+                .any(|s| s.dashed && s.label.starts_with("start's"))
+        );
+    }
+
+    #[test]
+    fn cam_clay_particles_are_coloured_and_labelled_by_p_c() {
+        let (_, model) = model_of(crate::cases::CLAY_BIAXIAL);
+        let img = particles_panel(&model, 0.0);
+        assert_eq!(img.value_label, "p_c (Pa)");
+        assert!(
+            img.panels[0]
+                .title
+                .contains("preconsolidation pressure p_c")
+        );
+        // p_c0 = ocr p′0 = 100 kPa: the scale spans the values, not 0.
+        assert!(img.range.0 > 0.9e5, "{:?}", img.range);
+        assert!(img.axes);
+        let (_, model) = model_of(crate::cases::COLUMN_COLLAPSE);
+        let img = particles_panel(&model, 0.0);
+        assert_eq!(img.value_label, "ε̄p");
+    }
 }

@@ -13,6 +13,9 @@ use std::fmt::Write;
 #[derive(Debug, Clone, Default)]
 pub struct OutOfPlane {
     rule: Vec<Szz>,
+    /// Per body: modified Cam-clay, whose plastic state holds p_c and v
+    /// where the other plastic laws hold ε̄p and εp_v.
+    cam_clay: Vec<bool>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -44,7 +47,28 @@ impl OutOfPlane {
                 _ => Szz::Unknown,
             })
             .collect();
-        OutOfPlane { rule }
+        let cam_clay = model
+            .body_material
+            .iter()
+            .map(|&m| matches!(model.materials[m as usize], Material::ModifiedCamClay(_)))
+            .collect();
+        OutOfPlane { rule, cam_clay }
+    }
+
+    /// Particle `i` is of a modified Cam-clay body.
+    pub fn cam_clay(&self, p: &Particles, i: usize) -> bool {
+        self.cam_clay.get(p.body[i] as usize) == Some(&true)
+    }
+
+    /// Some body is modified Cam-clay; some body is of another plastic law.
+    fn plastic_kinds(&self) -> (bool, bool) {
+        let mcc = self.cam_clay.iter().any(|&c| c);
+        let other = self
+            .rule
+            .iter()
+            .zip(&self.cam_clay)
+            .any(|(r, &c)| matches!(r, Szz::Carried) && !c);
+        (mcc, other)
     }
 
     /// σzz of particle `i` (Pa); 0 for a body this does not know.
@@ -89,13 +113,40 @@ pub fn particles_vtu(p: &Particles, zz: &OutOfPlane, t: f64) -> Vec<u8> {
     let mut sig = (0..n).flat_map(|i| p.stress[i]);
     arrays.push(("stress_xx_yy_xy", "Float32", 3, f32s(&mut sig)));
     if !p.plastic.is_empty() {
-        // σzz, ε̄p, εp_v and the last return's active surfaces (0 = elastic).
+        // σzz, the state's two fields and the last return's active surfaces (0 = elastic).
         let mut szz = p.plastic.iter().map(|q| q[0]);
         arrays.push(("stress_zz", "Float32", 1, f32s(&mut szz)));
-        let mut eq = p.plastic.iter().map(|q| q[1]);
-        arrays.push(("plastic_strain_eq", "Float32", 1, f32s(&mut eq)));
-        let mut vol = p.plastic.iter().map(|q| q[2]);
-        arrays.push(("plastic_strain_vol", "Float32", 1, f32s(&mut vol)));
+        // Each array holds what it names: ε̄p and εp_v for Mohr–Coulomb and
+        // Drucker–Prager, p_c and v for modified Cam-clay (whose state holds
+        // those in the same slots); a particle of another law has 0 there.
+        let (mcc, other) = zz.plastic_kinds();
+        let slot = |k: usize, cam: bool| {
+            (0..n).map(move |i| {
+                if zz.cam_clay(p, i) == cam {
+                    p.plastic[i][k]
+                } else {
+                    0.0
+                }
+            })
+        };
+        if other || !mcc {
+            arrays.push(("plastic_strain_eq", "Float32", 1, f32s(&mut slot(1, false))));
+            arrays.push((
+                "plastic_strain_vol",
+                "Float32",
+                1,
+                f32s(&mut slot(2, false)),
+            ));
+        }
+        if mcc {
+            arrays.push((
+                "preconsolidation_pressure",
+                "Float32",
+                1,
+                f32s(&mut slot(1, true)),
+            ));
+            arrays.push(("specific_volume", "Float32", 1, f32s(&mut slot(2, true))));
+        }
         let ret: Vec<u8> = p
             .plastic
             .iter()

@@ -771,6 +771,27 @@ pub enum ExactKind {
     /// Cantilever under self-weight, static (implicit-MPM paper §5.1): the
     /// free end's mid-height deflection against 0.67433 m.
     Cantilever,
+    /// The one contact pair's first body sliding on a face of its second
+    /// under gravity: slide = max(g_t − μ g_n, 0) ∫R (a t²/2 unramped).
+    ContactSliding,
+    /// The one contact pair's first body, a disk, rolling without slip on
+    /// its second: the centre moves (2/3) g_t t²/2.
+    ContactRolling,
+    /// Two disks meeting through a frictionless pair: momentum kept, no spin.
+    DiskImpact,
+    /// A strip footing (the pair's first body) on a Tresca soil (its
+    /// second): the peak q/c against Prandtl's 2 + π.
+    PrandtlFooting,
+    /// Drained compression of modified Cam-clay: q/p′ at t_end against M.
+    CriticalState,
+    /// The implicit-MPM paper's cohesive column collapse (§5.3): run-out
+    /// and height against `study column`'s figures (the paper has pictures).
+    ColumnCollapse,
+    /// A cohesionless column collapse: (L_f − W)/W against the
+    /// experiments' 1.2 a.
+    GranularCollapse,
+    /// Nothing does work: kinetic + strain energy at t_end against the start's.
+    Energy,
 }
 
 /// Manufactured solutions known to the code.

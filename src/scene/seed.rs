@@ -318,14 +318,34 @@ pub fn bodies_bbox(scene: &Scene) -> [f64; 4] {
         ];
     };
     for (_, body) in scene.bodies() {
-        body.rects.iter().for_each(|r| grow(*r));
-        body.disks
-            .iter()
-            .for_each(|d| grow(Curved::Disk(*d).bbox()));
-        body.polygons
-            .iter()
-            .for_each(|p| grow(Curved::Polygon(p.clone()).bbox()));
+        grow(body_bbox(body));
     }
+    bb
+}
+
+/// Bounding box `[xmin, ymin, xmax, ymax]` of one body's shapes (m).
+pub fn body_bbox(body: &crate::scene::schema::BodySpec) -> [f64; 4] {
+    let mut bb = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut grow = |b: [f64; 4]| {
+        bb = [
+            bb[0].min(b[0]),
+            bb[1].min(b[1]),
+            bb[2].max(b[2]),
+            bb[3].max(b[3]),
+        ];
+    };
+    body.rects.iter().for_each(|r| grow(*r));
+    body.disks
+        .iter()
+        .for_each(|d| grow(Curved::Disk(*d).bbox()));
+    body.polygons
+        .iter()
+        .for_each(|p| grow(Curved::Polygon(p.clone()).bbox()));
     bb
 }
 

@@ -1283,6 +1283,15 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ExactKind::SlidingBlock => return check_sliding_block(file),
         ExactKind::RollingDisk => return check_rolling_disk(file),
         ExactKind::Cantilever => "cantilever",
+        ExactKind::ContactSliding
+        | ExactKind::ContactRolling
+        | ExactKind::DiskImpact
+        | ExactKind::PrandtlFooting => return check_pair_reference(file, kind),
+        ExactKind::CriticalState => return check_critical_state(file),
+        ExactKind::ColumnCollapse | ExactKind::GranularCollapse => {
+            return check_collapse(file, kind);
+        }
+        ExactKind::Energy => return check_energy(file),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -1324,7 +1333,17 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         ));
     }
     match kind {
-        ExactKind::AlignedVibration | ExactKind::SlidingBlock | ExactKind::RollingDisk => {}
+        ExactKind::AlignedVibration
+        | ExactKind::SlidingBlock
+        | ExactKind::RollingDisk
+        | ExactKind::ContactSliding
+        | ExactKind::ContactRolling
+        | ExactKind::DiskImpact
+        | ExactKind::PrandtlFooting
+        | ExactKind::CriticalState
+        | ExactKind::ColumnCollapse
+        | ExactKind::GranularCollapse
+        | ExactKind::Energy => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(
@@ -1393,6 +1412,182 @@ fn check_sliding_block(file: &SceneFile) -> Result<(), SceneError> {
     }
     if !(file.constraints.is_empty() && file.tractions.is_empty() && file.point_loads.is_empty()) {
         return fail("no constraints, tractions or point loads (gravity and the wall only)");
+    }
+    Ok(())
+}
+
+/// The `exact` value's name as a scene writes it.
+fn exact_name(kind: ExactKind) -> String {
+    serde_json::to_value(kind)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
+/// The references on a contact pair (`contact_sliding`, `contact_rolling`,
+/// `disk_impact`, `prandtl_footing`): one pair, and what each reads of it.
+fn check_pair_reference(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
+    let name = exact_name(kind);
+    let bad = |msg: String| Err(SceneError::invalid("exact", format!("= \"{name}\" {msg}")));
+    if file.contact.len() != 1 {
+        return bad(format!(
+            "needs exactly one [contact.<name>] pair, the scene has {}",
+            file.contact.len()
+        ));
+    }
+    let pair = file.contact.values().next().expect("one pair");
+    let (Some(first), Some(second)) = (
+        file.bodies.get(&pair.bodies[0]),
+        file.bodies.get(&pair.bodies[1]),
+    ) else {
+        // check_contact names the missing body.
+        return Ok(());
+    };
+    let rects = |b: &BodySpec| !b.rects.is_empty() && b.disks.is_empty() && b.polygons.is_empty();
+    let one_disk = |b: &BodySpec| b.disks.len() == 1 && b.rects.is_empty() && b.polygons.is_empty();
+    let gravity = file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]);
+    match kind {
+        ExactKind::ContactSliding | ExactKind::ContactRolling => {
+            let roll = kind == ExactKind::ContactRolling;
+            if roll && !one_disk(first) {
+                return bad(
+                    "needs the pair's first body made of one disk (the rolling disk)".into(),
+                );
+            }
+            if !roll && !rects(first) {
+                return bad("needs the pair's first body (the sliding one) made of rects".into());
+            }
+            if !rects(second) {
+                return bad(
+                    "needs the pair's second body (the one slid or rolled on) made of rects".into(),
+                );
+            }
+            if !gravity {
+                return bad("needs gravity".into());
+            }
+            if first.velocity != [0.0, 0.0] {
+                return bad("needs the pair's first body at rest".into());
+            }
+            if roll && pair.law == Contact::Slip {
+                return bad(
+                    "needs law = \"friction\" or \"stick\": a disk on a slip pair slides".into(),
+                );
+            }
+            if roll
+                && file
+                    .gravity
+                    .as_ref()
+                    .is_some_and(|g| g.ramp != crate::scene::schema::Ramp::None)
+            {
+                return bad("needs constant gravity (gravity.ramp = \"none\")".into());
+            }
+        }
+        ExactKind::DiskImpact => {
+            if !(one_disk(first) && one_disk(second)) {
+                return bad("needs the pair's two bodies made of one disk each".into());
+            }
+            if pair.law != Contact::Slip {
+                return bad("needs a frictionless pair (law = \"slip\")".into());
+            }
+            if gravity || !file.tractions.is_empty() || !file.point_loads.is_empty() {
+                return bad("needs no gravity, tractions or point loads (momentum is kept)".into());
+            }
+        }
+        _ => {
+            if !rects(first) {
+                return bad("needs the pair's first body (the footing) made of rects".into());
+            }
+            let soil = file.materials.get(&second.material);
+            let tresca = soil.is_some_and(|m| {
+                m.get("cohesion").is_some_and(|c| c > 0.0)
+                    && m.get("friction_angle").unwrap_or(0.0) == 0.0
+            });
+            if !tresca {
+                return bad(
+                    "needs the pair's second body (the soil) of a material with cohesion > 0 and friction_angle = 0 (Tresca): Prandtl's (2 + pi) c is for that soil".into(),
+                );
+            }
+            if first.velocity == [0.0, 0.0] {
+                return bad(
+                    "needs the footing's velocity into the soil (bodies.<footing>.velocity)".into(),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `exact = "critical_state"`: a modified Cam-clay material.
+fn check_critical_state(file: &SceneFile) -> Result<(), SceneError> {
+    if !file
+        .materials
+        .values()
+        .any(|m| m.model == "modified_cam_clay")
+    {
+        return Err(SceneError::invalid(
+            "exact",
+            "= \"critical_state\" needs a material with model = \"modified_cam_clay\" (its M is the reference)",
+        ));
+    }
+    Ok(())
+}
+
+/// The column `exact = "column_collapse"`'s reference figures are for,
+/// `[xmin, ymin, xmax, ymax]` (m): cases/column_collapse.toml's.
+pub const COLUMN_COLLAPSE_RECT: [f64; 4] = [0.0, 0.0, 2.0, 4.0];
+
+/// `exact = "column_collapse"` / `"granular_collapse"`: one body, one rect
+/// from x = 0 (the back wall), gravity along −y.
+fn check_collapse(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
+    let name = exact_name(kind);
+    let bad = |msg: String| Err(SceneError::invalid("exact", format!("= \"{name}\" {msg}")));
+    let rect = match file.bodies.values().collect::<Vec<_>>().as_slice() {
+        [b] if b.rects.len() == 1 && b.disks.is_empty() && b.polygons.is_empty() => b.rects[0],
+        _ => return bad("needs one body made of one rect (the column)".into()),
+    };
+    if rect[0] != 0.0 {
+        return bad(format!(
+            "measures the run-out from x = 0, the back wall: the column must start there (its rect starts at x = {})",
+            rect[0]
+        ));
+    }
+    if !file
+        .gravity
+        .as_ref()
+        .is_some_and(|g| g.g[0] == 0.0 && g.g[1] < 0.0)
+    {
+        return bad("needs gravity along -y (gravity.g = [0, -g])".into());
+    }
+    if kind == ExactKind::ColumnCollapse && rect != COLUMN_COLLAPSE_RECT {
+        return bad(format!(
+            "compares with `study column`'s figures for the 2 m x 4 m column of cases/column_collapse.toml (rect [0, 0, 2, 4]), got {rect:?}; exact = \"granular_collapse\" scales with any column"
+        ));
+    }
+    Ok(())
+}
+
+/// `exact = "energy"`: nothing that does work on the bodies.
+fn check_energy(file: &SceneFile) -> Result<(), SceneError> {
+    let bad = |what: &str| {
+        Err(SceneError::invalid(
+            "exact",
+            format!("= \"energy\" needs nothing doing work on the bodies: remove {what}"),
+        ))
+    };
+    if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
+        return bad("gravity");
+    }
+    if !file.tractions.is_empty() || !file.point_loads.is_empty() {
+        return bad("the tractions and point loads");
+    }
+    if file.constraints.values().any(|c| c.velocity != [0.0, 0.0]) {
+        return bad("the prescribed velocities (constraints' velocity)");
+    }
+    if !file.walls.is_empty() {
+        return bad("the walls (their contact forces do work)");
+    }
+    if file.manufactured.is_some() {
+        return bad("[manufactured] (its body force does work)");
     }
     Ok(())
 }

@@ -120,55 +120,24 @@ fn spans(figs: &[(f64, f64)]) -> ((f64, f64), (f64, f64)) {
     (span(|x| x.0), span(|x| x.1))
 }
 
-/// Half the particle spacing at cell size `h`: a particle's extent beyond
-/// its centre.
-fn half_spacing(h: f64) -> f64 {
-    0.5 * h / PPC
+/// The particle spacing at cell size `h`.
+fn spacing(h: f64) -> f64 {
+    h / PPC
 }
 
-/// The furthest particle's reach (centre plus half a spacing), m.
-pub fn front(p: &Particles, h: f64) -> f64 {
-    p.x.iter().map(|x| x[0]).fold(f64::NEG_INFINITY, f64::max) + half_spacing(h)
-}
-
-/// Run-out: the right edge of the last column of width h (from x = 0)
-/// where the deposit is at least one cell (h) thick, m. A thin sheet of
-/// a few particles ahead of the deposit does not count, as in the
-/// experiments, where the run-out is the deposit's visible front.
+/// Run-out (`exact::collapse::run_out`), m.
 pub fn run_out(p: &Particles, h: f64) -> f64 {
-    profile(p, h)
-        .iter()
-        .filter(|(_, y)| *y >= h)
-        .map(|(x, _)| x + 0.5 * h)
-        .fold(0.0, f64::max)
-        .min(front(p, h))
+    crate::exact::collapse::run_out(p, h, spacing(h))
 }
 
 /// Height: the largest y of the material, m.
 pub fn height(p: &Particles, h: f64) -> f64 {
-    p.x.iter().map(|x| x[1]).fold(f64::NEG_INFINITY, f64::max) + half_spacing(h)
+    crate::exact::collapse::height(p, spacing(h))
 }
 
-/// Free-surface profile: per column of width h from x = 0, the top of the
-/// highest particle in it (m); columns without particles end the profile
-/// at the run-out.
+/// Free-surface profile (`exact::collapse::profile`).
 pub fn profile(p: &Particles, h: f64) -> Vec<(f64, f64)> {
-    let reach = front(p, h);
-    let n = (reach / h).ceil().max(1.0) as usize;
-    let mut top = vec![f64::NEG_INFINITY; n];
-    for x in &p.x {
-        let k = ((x[0] / h).floor().max(0.0) as usize).min(n - 1);
-        top[k] = top[k].max(x[1] + half_spacing(h));
-    }
-    let mut pts: Vec<(f64, f64)> = top
-        .iter()
-        .enumerate()
-        .filter(|(_, y)| y.is_finite())
-        .map(|(k, y)| ((k as f64 + 0.5) * h, *y))
-        .collect();
-    pts.insert(0, (0.0, pts.first().map_or(0.0, |p| p.1)));
-    pts.push((reach, 0.0));
-    pts
+    crate::exact::collapse::profile(p, h, spacing(h))
 }
 
 /// The snapshot nearest to `t`.
@@ -307,6 +276,7 @@ impl Cohesive<'_> {
                     panels,
                     range: (0.0, 1.0),
                     panel_size: (420, 260),
+                    axes: false,
                 }
                 .save(&dir.join(stem))?;
                 charts.push(dir.join(format!("{stem}.png")));

@@ -33,66 +33,7 @@ use crate::simulation::BackendChoice;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// One body's rigid-body motion measured from its particles.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BodyMotion {
-    /// kg per unit thickness.
-    pub mass: f64,
-    /// Centre of mass (m).
-    pub centre: [f64; 2],
-    /// Mass-weighted mean displacement since t = 0 (m): the centre's.
-    pub displacement: [f64; 2],
-    /// Velocity of the centre of mass (m/s).
-    pub v: [f64; 2],
-    /// Angular velocity about the centre, Σ m (r × v) / Σ m |r|² (rad/s,
-    /// counter-clockwise positive).
-    pub omega: f64,
-}
-
-/// The motion of each of `n_bodies` bodies (`Particles::body` order).
-pub fn body_motion(p: &Particles, n_bodies: usize) -> Vec<BodyMotion> {
-    let mut out = vec![
-        BodyMotion {
-            mass: 0.0,
-            centre: [0.0; 2],
-            displacement: [0.0; 2],
-            v: [0.0; 2],
-            omega: 0.0,
-        };
-        n_bodies
-    ];
-    for i in 0..p.len() {
-        let b = &mut out[p.body[i] as usize];
-        let m = p.mass[i];
-        b.mass += m;
-        for d in 0..2 {
-            b.centre[d] += m * p.x[i][d];
-            b.displacement[d] += m * (p.x[i][d] - p.x0[i][d]);
-            b.v[d] += m * p.v[i][d];
-        }
-    }
-    for b in &mut out {
-        let m = b.mass.max(f64::MIN_POSITIVE);
-        for d in 0..2 {
-            b.centre[d] /= m;
-            b.displacement[d] /= m;
-            b.v[d] /= m;
-        }
-    }
-    let mut ang = vec![[0.0f64; 2]; n_bodies];
-    for i in 0..p.len() {
-        let k = p.body[i] as usize;
-        let b = &out[k];
-        let r = [p.x[i][0] - b.centre[0], p.x[i][1] - b.centre[1]];
-        let v = [p.v[i][0] - b.v[0], p.v[i][1] - b.v[1]];
-        ang[k][0] += p.mass[i] * (r[0] * v[1] - r[1] * v[0]);
-        ang[k][1] += p.mass[i] * (r[0] * r[0] + r[1] * r[1]);
-    }
-    for (b, a) in out.iter_mut().zip(ang) {
-        b.omega = if a[1] > 0.0 { a[0] / a[1] } else { 0.0 };
-    }
-    out
-}
+pub use crate::exact::bodies::{BodyMotion, body_motion};
 
 /// How far body 0's particle domains reach past body 1's along the line
 /// from 0's centre to 1's (m; negative: apart). Domains are squares of
@@ -118,6 +59,8 @@ pub fn overlap(p: &Particles, b: &[BodyMotion]) -> f64 {
 }
 
 /// A case's text without its `[contact.<name>]` table: one shared field.
+/// Its `exact` line goes too: the pair's reference (`contact_sliding`,
+/// `disk_impact`, ...) needs the pair.
 pub fn one_field(case: &str, table_name: &str) -> String {
     let head = format!("[contact.{table_name}]");
     let start = case
@@ -125,6 +68,10 @@ pub fn one_field(case: &str, table_name: &str) -> String {
         .unwrap_or_else(|| panic!("the case has no {head}"));
     let end = start + case[start..].find("\n\n").unwrap_or(case.len() - start);
     format!("{}{}", &case[..start], &case[end..])
+        .lines()
+        .filter(|l| !l.starts_with("exact = "))
+        .map(|l| format!("{l}\n"))
+        .collect()
 }
 
 /// The block case's incline: 30°, gravity 9.81 m/s² ramped by eq. 45 over

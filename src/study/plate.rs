@@ -192,6 +192,7 @@ fn fe_against_npc(
             cols: TIMES.len(),
             range: (0.0, vmax),
             panel_size: (230, 250),
+            axes: false,
         }
         .save(&dir.join("study-plate-fe-npc"))?;
         charts.push(dir.join("study-plate-fe-npc.png"));
@@ -276,6 +277,7 @@ fn regular_against_perturbed(
         cols: 2,
         range: (0.0, vmax),
         panel_size: (300, 300),
+        axes: false,
     }
     .save(&dir.join("study-plate-perturbed"))?;
     charts.push(dir.join("study-plate-perturbed.png"));

@@ -113,7 +113,7 @@ pub fn check_metric(plan: &Plan, metric: &str) -> Result<()> {
     let known: Vec<String> = match scene.file.exact {
         Some(kind) => {
             let model = crate::model::Model::new(&scene)?;
-            let e = crate::exact::score(kind, &scene, &model, &model.particles, 0.0);
+            let e = crate::exact::score(kind, &scene, &model, &model.particles, 0.0, &[]);
             let json = serde_json::to_string(&e).expect("errors serialise");
             let summary = format!(r#"{{"status":"completed","errors":{json}}}"#);
             record::Record::from_summary("", vec![], &summary)

@@ -229,7 +229,7 @@ fn run_one(job: &Job, threads: usize) -> Result<RunData, String> {
         .drive_with(schedule, &mut keeper)
         .map_err(|e| e.to_string())?;
     let wall = start.elapsed().as_secs_f64();
-    let errors = sim.score().map_err(|e| e.to_string())?;
+    let errors = sim.score_with(&keeper.samples).map_err(|e| e.to_string())?;
     let backend = sim.backend();
     let t = backend.time();
     let bytes_per_particle = backend.bytes_per_particle();
