@@ -180,7 +180,7 @@ fn cam_clay_is_labelled_by_its_preconsolidation_pressure() {
     let r = bin()
         .arg("render")
         .arg(&out)
-        .args(["--field", "p_c", "--width", "200"])
+        .args(["--field", "p_c", "--width", "320"])
         .output()
         .unwrap();
     assert!(r.status.success(), "{}", said(&r));
@@ -200,7 +200,7 @@ fn cam_clay_is_labelled_by_its_preconsolidation_pressure() {
     let r = bin()
         .arg("render")
         .arg(&out)
-        .args(["--field", "eps_p", "--width", "200"])
+        .args(["--field", "eps_p", "--width", "320"])
         .output()
         .unwrap();
     assert_eq!(r.status.code(), Some(2), "{}", said(&r));

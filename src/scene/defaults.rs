@@ -37,7 +37,7 @@ pub fn pic_fraction(file: &SceneFile) -> Option<(f64, String)> {
                     "solver.pic_fraction = {GRANULAR_PIC} by default: body '{body}' is of \
                      material '{}', frictional (friction angle {phi} degrees) and cohesionless \
                      at the grid's scale (cohesion {c} Pa below the weight of one cell of it, \
-                     rho |g| h = {weight:.4} Pa), and pure FLIP's grid noise keeps such a deposit \
+                     rho |g| h = {weight:.1} Pa), and pure FLIP's grid noise keeps such a deposit \
                      flowing; set solver.pic_fraction = 0 for pure FLIP",
                     b.material
                 ),
