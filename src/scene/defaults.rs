@@ -69,7 +69,13 @@ mod tests {
         let s = scene(granular, &["solver.pic_fraction=0"]);
         assert_eq!((s.solver().pic_fraction, s.chosen.len()), (Some(0.0), 0));
         // Cohesive at the grid's scale (5 kPa against rho g h = 454 Pa), no
-        // friction, no gravity, the implicit step: pure FLIP as before.
+        // friction, no gravity: pure FLIP as before. (Without gravity the
+        // case's exact run-out does not apply: its line goes.)
+        let unscored: String = granular
+            .lines()
+            .filter(|l| !l.starts_with("exact"))
+            .collect::<Vec<_>>()
+            .join("\n");
         for sets in [
             &["materials.sand.cohesion=5e3"][..],
             &["materials.sand.friction_angle=0"],
@@ -78,7 +84,7 @@ mod tests {
                 "bodies.column.initial_stress=\"none\"",
             ],
         ] {
-            let s = scene(granular, sets);
+            let s = scene(&unscored, sets);
             assert_eq!(s.solver().pic_fraction, None, "{sets:?}");
         }
         // The cohesive column of the implicit-MPM paper stays FLIP.

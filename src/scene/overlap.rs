@@ -13,6 +13,7 @@
 //! on an edge, a disk resting on a rectangle) touch within `tol` and do
 //! not overlap.
 
+use super::seed::inside_polygon;
 use super::seed::polygon_area;
 
 /// A body's shape, as the scene gives it.
@@ -61,7 +62,7 @@ pub fn overlap(a: &Shape, b: &Shape, tol: f64) -> Option<([f64; 2], Option<f64>)
         (Shape::Disk(d), p) | (p, Shape::Disk(d)) => {
             let poly = p.vertices().expect("not a disk");
             let c = [d[0], d[1]];
-            let (q, dist) = if inside(&poly, c) {
+            let (q, dist) = if inside_polygon(&poly, c) {
                 (c, 0.0)
             } else {
                 closest_on_boundary(&poly, c)
@@ -115,7 +116,7 @@ fn piece_inside(a: &[[f64; 2]], b: &[[f64; 2]], tol: f64) -> Option<[f64; 2]> {
                 p0[0] + t * e[0] + off * inward[0],
                 p0[1] + t * e[1] + off * inward[1],
             ];
-            if inside(b, x) && inside(a, x) {
+            if inside_polygon(b, x) && inside_polygon(a, x) {
                 return Some(x);
             }
         }
@@ -147,22 +148,6 @@ fn crossings(p0: [f64; 2], e: [f64; 2], q0: [f64; 2], q1: [f64; 2]) -> Vec<f64> 
     } else {
         Vec::new()
     }
-}
-
-fn inside(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
-    let mut inside = false;
-    let n = poly.len();
-    let mut j = n - 1;
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[j]);
-        if (a[1] > p[1]) != (b[1] > p[1])
-            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
-        {
-            inside = !inside;
-        }
-        j = i;
-    }
-    inside
 }
 
 /// The point of `poly`'s boundary nearest `c`, and its distance.

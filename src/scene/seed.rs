@@ -82,7 +82,8 @@ pub fn polygon_area(poly: &[[f64; 2]]) -> f64 {
         * 0.5
 }
 
-fn inside_polygon(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
+/// Whether `p` lies inside `poly` (even-odd rule).
+pub fn inside_polygon(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
     let mut inside = false;
     let n = poly.len();
     let mut j = n - 1;
@@ -280,73 +281,53 @@ impl Curved {
 
     fn bbox(&self) -> [f64; 4] {
         match self {
-            Curved::Disk(d) => [d[0] - d[2], d[1] - d[2], d[0] + d[2], d[1] + d[2]],
-            Curved::Polygon(poly) => poly.iter().fold(
-                [
-                    f64::INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::NEG_INFINITY,
-                ],
-                |b, p| {
-                    [
-                        b[0].min(p[0]),
-                        b[1].min(p[1]),
-                        b[2].max(p[0]),
-                        b[3].max(p[1]),
-                    ]
-                },
-            ),
+            Curved::Disk(d) => disk_bbox(*d),
+            Curved::Polygon(poly) => polygon_bbox(poly),
         }
     }
 }
 
+/// The box `[xmin, ymin, xmax, ymax]` holding both boxes.
+fn union(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
+}
+
+const EMPTY_BOX: [f64; 4] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NEG_INFINITY,
+];
+
+/// Bounding box `[xmin, ymin, xmax, ymax]` of the disk `[cx, cy, r]` (m).
+pub fn disk_bbox(d: [f64; 3]) -> [f64; 4] {
+    [d[0] - d[2], d[1] - d[2], d[0] + d[2], d[1] + d[2]]
+}
+
+/// Bounding box `[xmin, ymin, xmax, ymax]` of a polygon's vertices (m).
+pub fn polygon_bbox(poly: &[[f64; 2]]) -> [f64; 4] {
+    poly.iter()
+        .fold(EMPTY_BOX, |b, p| union(b, [p[0], p[1], p[0], p[1]]))
+}
+
 /// Bounding box `[xmin, ymin, xmax, ymax]` of every shape of every body (m).
 pub fn bodies_bbox(scene: &Scene) -> [f64; 4] {
-    let mut bb = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    let mut grow = |b: [f64; 4]| {
-        bb = [
-            bb[0].min(b[0]),
-            bb[1].min(b[1]),
-            bb[2].max(b[2]),
-            bb[3].max(b[3]),
-        ];
-    };
-    for (_, body) in scene.bodies() {
-        grow(body_bbox(body));
-    }
-    bb
+    scene
+        .bodies()
+        .fold(EMPTY_BOX, |bb, (_, body)| union(bb, body_bbox(body)))
 }
 
 /// Bounding box `[xmin, ymin, xmax, ymax]` of one body's shapes (m).
 pub fn body_bbox(body: &crate::scene::schema::BodySpec) -> [f64; 4] {
-    let mut bb = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    let mut grow = |b: [f64; 4]| {
-        bb = [
-            bb[0].min(b[0]),
-            bb[1].min(b[1]),
-            bb[2].max(b[2]),
-            bb[3].max(b[3]),
-        ];
-    };
-    body.rects.iter().for_each(|r| grow(*r));
-    body.disks
-        .iter()
-        .for_each(|d| grow(Curved::Disk(*d).bbox()));
-    body.polygons
-        .iter()
-        .for_each(|p| grow(Curved::Polygon(p.clone()).bbox()));
-    bb
+    let rects = body.rects.iter().copied();
+    let disks = body.disks.iter().map(|d| disk_bbox(*d));
+    let polygons = body.polygons.iter().map(|p| polygon_bbox(p));
+    rects.chain(disks).chain(polygons).fold(EMPTY_BOX, union)
 }
 
 #[cfg(test)]

@@ -1167,23 +1167,8 @@ fn check_body_overlaps(file: &SceneFile) -> Result<(), SceneError> {
         let mut add = |kind: &str, i: usize, s: Shape| {
             let bb = match &s {
                 Shape::Rect(r) => *r,
-                Shape::Disk(d) => [d[0] - d[2], d[1] - d[2], d[0] + d[2], d[1] + d[2]],
-                Shape::Polygon(p) => p.iter().fold(
-                    [
-                        f64::INFINITY,
-                        f64::INFINITY,
-                        f64::NEG_INFINITY,
-                        f64::NEG_INFINITY,
-                    ],
-                    |b, p| {
-                        [
-                            b[0].min(p[0]),
-                            b[1].min(p[1]),
-                            b[2].max(p[0]),
-                            b[3].max(p[1]),
-                        ]
-                    },
-                ),
+                Shape::Disk(d) => super::seed::disk_bbox(*d),
+                Shape::Polygon(p) => super::seed::polygon_bbox(p),
             };
             shapes.push((bi, format!("bodies.{n}.{kind}[{i}]"), s, bb));
         };
