@@ -313,7 +313,7 @@ fn short_implicit_rolling_disk_follows_the_exact_motion() {
 /// The rolling disk as `study disk` runs it (R/h = 20, 0.5 s), implicit,
 /// every shape at Δt1 = 2Δt2 = 4Δt3: a measurement for docs/methods.md,
 /// not a check (about an hour on two cores). `cargo test --release --test
-/// implicit -- --ignored --nocapture implicit_rolling_disk_table`.
+/// suite -- --ignored --nocapture implicit_rolling_disk_table`.
 #[test]
 #[ignore]
 fn implicit_rolling_disk_table() {
