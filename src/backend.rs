@@ -53,6 +53,27 @@ pub struct State {
     pub cloud: Option<CloudState>,
 }
 
+impl State {
+    /// `particles` at time `t` (the last step's Δt `dt`) as a state of
+    /// `model` at a step boundary: every field's grid nodes (grid nodes ×
+    /// `Model::n_fields`, one set per body of a contact pair) at zero,
+    /// which is exact there (each step clears them before it scatters); no
+    /// Newton counters, held contacts or node cloud.
+    pub fn at_step_boundary(model: &Model, particles: Particles, t: f64, dt: f64) -> State {
+        let nodes = model.grid.n_nodes() * model.n_fields();
+        State {
+            particles,
+            mv: vec![[0.0; 3]; nodes],
+            force: vec![[0.0; 2]; nodes],
+            t,
+            dt,
+            newton: None,
+            held_contacts: Vec::new(),
+            cloud: None,
+        }
+    }
+}
+
 /// What a GMM run's node cloud carries from step to step, beyond what its
 /// scene rebuilds (the nodes' lattice origin, constraints and the rim
 /// nodes' fit to the outline come from the initial particles): per node, the

@@ -129,19 +129,13 @@ pub fn resume(dir: &Path, overrides: &[Override], opts: &RunOptions) -> Result<O
     let plan = preflight(&scene, opts)?;
     let mut sim = Simulation::new(&plan.scene, &spec(opts))?;
     // Every field's nodes: a scene with contact pairs has one grid per
-    // field (`Model::n_fields`). The step clears them before it scatters,
-    // so zeros continue the run exactly; only their count must fit.
+    // field, and resume refused every such scene while it sized one.
     let model = sim.backend_ref().model();
-    let nodes = model.grid.n_nodes() * model.n_fields();
     let state = State {
-        particles: ck.particles.clone(),
-        mv: vec![[0.0; 3]; nodes],
-        force: vec![[0.0; 2]; nodes],
-        t: ck.t,
-        dt: ck.dt,
         newton: ck.newton.clone(),
         held_contacts: ck.held_contacts.clone(),
         cloud: ck.cloud.clone(),
+        ..State::at_step_boundary(model, ck.particles.clone(), ck.t, ck.dt)
     };
     sim.backend().restore(&state, ck.steps)?;
     // What the run wrote after its checkpoint goes; the snapshots up to it stay.
