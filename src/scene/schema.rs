@@ -724,8 +724,8 @@ pub struct OutputSpec {
     #[serde(default = "default_true")]
     pub particles_csv: bool,
     /// Leave `checkpoint.lmeck` at t_end when the run completes, so
-    /// `lme-mpm resume DIR --set solver.t_end=LATER` can extend it (about
-    /// 190 bytes per particle on disk). Default true.
+    /// `lme-mpm resume DIR --set solver.t_end=LATER` can extend it (124 to
+    /// 188 bytes per particle on disk, docs/outputs.md). Default true.
     #[serde(default = "default_true")]
     pub final_checkpoint: bool,
     /// Named points (m); the particle nearest to each at t = 0 is tracked.
