@@ -65,17 +65,18 @@ fn run_whole(scene: &lme_mpm::scene::Scene, model: &Model) -> Option<(Particles,
     Some((b.particles().unwrap().clone(), b.steps()))
 }
 
-#[test]
-fn gpu_resume_matches_an_uninterrupted_gpu_run() {
-    let scene = common::scene("dyka_bar.toml", &["solver.t_end=3e-5"]);
-    let model = Model::new(&scene).unwrap();
-    let Some((whole, whole_steps)) = run_whole(&scene, &model) else {
-        return;
-    };
-
+/// A GPU run of `model` stopped after `after` samples, restored into a
+/// fresh GPU backend and driven on to the end: the time it stopped at, its
+/// step count then, the resumed backend's steps at the end and its
+/// particles.
+fn interrupted_and_resumed(
+    scene: &lme_mpm::scene::Scene,
+    model: &Model,
+    after: usize,
+) -> (f64, u64, u64, Particles) {
     let stop = Arc::new(AtomicBool::new(false));
     let mut first = Stopper {
-        after: 40,
+        after,
         seen: 0,
         stop: Arc::clone(&stop),
         saved: None,
@@ -95,7 +96,7 @@ fn gpu_resume_matches_an_uninterrupted_gpu_run() {
     assert_eq!(state.t, t1);
 
     let ctx = common::gpu::open("gpu_resume", false).expect("opened once already");
-    let mut c = GpuBackend::new(ctx, model).unwrap();
+    let mut c = GpuBackend::new(ctx, model.clone()).unwrap();
     c.restore(&state, steps).unwrap();
     assert_eq!((c.time(), c.steps()), (t1, steps));
     let schedule = Schedule {
@@ -105,7 +106,17 @@ fn gpu_resume_matches_an_uninterrupted_gpu_run() {
     let mut rec = solver::Recorder::default();
     let status = solver::drive_from(&mut c, schedule, &mut rec, Some(cursor)).unwrap();
     assert_eq!(status, RunStatus::Completed);
-    let resumed = c.particles().unwrap().clone();
+    (t1, steps, c.steps(), c.particles().unwrap().clone())
+}
+
+#[test]
+fn gpu_resume_matches_an_uninterrupted_gpu_run() {
+    let scene = common::scene("dyka_bar.toml", &["solver.t_end=3e-5"]);
+    let model = Model::new(&scene).unwrap();
+    let Some((whole, whole_steps)) = run_whole(&scene, &model) else {
+        return;
+    };
+    let (t1, steps, end_steps, resumed) = interrupted_and_resumed(&scene, &model, 40);
 
     let v0 = 5.0;
     let z = (200e9f64 * 7833.0).sqrt();
@@ -114,18 +125,17 @@ fn gpu_resume_matches_an_uninterrupted_gpu_run() {
     let dv = rms(&vx(&whole), &vx(&resumed)) / v0;
     let ds = rms(&sx(&whole), &sx(&resumed)) / (z * v0);
     println!(
-        "interrupted at t = {t1:.4e} s (step {steps}); steps whole {whole_steps} resumed {}; \
-         velocity RMS diff / v0 = {dv:.2e}, stress RMS diff / (Z v0) = {ds:.2e}",
-        c.steps()
+        "interrupted at t = {t1:.4e} s (step {steps}); steps whole {whole_steps} resumed \
+         {end_steps}; velocity RMS diff / v0 = {dv:.2e}, stress RMS diff / (Z v0) = {ds:.2e}"
     );
     assert!(dv < TOL && ds < TOL, "velocity {dv}, stress {ds}");
-    assert!(c.steps().abs_diff(whole_steps) <= 1);
+    assert!(end_steps.abs_diff(whole_steps) <= 1);
 }
 
-/// The contact disks (a pair: three fields of grid nodes) stopped during
-/// the impact and restored into a fresh GPU backend end where an
-/// uninterrupted GPU run ends. Before the state held every field's nodes,
-/// `restore` refused the scene (3233 nodes against 9699).
+/// The contact disks (a pair: three fields of grid nodes) stopped as they
+/// meet and restored into a fresh GPU backend end where an uninterrupted
+/// GPU run ends. Before the state held every field's nodes, `restore`
+/// refused the scene (3233 nodes against 9699).
 #[test]
 fn gpu_resume_of_a_contact_run_matches_an_uninterrupted_one() {
     let scene = common::scene(
@@ -136,46 +146,13 @@ fn gpu_resume_of_a_contact_run_matches_an_uninterrupted_one() {
     let Some((whole, _)) = run_whole(&scene, &model) else {
         return;
     };
-    let stop = Arc::new(AtomicBool::new(false));
     // The 11th sample (the first is at t = 0) is at 0.025 s, as the disks
     // meet: the resumed part holds the whole impact.
-    let mut first = Stopper {
-        after: 11,
-        seen: 0,
-        stop: Arc::clone(&stop),
-        saved: None,
-    };
-    let ctx = common::gpu::open("gpu_resume_contact", false).expect("opened once already");
-    let mut b = GpuBackend::new(ctx, model.clone()).unwrap();
-    let schedule = Schedule {
-        sample_interval: scene.sample_interval,
-        stop: Some(stop),
-        ..Default::default()
-    };
-    let status = solver::drive(&mut b, schedule.clone(), &mut first).unwrap();
-    assert!(
-        matches!(status, RunStatus::Interrupted { .. }),
-        "{status:?}"
-    );
-    let (state, steps, cursor) = first.saved.expect("a checkpoint at the interruption");
-    let ctx = common::gpu::open("gpu_resume_contact", false).expect("opened once already");
-    let mut c = GpuBackend::new(ctx, model).unwrap();
-    c.restore(&state, steps).unwrap();
-    let schedule = Schedule {
-        stop: None,
-        ..schedule
-    };
-    let mut rec = solver::Recorder::default();
-    let status = solver::drive_from(&mut c, schedule, &mut rec, Some(cursor)).unwrap();
-    assert_eq!(status, RunStatus::Completed);
-    let resumed = c.particles().unwrap().clone();
+    let (t1, _, _, resumed) = interrupted_and_resumed(&scene, &model, 11);
     // Velocities over the impact speed, 1 m/s.
     let comp = |p: &Particles, k: usize| p.v.iter().map(|v| v[k]).collect::<Vec<_>>();
     let dv =
         rms(&comp(&whole, 0), &comp(&resumed, 0)).max(rms(&comp(&whole, 1), &comp(&resumed, 1)));
-    println!(
-        "contact disks interrupted at t = {:.4e} s: velocity RMS diff {dv:.2e} m/s",
-        state.t
-    );
+    println!("contact disks interrupted at t = {t1:.4e} s: velocity RMS diff {dv:.2e} m/s");
     assert!(dv < TOL, "velocity RMS diff {dv} m/s");
 }

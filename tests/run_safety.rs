@@ -405,16 +405,22 @@ fn a_damaged_or_missing_checkpoint_is_refused_with_exit_2() {
     assert!(stderr(&o).contains("checkpoint"), "{}", stderr(&o));
 }
 
-#[test]
-fn progress_lines_on_a_pipe_unless_quiet() {
-    let out = tmp("progress");
-    let o = bin()
+/// Dyka's bar to 1e-5 s on the CPU into `out`, progress lines on (no
+/// `--quiet`; stderr is a pipe).
+fn dyka_with_progress(out: &Path) -> Output {
+    bin()
         .args(["run", "--backend", "cpu", "--out"])
-        .arg(&out)
+        .arg(out)
         .arg(common::case("dyka_bar.toml"))
         .args(["--set", "solver.t_end=1e-5"])
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+#[test]
+fn progress_lines_on_a_pipe_unless_quiet() {
+    let out = tmp("progress");
+    let o = dyka_with_progress(&out);
     assert!(o.status.success());
     let err = stderr(&o);
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("progress:")).collect();
@@ -453,13 +459,7 @@ fn progress_of(err: &str) -> Vec<(String, f64)> {
 #[test]
 fn a_resumed_runs_progress_counts_its_own_steps_and_repeats_no_line() {
     let out = tmp("progress-resume");
-    let first = bin()
-        .args(["run", "--backend", "cpu", "--out"])
-        .arg(&out)
-        .arg(common::case("dyka_bar.toml"))
-        .args(["--set", "solver.t_end=1e-5"])
-        .output()
-        .unwrap();
+    let first = dyka_with_progress(&out);
     assert!(first.status.success(), "{}", stderr(&first));
     let before = progress_of(&stderr(&first));
     let fastest = before.iter().map(|p| p.1).fold(0.0, f64::max);
