@@ -3,7 +3,8 @@
 // CPU's `wall_touch` and `wall_contact` zero).
 // With CONTACT, every field's nodes, the fields' mass gradients and
 // volumes (`contact_grad.wgsl` scatters them) and the smallest particle
-// half-width (`contact_slack`, kept by atomicMin).
+// half-width (`contact_slack`, kept by atomicMin), and the momentum the
+// interface's PIC share changes in g2p (`contact_pic`).
 // CPU twin: src/cpu/clear_grid.rs.
 #include "shared/common.wgsl"
 
@@ -19,6 +20,7 @@
 #if CONTACT
 @group(0) @binding({{B_CONTACT_GRAD}}) var<storage, read_write> contact_grad: array<f32>;
 @group(0) @binding({{B_CONTACT_SLACK}}) var<storage, read_write> contact_slack: array<u32>;
+@group(0) @binding({{B_CONTACT_PIC}}) var<storage, read_write> contact_pic: array<f32>;
 #endif
 
 @compute @workgroup_size(256)
@@ -35,6 +37,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if n == 0u {
         // The largest finite f32: atomicMin on the bits of positive floats.
         contact_slack[0] = 0x7f7fffffu;
+    }
+    // The momentum g2p's interface blend changes, per field (its mass,
+    // entry 0, stays).
+    if n < N_FIELDS {
+        contact_pic[3u * n + 1u] = 0.0;
+        contact_pic[3u * n + 2u] = 0.0;
     }
     if n >= field_nodes() {
         return;

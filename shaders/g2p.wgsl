@@ -5,11 +5,39 @@
 //      compensated (Kahan) sum u − u_lo: a slow, steady motion would otherwise
 //      lose the same fraction of every small increment to f32 rounding.
 // PIC: v = (1 − α) v_FLIP + α Σ N v_I, α = params.pic_fraction.
+// CONTACT: a particle that reaches a node where a pair of its field is in
+// contact (a normal in contact_detect's output) takes α at least
+// CONTACT_PIC_FRACTION (shared/contact.wgsl), and adds the momentum this
+// changes to its field's sum, which contact_conserve.wgsl gives back.
 // CPU twin: src/cpu/g2p.rs.
 #include "shared/common.wgsl"
 #include "shared/kahan.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
+#if CONTACT
+#include "shared/contact.wgsl"
+@group(0) @binding({{B_CONTACT_PAIRS}}) var<storage, read> contact_pairs: array<ContactPair>;
+@group(0) @binding({{B_CONTACT_NORMAL}}) var<storage, read> contact_normal_in: array<f32>;
+@group(0) @binding({{B_MASS}}) var<storage, read> mass: array<f32>;
+// Per field [mass, Σ m_p Δv_p]: the blend's momentum, for contact_conserve.
+@group(0) @binding({{B_CONTACT_PIC}}) var<storage, read_write> contact_pic: array<{{ATOMIC_T}}>;
+#include "shared/atomics.wgsl" ARR=contact_pic FN=pic_add
+
+// Whether a pair of field f with a tangential force (stick, friction) is
+// in contact at grid node i.
+fn touched(f: u32, i: u32) -> bool {
+    for (var k = 0u; k < N_PAIRS; k++) {
+        let pf = contact_pairs[k].fields;
+        if contact_pairs[k].law != CONTACT_SLIP && (pf.x == f || pf.y == f) {
+            let o = 3u * (k * params.n_nodes + i);
+            if contact_normal_in[o] != 0.0 || contact_normal_in[o + 1u] != 0.0 {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+#endif
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;
 @group(0) @binding({{B_U}}) var<storage, read_write> u: array<vec2<f32>>;
@@ -30,6 +58,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let c = shape_ctx(p, x0[p] + u[p]);
     var acc = vec2<f32>(0.0);
     var vel = vec2<f32>(0.0);
+#if CONTACT
+    var near_contact = false;
+    let base = field_base(p);
+#endif
     for (var r = 0u; r < SHAPE_ROWS; r++) {
         let span = shape_span(c, r);
         for (var k = span.x; k < span.y; k++) {
@@ -37,6 +69,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             if !w.ok {
                 continue;
             }
+#if CONTACT
+            if w.n > 0.0 && !near_contact {
+                near_contact = touched(field[p], w.node - base);
+            }
+#endif
             let b = w.node * NODE_STRIDE;
             let m = node_acc[b];
             if m > params.mass_eps {
@@ -45,10 +82,31 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             }
         }
     }
+#if CONTACT
+    var alpha = params.pic_fraction;
+    if near_contact {
+        alpha = max(alpha, CONTACT_PIC_FRACTION);
+    }
+    let flip = v[p] + dt * acc;
+    var vp = flip;
+    if alpha > 0.0 {
+        vp = (1.0 - alpha) * flip + alpha * vel;
+    }
+    if alpha > params.pic_fraction {
+        // The interface's share over the scene's: its momentum change,
+        // which contact_conserve gives back to the field.
+        let scene_v = (1.0 - params.pic_fraction) * flip + params.pic_fraction * vel;
+        let dp = mass[p] * (vp - scene_v);
+        let f = field[p];
+        pic_add(3u * f + 1u, dp.x);
+        pic_add(3u * f + 2u, dp.y);
+    }
+#else
 #if PIC
     let vp = (1.0 - params.pic_fraction) * (v[p] + dt * acc) + params.pic_fraction * vel;
 #else
     let vp = v[p] + dt * acc;
+#endif
 #endif
     var du = dt * vel;
 #if NPC

@@ -173,6 +173,10 @@ pub enum Pass {
     ContactDetect,
     ContactExchange,
     ContactExchangeForce,
+    /// Contact pairs only, after `G2p`: each field given back the momentum
+    /// the interface's PIC share changed (`cpu::contact::conserve`,
+    /// contact_conserve.wgsl).
+    ContactConserve,
     /// Constraint points only (`cpu::constraint_points::hold`): the
     /// projection that holds the points at their group's velocity
     /// (constraint_points.wgsl), right after each `GridPredict` pass, and
@@ -195,7 +199,7 @@ pub enum Pass {
 
 impl Pass {
     /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 42] = [
+    pub const ALL: [Pass; 43] = [
         Pass::Cfl,
         Pass::StepBegin,
         Pass::ClearGrid,
@@ -229,6 +233,7 @@ impl Pass {
         Pass::ContactDetect,
         Pass::ContactExchange,
         Pass::ContactExchangeForce,
+        Pass::ContactConserve,
         Pass::ConstraintPoints,
         Pass::ConstraintPointsForce,
         Pass::G2p,
@@ -254,6 +259,7 @@ impl Pass {
             Pass::ContactGrad => "contact_grad.wgsl",
             Pass::ContactDetect => "contact_detect.wgsl",
             Pass::ContactExchange | Pass::ContactExchangeForce => "contact_exchange.wgsl",
+            Pass::ContactConserve => "contact_conserve.wgsl",
             Pass::ConstraintPoints | Pass::ConstraintPointsForce => "constraint_points.wgsl",
             Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
@@ -506,6 +512,7 @@ impl StepPlan {
             Stage::GridCorrect if contact => &[Pass::GridCorrect, Pass::ContactExchangeForce],
             Stage::GridCorrect if walls => &[Pass::WallContact, Pass::GridCorrect],
             Stage::GridCorrect => &[Pass::GridCorrect],
+            Stage::G2p if contact => &[Pass::G2p, Pass::ContactConserve],
             Stage::G2p => &[Pass::G2p],
             Stage::Remap if mls => &[Pass::RemapClear, Pass::MlsRemap, Pass::GridPredict],
             // The contacts stay those of the step's start (`GridPredict`).

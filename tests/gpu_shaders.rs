@@ -568,6 +568,10 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("LR_MAX_STEP", f(lme_mpm::cpu::contact::LR_MAX_STEP)),
         ("LR_MIN_SCALE", f(lme_mpm::cpu::contact::LR_MIN_SCALE)),
         ("LR_FLAT_COS", f(lme_mpm::cpu::contact::LR_FLAT_COS)),
+        (
+            "CONTACT_PIC_FRACTION",
+            f(lme_mpm::model::contact::CONTACT_PIC_FRACTION),
+        ),
     ];
     let modules = every_pass_module();
     // Every model's code, generated from the registry.

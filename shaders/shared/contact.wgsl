@@ -18,6 +18,10 @@ struct ContactPair {
 // Keep in sync with `CONTACT_GAP_SLACK` in src/cpu/contact.rs.
 const CONTACT_GAP_SLACK: f32 = 1e-3;
 
+// Least share of PIC in g2p for particles at a node in contact. Keep in
+// sync with `CONTACT_PIC_FRACTION` in src/model/contact.rs.
+const CONTACT_PIC_FRACTION: f32 = 0.05;
+
 // The logistic-regression normal: ridge, Newton steps, step cap, least scale.
 // Keep in sync with `LR_RIDGE`, `LR_ITERATIONS`, `LR_MAX_STEP`, `LR_MIN_SCALE` in
 // src/cpu/contact.rs (tests/gpu_shaders.rs checks).

@@ -22,7 +22,8 @@
 
 use super::stage_inputs::ShapeCache;
 use crate::model::Contacts;
-use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_SLIP, CONTACT_STICK};
+use rayon::prelude::*;
 
 /// Slack of the gap test relative to the particles' half-width: domains
 /// seeded flush against each other touch whatever the round-off.
@@ -40,17 +41,29 @@ pub struct ContactState {
     /// Per pair node: the gap between the two bodies' particle domains
     /// there (m; negative where they overlap).
     pub gap: Vec<f64>,
+    /// Per field node: some pair of the field with a tangential force
+    /// (stick, friction) is in contact there (the nodes whose particles
+    /// take `CONTACT_PIC_FRACTION` in g2p).
+    pub touched: Vec<bool>,
+    /// Per particle: m_p times the change the interface's PIC share made
+    /// to its velocity in g2p (zero elsewhere), summed by `conserve`.
+    pub pic_dp: Vec<[f64; 2]>,
+    /// Scratch per field: [mass, Σ pic_dp].
+    field_dp: Vec<[f64; 3]>,
     /// Scratch: (pair node, side, particle) of the particles reaching a
     /// node where the pair has a normal.
     members: Vec<(u32, u8, u32)>,
 }
 
 impl ContactState {
-    pub fn new(c: &Contacts, n_nodes: usize) -> Self {
+    pub fn new(c: &Contacts, n_nodes: usize, n_particles: usize) -> Self {
         ContactState {
             grad: vec![[0.0; 3]; c.n_fields * n_nodes],
             normal: vec![[0.0; 2]; c.pairs.len() * n_nodes],
             gap: vec![f64::INFINITY; c.pairs.len() * n_nodes],
+            touched: vec![false; c.n_fields * n_nodes],
+            pic_dp: vec![[0.0; 2]; n_particles],
+            field_dp: vec![[0.0; 3]; c.n_fields],
             members: Vec::new(),
         }
     }
@@ -207,6 +220,58 @@ pub fn detect(
             *n = [0.0; 2];
         }
     }
+    // Where a pair with a tangential force (stick, friction) touches: a
+    // frictionless pair has no cap to chatter against.
+    st.touched.fill(false);
+    for (k, pair) in c.pairs.iter().enumerate() {
+        if pair.law == CONTACT_SLIP {
+            continue;
+        }
+        for i in 0..n_nodes {
+            if st.touching(k, n_nodes, i) {
+                for f in pair.fields {
+                    st.touched[f as usize * n_nodes + i] = true;
+                }
+            }
+        }
+    }
+}
+
+/// After g2p: gives each field back the momentum the interface's PIC share
+/// took from it or gave it (`pic_dp`, summed in particle order), as one
+/// velocity shift of all the field's particles. The blend acts on a few
+/// particles, so unlike PIC over a whole body it does not conserve
+/// momentum by itself (colliding disks drifted by 3.5 % of their impact
+/// momentum); the shift restores it to round-off and leaves every relative
+/// motion as the blend made it.
+pub fn conserve(
+    c: &Contacts,
+    st: &mut ContactState,
+    mass: &[f64],
+    body: &[u32],
+    v: &mut [[f64; 2]],
+) {
+    st.field_dp.fill([0.0; 3]);
+    for ((dp, &m), &b) in st.pic_dp.iter().zip(mass).zip(body) {
+        let f = &mut st.field_dp[c.field_of_body[b as usize] as usize];
+        f[0] += m;
+        f[1] += dp[0];
+        f[2] += dp[1];
+    }
+    if st.field_dp.iter().all(|f| f[1] == 0.0 && f[2] == 0.0) {
+        return;
+    }
+    let shift: &[[f64; 3]] = &st.field_dp;
+    v.par_iter_mut()
+        .zip(body.par_iter())
+        .with_min_len(1024)
+        .for_each(|(v, &b)| {
+            let f = shift[c.field_of_body[b as usize] as usize];
+            if f[0] > 0.0 {
+                v[0] -= f[1] / f[0];
+                v[1] -= f[2] / f[0];
+            }
+        });
 }
 
 /// Solves the 3 × 3 system a s = r by Cramer's rule (None if singular).
@@ -501,7 +566,6 @@ pub fn exchange(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::walls::CONTACT_SLIP;
 
     const N: [f64; 2] = [0.0, -1.0];
 
@@ -569,7 +633,7 @@ mod tests {
             n_fields: 3,
         };
         let n_nodes = 2;
-        let mut st = ContactState::new(&c, n_nodes);
+        let mut st = ContactState::new(&c, n_nodes, 0);
         st.normal = vec![[0.6, -0.8], [0.0, 1.0]];
         let mut mv = vec![
             [1.0, 0.3, -0.2],

@@ -9,9 +9,12 @@
 //! (1 − α) v_FLIP + α v_PIC, v_FLIP the update above and v_PIC = Σ N v_I
 //! with v_I the nodal velocity after the momentum update (the corrected
 //! one for NPC); positions are untouched (docs/methods.md, "PIC blend").
+//! A particle that reaches a node where a contact pair of its body is in
+//! contact takes at least `CONTACT_PIC_FRACTION` of PIC.
 //! GPU twin: `shaders/g2p.wgsl`.
 
 use super::stage_inputs::ShapeCache;
+use crate::model::contact::CONTACT_PIC_FRACTION;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
 use crate::model::{Grid, Integrator};
@@ -29,6 +32,14 @@ pub struct G2pParams {
     pub pic_fraction: f64,
 }
 
+/// Contact pairs: per field node, whether some pair of the field is in
+/// contact there (`ContactState::touched`), and per particle the
+/// momentum change the blend makes (`ContactState::pic_dp`, with the
+/// particles' masses): a particle
+/// reaching such a node takes `CONTACT_PIC_FRACTION` if the scene's share
+/// is smaller.
+pub type Touched<'a> = Option<(&'a [bool], &'a [f64], &'a mut [[f64; 2]])>;
+
 #[allow(clippy::too_many_arguments)]
 pub fn g2p(
     cache: &ShapeCache,
@@ -36,88 +47,141 @@ pub fn g2p(
     force: &[[f64; 2]],
     grid: &Grid,
     prm: G2pParams,
+    touched: Touched,
     x: &mut [[f64; 2]],
     v: &mut [[f64; 2]],
     a: &mut [[f64; 2]],
 ) -> Result<(), Fault> {
     let dt = prm.dt;
-    let kernel =
-        |p: usize, x: &mut [f64; 2], v: &mut [f64; 2], a: Option<&mut [f64; 2]>| -> Option<Fault> {
-            let (nodes, w) = cache.particle(p);
-            // Σ N f/m and Σ N v_I over nodes with mass.
-            let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
-            for (&node, wk) in nodes.iter().zip(w) {
-                let n = &mv[node as usize];
-                if n[0] > prm.mass_eps {
-                    let f = &force[node as usize];
-                    acc[0] += wk[0] * f[0] / n[0];
-                    acc[1] += wk[0] * f[1] / n[0];
-                    vel[0] += wk[0] * n[1];
-                    vel[1] += wk[0] * n[2];
-                }
+    let (touched, mass, pic_dp): (_, &[f64], &mut [[f64; 2]]) = match touched {
+        Some((t, m, dp)) => (Some(t), m, dp),
+        None => (None, &[], &mut []),
+    };
+    let kernel = |p: usize,
+                  x: &mut [f64; 2],
+                  v: &mut [f64; 2],
+                  a: Option<&mut [f64; 2]>,
+                  dp: Option<&mut [f64; 2]>|
+     -> Option<Fault> {
+        let (nodes, w) = cache.particle(p);
+        // Σ N f/m and Σ N v_I over nodes with mass.
+        let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
+        for (&node, wk) in nodes.iter().zip(w) {
+            let n = &mv[node as usize];
+            if n[0] > prm.mass_eps {
+                let f = &force[node as usize];
+                acc[0] += wk[0] * f[0] / n[0];
+                acc[1] += wk[0] * f[1] / n[0];
+                vel[0] += wk[0] * n[1];
+                vel[1] += wk[0] * n[2];
             }
-            if prm.pic_fraction > 0.0 {
-                // Blend of the FLIP update and Σ N v_I (the same v_I as
-                // the positions' before NPC's own changes to `vel`).
-                let a = prm.pic_fraction;
-                v[0] = (1.0 - a) * (v[0] + dt * acc[0]) + a * vel[0];
-                v[1] = (1.0 - a) * (v[1] + dt * acc[1]) + a * vel[1];
-            } else {
-                v[0] += dt * acc[0];
-                v[1] += dt * acc[1];
+        }
+        let alpha = match touched {
+            Some(t)
+                if nodes
+                    .iter()
+                    .zip(w)
+                    .any(|(&node, wk)| wk[0] > 0.0 && t[node as usize]) =>
+            {
+                prm.pic_fraction.max(CONTACT_PIC_FRACTION)
             }
-            match prm.integrator {
-                // MUSL moves as FE does (B-spline paper eqs. 29–30);
-                // `cpu::implicit` steps implicit models, so that arm is unused.
-                Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => {
-                    x[0] += dt * vel[0];
-                    x[1] += dt * vel[1];
-                }
-                Integrator::Npc { gamma, position } => {
-                    if position != NpcPosition::Corrected {
-                        // v_pred = v_corr − γ Δt f/m, interpolated.
-                        vel[0] -= gamma * dt * acc[0];
-                        vel[1] -= gamma * dt * acc[1];
-                    }
-                    let half_dt2 = if position == NpcPosition::Newmark {
-                        0.0
-                    } else {
-                        0.5 * dt * dt
-                    };
-                    x[0] += dt * vel[0] + half_dt2 * acc[0];
-                    x[1] += dt * vel[1] + half_dt2 * acc[1];
-                    if let Some(a) = a {
-                        *a = acc;
-                    }
-                }
-            }
-            if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
-                return Some(Fault::at(
-                    p,
-                    FaultKind::NonFinite {
-                        field: "position or velocity",
-                    },
-                ));
-            }
-            if !grid.contains(*x, prm.edge_margin) {
-                return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
-            }
-            None
+            _ => prm.pic_fraction,
         };
-    let fault = if a.is_empty() {
-        (x.par_iter_mut(), v.par_iter_mut())
+        if let Some(dp) = dp {
+            *dp = [0.0; 2];
+            if alpha > prm.pic_fraction {
+                // The interface's share over the scene's: its momentum
+                // change, which `contact::conserve` gives back.
+                let flip = [v[0] + dt * acc[0], v[1] + dt * acc[1]];
+                let scene = [
+                    (1.0 - prm.pic_fraction) * flip[0] + prm.pic_fraction * vel[0],
+                    (1.0 - prm.pic_fraction) * flip[1] + prm.pic_fraction * vel[1],
+                ];
+                let new = [
+                    (1.0 - alpha) * flip[0] + alpha * vel[0],
+                    (1.0 - alpha) * flip[1] + alpha * vel[1],
+                ];
+                *dp = [mass[p] * (new[0] - scene[0]), mass[p] * (new[1] - scene[1])];
+            }
+        }
+        if alpha > 0.0 {
+            // Blend of the FLIP update and Σ N v_I (the same v_I as
+            // the positions' before NPC's own changes to `vel`).
+            let a = alpha;
+            v[0] = (1.0 - a) * (v[0] + dt * acc[0]) + a * vel[0];
+            v[1] = (1.0 - a) * (v[1] + dt * acc[1]) + a * vel[1];
+        } else {
+            v[0] += dt * acc[0];
+            v[1] += dt * acc[1];
+        }
+        match prm.integrator {
+            // MUSL moves as FE does (B-spline paper eqs. 29–30);
+            // `cpu::implicit` steps implicit models, so that arm is unused.
+            Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => {
+                x[0] += dt * vel[0];
+                x[1] += dt * vel[1];
+            }
+            Integrator::Npc { gamma, position } => {
+                if position != NpcPosition::Corrected {
+                    // v_pred = v_corr − γ Δt f/m, interpolated.
+                    vel[0] -= gamma * dt * acc[0];
+                    vel[1] -= gamma * dt * acc[1];
+                }
+                let half_dt2 = if position == NpcPosition::Newmark {
+                    0.0
+                } else {
+                    0.5 * dt * dt
+                };
+                x[0] += dt * vel[0] + half_dt2 * acc[0];
+                x[1] += dt * vel[1] + half_dt2 * acc[1];
+                if let Some(a) = a {
+                    *a = acc;
+                }
+            }
+        }
+        if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
+            return Some(Fault::at(
+                p,
+                FaultKind::NonFinite {
+                    field: "position or velocity",
+                },
+            ));
+        }
+        if !grid.contains(*x, prm.edge_margin) {
+            return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
+        }
+        None
+    };
+    let fault = match (a.is_empty(), pic_dp.is_empty()) {
+        (true, true) => (x.par_iter_mut(), v.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v))| kernel(p, x, v, None))
-            .reduce(|| None, Fault::first)
-    } else {
-        (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
+            .map(|(p, (x, v))| kernel(p, x, v, None, None))
+            .reduce(|| None, Fault::first),
+        (false, true) => (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v, a))| kernel(p, x, v, Some(a)))
-            .reduce(|| None, Fault::first)
+            .map(|(p, (x, v, a))| kernel(p, x, v, Some(a), None))
+            .reduce(|| None, Fault::first),
+        (true, false) => (x.par_iter_mut(), v.par_iter_mut(), pic_dp.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(p, (x, v, d))| kernel(p, x, v, None, Some(d)))
+            .reduce(|| None, Fault::first),
+        (false, false) => (
+            x.par_iter_mut(),
+            v.par_iter_mut(),
+            a.par_iter_mut(),
+            pic_dp.par_iter_mut(),
+        )
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .map(|(p, (x, v, a, d))| kernel(p, x, v, Some(a), Some(d)))
+            .reduce(|| None, Fault::first),
     };
     fault.map_or(Ok(()), Err)
 }

@@ -143,7 +143,7 @@ impl CpuBackend {
             contact: model
                 .contact
                 .as_ref()
-                .map(|c| contact::ContactState::new(c, grid_nodes)),
+                .map(|c| contact::ContactState::new(c, grid_nodes, n)),
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -619,10 +619,16 @@ impl CpuBackend {
                     &self.force,
                     &m.grid,
                     prm,
+                    self.contact
+                        .as_mut()
+                        .map(|c| (&c.touched[..], &p.mass[..], &mut c.pic_dp[..])),
                     &mut p.x,
                     &mut p.v,
                     &mut p.a,
                 )?;
+                if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
+                    contact::conserve(c, st, &p.mass, &p.body, &mut p.v);
+                }
             }
             Stage::Remap => {
                 if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {

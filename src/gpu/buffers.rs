@@ -98,6 +98,11 @@ pub enum Buf {
     /// Contact pairs only: per pair and grid node, [n_x, n_y, gap]
     /// (contact_detect.wgsl; n zero where the pair is not in contact).
     ContactNormal,
+    /// Contact pairs only: per field, [mass, Σ m_p Δv_p] (f32): the field's
+    /// mass (uploaded) and the momentum the interface's PIC share changed
+    /// in g2p (float atomics; zeroed by clear_grid), which
+    /// contact_conserve.wgsl gives back (`cpu::contact::conserve`).
+    ContactPic,
     /// Constraint points only: their tables (u32; `gpu::constraint_points`),
     /// the last of which, per grid node the groups that freed it, is read
     /// by `grid_update` and `contact_exchange` too.
@@ -114,7 +119,7 @@ pub enum Buf {
 }
 
 impl Buf {
-    pub const ALL: [Buf; 51] = [
+    pub const ALL: [Buf; 52] = [
         Buf::Params,
         Buf::Sim,
         Buf::Materials,
@@ -162,6 +167,7 @@ impl Buf {
         Buf::ContactGrad,
         Buf::ContactSlack,
         Buf::ContactNormal,
+        Buf::ContactPic,
         Buf::PointTable,
         Buf::PointWork,
         Buf::Body,
@@ -482,6 +488,15 @@ fn grid_and_output_data(
             Buf::ContactNormal,
             vec![0u8; 12 * c.pairs.len() * g.n_nodes()],
         ));
+        let mut pic = vec![0f32; 3 * c.n_fields];
+        let mut field_mass = vec![0f64; c.n_fields];
+        for (f, m) in field.iter().zip(&model.particles.mass) {
+            field_mass[*f as usize] += m;
+        }
+        for (k, m) in field_mass.iter().enumerate() {
+            pic[3 * k] = *m as f32;
+        }
+        data.push((Buf::ContactPic, bytemuck::cast_slice(&pic).to_vec()));
     }
     if model.cell_average_volumetric {
         data.push((
