@@ -11,7 +11,7 @@
 //! one for NPC); positions are untouched (docs/methods.md, "PIC blend").
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::stage_inputs::ShapeCache;
+use super::stage_inputs::{Slots, Weights};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
 use crate::model::{Grid, Integrator};
@@ -29,9 +29,11 @@ pub struct G2pParams {
     pub pic_fraction: f64,
 }
 
+/// `weights` not stored are evaluated at each particle's position before
+/// it moves (where this step's shape evaluation was).
 #[allow(clippy::too_many_arguments)]
 pub fn g2p(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
     mv: &[[f64; 3]],
     force: &[[f64; 2]],
     grid: &Grid,
@@ -41,82 +43,91 @@ pub fn g2p(
     a: &mut [[f64; 2]],
 ) -> Result<(), Fault> {
     let dt = prm.dt;
-    let kernel =
-        |p: usize, x: &mut [f64; 2], v: &mut [f64; 2], a: Option<&mut [f64; 2]>| -> Option<Fault> {
-            let (nodes, w) = cache.particle(p);
-            // Σ N f/m and Σ N v_I over nodes with mass.
-            let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
-            for (&node, wk) in nodes.iter().zip(w) {
-                let n = &mv[node as usize];
-                if n[0] > prm.mass_eps {
-                    let f = &force[node as usize];
-                    acc[0] += wk[0] * f[0] / n[0];
-                    acc[1] += wk[0] * f[1] / n[0];
-                    vel[0] += wk[0] * n[1];
-                    vel[1] += wk[0] * n[2];
-                }
-            }
-            if prm.pic_fraction > 0.0 {
-                // Blend of the FLIP update and Σ N v_I (the same v_I as
-                // the positions' before NPC's own changes to `vel`).
-                let a = prm.pic_fraction;
-                v[0] = (1.0 - a) * (v[0] + dt * acc[0]) + a * vel[0];
-                v[1] = (1.0 - a) * (v[1] + dt * acc[1]) + a * vel[1];
-            } else {
-                v[0] += dt * acc[0];
-                v[1] += dt * acc[1];
-            }
-            match prm.integrator {
-                // MUSL moves as FE does (B-spline paper eqs. 29–30);
-                // `cpu::implicit` steps implicit models, so that arm is unused.
-                Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => {
-                    x[0] += dt * vel[0];
-                    x[1] += dt * vel[1];
-                }
-                Integrator::Npc { gamma, position } => {
-                    if position != NpcPosition::Corrected {
-                        // v_pred = v_corr − γ Δt f/m, interpolated.
-                        vel[0] -= gamma * dt * acc[0];
-                        vel[1] -= gamma * dt * acc[1];
-                    }
-                    let half_dt2 = if position == NpcPosition::Newmark {
-                        0.0
-                    } else {
-                        0.5 * dt * dt
-                    };
-                    x[0] += dt * vel[0] + half_dt2 * acc[0];
-                    x[1] += dt * vel[1] + half_dt2 * acc[1];
-                    if let Some(a) = a {
-                        *a = acc;
-                    }
-                }
-            }
-            if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
-                return Some(Fault::at(
-                    p,
-                    FaultKind::NonFinite {
-                        field: "position or velocity",
-                    },
-                ));
-            }
-            if !grid.contains(*x, prm.edge_margin) {
-                return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
-            }
-            None
+    let kernel = |slots: &mut Slots,
+                  p: usize,
+                  x: &mut [f64; 2],
+                  v: &mut [f64; 2],
+                  a: Option<&mut [f64; 2]>|
+     -> Option<Fault> {
+        let (nodes, w) = match weights.particle_values(p, *x, slots) {
+            Ok(nw) => nw,
+            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
         };
+        // Σ N f/m and Σ N v_I over nodes with mass.
+        let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
+        for (&node, wk) in nodes.iter().zip(w) {
+            let n = &mv[node as usize];
+            if n[0] > prm.mass_eps {
+                let f = &force[node as usize];
+                acc[0] += wk[0] * f[0] / n[0];
+                acc[1] += wk[0] * f[1] / n[0];
+                vel[0] += wk[0] * n[1];
+                vel[1] += wk[0] * n[2];
+            }
+        }
+        if prm.pic_fraction > 0.0 {
+            // Blend of the FLIP update and Σ N v_I (the same v_I as
+            // the positions' before NPC's own changes to `vel`).
+            let a = prm.pic_fraction;
+            v[0] = (1.0 - a) * (v[0] + dt * acc[0]) + a * vel[0];
+            v[1] = (1.0 - a) * (v[1] + dt * acc[1]) + a * vel[1];
+        } else {
+            v[0] += dt * acc[0];
+            v[1] += dt * acc[1];
+        }
+        match prm.integrator {
+            // MUSL moves as FE does (B-spline paper eqs. 29–30);
+            // `cpu::implicit` steps implicit models, so that arm is unused.
+            Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => {
+                x[0] += dt * vel[0];
+                x[1] += dt * vel[1];
+            }
+            Integrator::Npc { gamma, position } => {
+                if position != NpcPosition::Corrected {
+                    // v_pred = v_corr − γ Δt f/m, interpolated.
+                    vel[0] -= gamma * dt * acc[0];
+                    vel[1] -= gamma * dt * acc[1];
+                }
+                let half_dt2 = if position == NpcPosition::Newmark {
+                    0.0
+                } else {
+                    0.5 * dt * dt
+                };
+                x[0] += dt * vel[0] + half_dt2 * acc[0];
+                x[1] += dt * vel[1] + half_dt2 * acc[1];
+                if let Some(a) = a {
+                    *a = acc;
+                }
+            }
+        }
+        if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
+            return Some(Fault::at(
+                p,
+                FaultKind::NonFinite {
+                    field: "position or velocity",
+                },
+            ));
+        }
+        if !grid.contains(*x, prm.edge_margin) {
+            return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
+        }
+        None
+    };
     let fault = if a.is_empty() {
         (x.par_iter_mut(), v.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v))| kernel(p, x, v, None))
+            .map_init(Slots::default, |sl, (p, (x, v))| kernel(sl, p, x, v, None))
             .reduce(|| None, Fault::first)
     } else {
         (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v, a))| kernel(p, x, v, Some(a)))
+            .map_init(Slots::default, |sl, (p, (x, v, a))| {
+                kernel(sl, p, x, v, Some(a))
+            })
             .reduce(|| None, Fault::first)
     };
     fault.map_or(Ok(()), Err)
