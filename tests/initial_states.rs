@@ -470,10 +470,10 @@ fn pic_blend_is_the_stated_mix() {
         let mut slots = Slots::default();
         let mut worst: f64 = 0.0;
         let mut differ: f64 = 0.0;
-        for p in 0..v_start.len() {
+        for (p, &x) in x_start.iter().enumerate() {
             // Σ N v_I with the step's weights; MUSL's nodes then hold the
             // remapped velocity, so take PIC from the α = 1 run's particles.
-            let (nodes, w) = weights.particle(p, x_start[p], &mut slots).unwrap();
+            let (nodes, w) = weights.particle(p, x, &mut slots).unwrap();
             let mut v_pic = [0.0; 2];
             for (&n, wk) in nodes.iter().zip(w) {
                 let node = pic.mv[n as usize];
