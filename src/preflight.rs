@@ -374,9 +374,24 @@ fn memory(
         // model::ExternalForces: force and ramp time per particle.
         particle += 24.0;
     }
-    // Shape cache (cpu::ShapeCache): a count and per slot a u32 and 3 f64.
+    // Shape cache (cpu::ShapeCache): a count and per slot a u32 and 3 f64,
+    // stored only where a step needs it (`ShapeCache::needed`; the
+    // implicit backend always stores its own).
     let slots = shape.max_nodes() as f64;
-    let cache = 2.0 + slots * (4.0 + 24.0);
+    let stored = matches!(shape, Shape::Lme(_))
+        || !f.walls.is_empty()
+        || contact_fields(scene).1 > 0.0
+        || f.solver.volumetric_strain == crate::scene::VolumetricStrain::CellAverage
+        || f.solver.mls
+        || matches!(
+            f.solver.integrator,
+            crate::scene::IntegratorKind::Musl | crate::scene::IntegratorKind::Implicit
+        );
+    let cache = if stored {
+        2.0 + slots * (4.0 + 24.0)
+    } else {
+        0.0
+    };
     // Nodes: [m, qx, qy] and [fx, fy] (f64), the fix bits, perturbed
     // positions, and one private copy of both per thread beyond the first
     // (cpu::scatter).

@@ -136,14 +136,16 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
         );
         let mut plain = vec![[0.0; 2]; grid.n_nodes()];
         lme_mpm::cpu::forces::forces(
-            &cache,
+            lme_mpm::cpu::Weights::Cache(&cache),
+            &x,
             &stress,
             &mass,
             &rho,
             &body,
             &mut plain,
             &mut Scatter::default(),
-        );
+        )
+        .unwrap();
         // The 2 × 2 Gauss rule on the exact field.
         let mut gauss = vec![[0.0; 2]; grid.n_nodes()];
         for g in 0..mls.n_gauss_points() {

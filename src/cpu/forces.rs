@@ -2,41 +2,64 @@
 //! f_I = Σ_p (−V_p σ_p ∇N_I + N_I m_p b) (paper eq. 14; V_p = m_p / ρ_p).
 //! GPU twin: `shaders/forces.wgsl`.
 
-use super::{scatter::Scatter, stage_inputs::ShapeCache};
+use super::scatter::Scatter;
+use super::stage_inputs::{Slots, Weights};
+use crate::model::fault::{Fault, FaultKind};
 use crate::model::node_force;
+use rayon::prelude::*;
 
 /// `body(p)` is particle p's body force per unit mass at this step (m/s²):
 /// gravity, plus a manufactured solution's source term when there is one.
+/// `x` is where `weights` are evaluated when not stored.
+#[allow(clippy::too_many_arguments)]
 pub fn forces(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
+    x: &[[f64; 2]],
     stress: &[[f64; 3]],
     mass: &[f64],
     rho: &[f64],
     body: &(dyn Fn(usize) -> [f64; 2] + Sync),
     force: &mut [[f64; 2]],
     scatter: &mut Scatter<2>,
-) {
-    scatter.run(force, mass.len(), |p, acc| {
-        let vol = mass[p] / rho[p];
-        let s = stress[p];
-        let g = body(p);
-        let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
-        add_particle_forces(cache, p, vol, s, [bx, by], acc);
-    });
+) -> Result<(), Fault> {
+    let n = mass.len();
+    let len = Scatter::<2>::range_len(n);
+    let fault = scatter.run_ranges(
+        force,
+        n,
+        (0..n.div_ceil(len)).into_par_iter(),
+        |first, _, acc| {
+            let mut slots = Slots::default();
+            let mut fault = None;
+            for p in first..(first + len).min(n) {
+                let vol = mass[p] / rho[p];
+                let s = stress[p];
+                let g = body(p);
+                let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
+                match weights.particle(p, x[p], &mut slots) {
+                    Ok((nodes, w)) => add_particle_forces(nodes, w, vol, s, [bx, by], acc),
+                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                }
+            }
+            fault
+        },
+        Fault::first,
+        || None,
+    );
+    fault.map_or(Ok(()), Err)
 }
 
-/// Adds particle p's −V_p σ_p ∇N + N m_p b to its nodes in `acc` (`mb` is
+/// Adds a particle's −V_p σ_p ∇N + N m_p b to its nodes in `acc` (`mb` is
 /// m_p b). Shared with the fused `stress::stress_forces`.
 #[inline]
 pub fn add_particle_forces(
-    cache: &ShapeCache,
-    p: usize,
+    nodes: &[u32],
+    w: &[[f64; 3]],
     vol: f64,
     s: [f64; 3],
     mb: [f64; 2],
     acc: &mut [[f64; 2]],
 ) {
-    let (nodes, w) = cache.particle(p);
     for (&node, wk) in nodes.iter().zip(w) {
         let acc = &mut acc[node as usize];
         let f = node_force(vol, s, wk, mb);

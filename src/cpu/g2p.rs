@@ -13,7 +13,7 @@
 //! contact takes at least `CONTACT_PIC_FRACTION` of PIC.
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::stage_inputs::ShapeCache;
+use super::stage_inputs::{Slots, Weights};
 use crate::model::contact::CONTACT_PIC_FRACTION;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
@@ -40,9 +40,11 @@ pub struct G2pParams {
 /// is smaller.
 pub type Touched<'a> = Option<(&'a [bool], &'a [f64], &'a mut [[f64; 2]])>;
 
+/// `weights` not stored are evaluated at each particle's position before
+/// it moves (where this step's shape evaluation was).
 #[allow(clippy::too_many_arguments)]
 pub fn g2p(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
     mv: &[[f64; 3]],
     force: &[[f64; 2]],
     grid: &Grid,
@@ -57,13 +59,17 @@ pub fn g2p(
         Some((t, m, dp)) => (Some(t), m, dp),
         None => (None, &[], &mut []),
     };
-    let kernel = |p: usize,
+    let kernel = |slots: &mut Slots,
+                  p: usize,
                   x: &mut [f64; 2],
                   v: &mut [f64; 2],
                   a: Option<&mut [f64; 2]>,
                   dp: Option<&mut [f64; 2]>|
      -> Option<Fault> {
-        let (nodes, w) = cache.particle(p);
+        let (nodes, w) = match weights.particle_values(p, *x, slots) {
+            Ok(nw) => nw,
+            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
+        };
         // Σ N f/m and Σ N v_I over nodes with mass.
         let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
         for (&node, wk) in nodes.iter().zip(w) {
@@ -157,19 +163,25 @@ pub fn g2p(
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v))| kernel(p, x, v, None, None))
+            .map_init(Slots::default, |sl, (p, (x, v))| {
+                kernel(sl, p, x, v, None, None)
+            })
             .reduce(|| None, Fault::first),
         (false, true) => (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v, a))| kernel(p, x, v, Some(a), None))
+            .map_init(Slots::default, |sl, (p, (x, v, a))| {
+                kernel(sl, p, x, v, Some(a), None)
+            })
             .reduce(|| None, Fault::first),
         (true, false) => (x.par_iter_mut(), v.par_iter_mut(), pic_dp.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v, d))| kernel(p, x, v, None, Some(d)))
+            .map_init(Slots::default, |sl, (p, (x, v, d))| {
+                kernel(sl, p, x, v, None, Some(d))
+            })
             .reduce(|| None, Fault::first),
         (false, false) => (
             x.par_iter_mut(),
@@ -180,7 +192,9 @@ pub fn g2p(
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map(|(p, (x, v, a, d))| kernel(p, x, v, Some(a), Some(d)))
+            .map_init(Slots::default, |sl, (p, (x, v, a, d))| {
+                kernel(sl, p, x, v, Some(a), Some(d))
+            })
             .reduce(|| None, Fault::first),
     };
     fault.map_or(Ok(()), Err)

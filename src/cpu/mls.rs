@@ -579,7 +579,8 @@ impl Mls {
             }
             let g = body(p);
             let mb = [mass[p] * g[0], mass[p] * g[1]];
-            super::forces::add_particle_forces(cache, p, vol, s, mb, acc);
+            let (nodes, w) = cache.particle(p);
+            super::forces::add_particle_forces(nodes, w, vol, s, mb, acc);
         });
         let (shape, gw, gf) = (&self.gp_shape, &self.gp_w, &self.gp_f);
         self.f_scatter.run(force, gf.len(), |g, acc| {

@@ -26,8 +26,8 @@ use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
 use crate::step::{CpuWork, Stage, StepPlan};
 use scatter::Scatter;
-pub use stage_inputs::ShapeCache;
 pub(crate) use stage_inputs::body_force;
+pub use stage_inputs::{ShapeCache, Slots, Weights};
 use std::sync::atomic::AtomicBool;
 
 /// Runs a `Model` on the CPU.
@@ -121,7 +121,7 @@ impl CpuBackend {
         let nodes = grid_nodes * model.n_fields();
         let min_mass = model.particles.min_mass();
         CpuBackend {
-            cache: ShapeCache::new(n, model.shape.max_nodes()),
+            cache: ShapeCache::for_model(&model),
             mv: vec![[0.0; 3]; nodes],
             force: vec![[0.0; 2]; nodes],
             reactions: vec![[0.0; 2]; model.reaction_names().len()],
@@ -214,8 +214,8 @@ impl CpuBackend {
                         / n;
             }
         }
-        // Shape cache: a count, then per slot a node index and 3 f64.
-        per += 2.0 + model.shape.max_nodes() as f64 * (4.0 + 24.0);
+        // Shape cache, when the scene stores one.
+        per += ShapeCache::bytes_per_particle(model);
         // The cell average: tr L and its slot, the correction; per cell
         // and body two sums.
         if model.cell_average_volumetric {
@@ -371,7 +371,8 @@ impl CpuBackend {
             self.t + self.dt,
         );
         stress::stress_forces(
-            &self.cache,
+            Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+            &p.x,
             &self.mv,
             self.dt,
             &p.body,
@@ -408,6 +409,12 @@ impl CpuBackend {
             Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
             Stage::ClearGrid => clear_grid::clear_grid(&mut self.mv, &mut self.force),
             Stage::ShapeEval => {
+                // Stages run one by one store the weights even where a
+                // whole step evaluates them on the spot (allocated here,
+                // once; then every shape evaluation fills the cache).
+                if !self.cache.is_stored(p.len()) {
+                    self.cache = ShapeCache::new(p.len(), m.shape.max_nodes());
+                }
                 shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
                 if let Some(c) = &m.contact {
                     contact::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
@@ -418,14 +425,15 @@ impl CpuBackend {
                     return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
                 }
                 p2g::p2g(
-                    &self.cache,
+                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+                    &p.x,
                     &p.mass,
                     &p.v,
                     &p.a,
                     a_factor,
                     &mut self.mv,
                     &mut self.p2g_scatter,
-                );
+                )?;
             }
             Stage::GridPredict => {
                 // Moving regions go where their velocity has taken them by
@@ -495,7 +503,8 @@ impl CpuBackend {
                     &self.mls_dl
                 };
                 stress::stress(
-                    &self.cache,
+                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+                    &p.x,
                     &self.mv,
                     self.dt,
                     &p.body,
@@ -535,14 +544,15 @@ impl CpuBackend {
                     return Ok(());
                 }
                 forces::forces(
-                    &self.cache,
+                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+                    &p.x,
                     &p.stress,
                     &p.mass,
                     &p.rho,
                     &body,
                     &mut self.force,
                     &mut self.force_scatter,
-                );
+                )?;
             }
             Stage::GridCorrect => {
                 let (fixed, pairs) = self
@@ -614,7 +624,7 @@ impl CpuBackend {
                     pic_fraction: m.pic_fraction,
                 };
                 g2p::g2p(
-                    &self.cache,
+                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
                     &self.mv,
                     &self.force,
                     &m.grid,

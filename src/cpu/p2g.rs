@@ -3,24 +3,48 @@
 //! NPC: q_I = Σ N m_p (v_p + (1 − γ) Δt a_p) (paper eq. 27, the stable form).
 //! GPU twin: `shaders/p2g.wgsl`.
 
-use super::{scatter::Scatter, stage_inputs::ShapeCache};
+use super::scatter::Scatter;
+use super::stage_inputs::{Slots, Weights};
+use crate::model::fault::{Fault, FaultKind};
+use rayon::prelude::*;
 
-/// `a` is empty for FE; `a_factor` = (1 − γ) Δt for NPC.
+/// `a` is empty for FE; `a_factor` = (1 − γ) Δt for NPC. `x` is where
+/// `weights` are evaluated when not stored.
+#[allow(clippy::too_many_arguments)]
 pub fn p2g(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
+    x: &[[f64; 2]],
     mass: &[f64],
     v: &[[f64; 2]],
     a: &[[f64; 2]],
     a_factor: f64,
     mv: &mut [[f64; 3]],
     scatter: &mut Scatter<3>,
-) {
-    scatter.run(mv, mass.len(), |p, acc| {
-        let m = mass[p];
-        let vel = particle_velocity(v, a, a_factor, p);
-        let (nodes, w) = cache.particle(p);
-        add_particle(nodes, w, m, vel, acc);
-    });
+) -> Result<(), Fault> {
+    let n = mass.len();
+    let len = Scatter::<3>::range_len(n);
+    let fault = scatter.run_ranges(
+        mv,
+        n,
+        (0..n.div_ceil(len)).into_par_iter(),
+        |first, _, acc| {
+            let mut slots = Slots::default();
+            let mut fault = None;
+            for p in first..(first + len).min(n) {
+                match weights.particle_values(p, x[p], &mut slots) {
+                    Ok((nodes, w)) => {
+                        let vel = particle_velocity(v, a, a_factor, p);
+                        add_particle(nodes, w, mass[p], vel, acc);
+                    }
+                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                }
+            }
+            fault
+        },
+        Fault::first,
+        || None,
+    );
+    fault.map_or(Ok(()), Err)
 }
 
 /// Adds one particle's N m and N m v to its nodes in `acc`. Shared with the

@@ -1,11 +1,15 @@
 //! Stage `shape_eval`: N and ∇N of every particle at its current position,
-//! into the per-step shape cache read by p2g, stress, forces and g2p. For
-//! LME this is the per-particle Newton solve on λ (warm-started).
+//! into the per-step shape cache read by p2g, stress, forces and g2p, where
+//! the scene stores one (`ShapeCache::needed`); otherwise those loops
+//! evaluate the shape themselves (`Weights::Eval`) and a whole step has no
+//! shape evaluation of its own. For LME this is the per-particle Newton
+//! solve on λ (warm-started).
 //! GPU twin: `shaders/lme_newton.wgsl` (LME); other shapes are evaluated
 //! inline in each GPU pass.
 
 use super::p2g::{add_particle, particle_velocity};
-use super::{scatter::Scatter, stage_inputs::ShapeCache};
+use super::stage_inputs::{ShapeCache, Weights};
+use super::{p2g, scatter::Scatter};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::Shape;
@@ -69,7 +73,8 @@ pub fn shape_eval(
 /// whole step runs without MLS): each worker range evaluates its particles'
 /// weights into the cache and scatters them while they are still in the
 /// core's cache. The same values and sums in the same order as the two
-/// stages. Arguments as `shape_eval` and `p2g::p2g`.
+/// stages. Without a stored cache it is `p2g::p2g` with the weights
+/// evaluated on the spot. Arguments as `shape_eval` and `p2g::p2g`.
 #[allow(clippy::too_many_arguments)]
 pub fn shape_eval_p2g(
     shape: &Shape,
@@ -84,8 +89,12 @@ pub fn shape_eval_p2g(
     mv: &mut [[f64; 3]],
     scatter: &mut Scatter<3>,
 ) -> Result<(), Fault> {
-    let s = cache.stride;
     let n = x.len();
+    if !cache.is_stored(n) {
+        let weights = Weights::eval(shape, grid);
+        return p2g::p2g(weights, x, mass, v, a, a_factor, mv, scatter);
+    }
+    let s = cache.stride;
     let len = Scatter::<3>::range_len(n);
     let particle = |p: usize,
                     lam: &mut [f64; 2],

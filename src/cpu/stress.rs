@@ -8,7 +8,8 @@
 //! GPU twin: `shaders/stress.wgsl`.
 
 use super::forces::add_particle_forces;
-use super::{scatter::Scatter, stage_inputs::ShapeCache};
+use super::scatter::Scatter;
+use super::stage_inputs::{Slots, Weights};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::{Material, PlasticState};
 use rayon::iter::Either;
@@ -42,7 +43,8 @@ fn optional_chunks<T: Send>(
 
 #[allow(clippy::too_many_arguments)]
 pub fn stress(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
+    x: &[[f64; 2]],
     mv: &[[f64; 3]],
     dt: f64,
     body: &[u32],
@@ -64,9 +66,14 @@ pub fn stress(
         .into_par_iter()
         .enumerate()
         .with_min_len(256)
-        .map(|(p, (s, r, f, q))| {
+        .map_init(Slots::default, |slots, (p, (s, r, f, q))| {
+            let (nodes, w) = match weights.particle(p, x[p], slots) {
+                Ok(nw) => nw,
+                Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
+            };
             update_particle(
-                cache,
+                nodes,
+                w,
                 mv,
                 dt,
                 &materials[body_material[body[p] as usize] as usize],
@@ -82,11 +89,12 @@ pub fn stress(
 }
 
 /// Particle p's velocity gradient and material update (the whole stage for
-/// one particle).
+/// one particle), from its nodes and weights.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn update_particle(
-    cache: &ShapeCache,
+    nodes: &[u32],
+    w: &[[f64; 3]],
     mv: &[[f64; 3]],
     dt: f64,
     material: &Material,
@@ -96,7 +104,6 @@ fn update_particle(
     extra: Extra<'_>,
     dl: Option<&[f64; 4]>,
 ) -> Option<Fault> {
-    let (nodes, w) = cache.particle(p);
     // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
     let mut l = [0.0; 4];
     for (&node, wk) in nodes.iter().zip(w) {
@@ -132,11 +139,12 @@ fn update_particle(
 /// Stages `stress` then `forces` in one pass over the particles (what a
 /// whole step runs without MLS; twin of stress.wgsl built with FORCES): each
 /// particle's update, then its forces from the stress just computed, with
-/// the shape cache read once. The same sums as the two stages, in the same
-/// order per node and thread, so the same result.
+/// the weights read (or evaluated) once. The same sums as the two stages,
+/// in the same order per node and thread, so the same result.
 #[allow(clippy::too_many_arguments)]
 pub fn stress_forces(
-    cache: &ShapeCache,
+    weights: Weights<'_>,
+    x: &[[f64; 2]],
     mv: &[[f64; 3]],
     dt: f64,
     body: &[u32],
@@ -153,17 +161,25 @@ pub fn stress_forces(
 ) -> Result<(), Fault> {
     let n = mass.len();
     let len = Scatter::<2>::range_len(n);
-    let particle =
-        |p: usize, s: &mut [f64; 3], r: &mut f64, extra: Extra<'_>, acc: &mut [[f64; 2]]| {
-            let material = &materials[body_material[body[p] as usize] as usize];
-            if let Some(fault) = update_particle(cache, mv, dt, material, p, s, r, extra, None) {
-                return Some(fault);
-            }
-            let g = body_force(p);
-            let m = mass[p];
-            add_particle_forces(cache, p, m / *r, *s, [m * g[0], m * g[1]], acc);
-            None
+    let particle = |p: usize,
+                    s: &mut [f64; 3],
+                    r: &mut f64,
+                    extra: Extra<'_>,
+                    slots: &mut Slots,
+                    acc: &mut [[f64; 2]]| {
+        let material = &materials[body_material[body[p] as usize] as usize];
+        let (nodes, w) = match weights.particle(p, x[p], slots) {
+            Ok(nw) => nw,
+            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
         };
+        if let Some(fault) = update_particle(nodes, w, mv, dt, material, p, s, r, extra, None) {
+            return Some(fault);
+        }
+        let g = body_force(p);
+        let m = mass[p];
+        add_particle_forces(nodes, w, m / *r, *s, [m * g[0], m * g[1]], acc);
+        None
+    };
     let ranges = (
         stress.par_chunks_mut(len),
         rho.par_chunks_mut(len),
@@ -177,12 +193,14 @@ pub fn stress_forces(
         ranges,
         |first, (s, r, mut f, mut q), acc| {
             let mut fault = None;
+            let mut slots = Slots::default();
             for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
                 let extra = (
                     f.as_deref_mut().map(|f| &mut f[k]),
                     q.as_deref_mut().map(|q| &mut q[k]),
                 );
-                fault = Fault::first(fault, particle(first + k, s, r, extra, acc));
+                let f = particle(first + k, s, r, extra, &mut slots, acc);
+                fault = Fault::first(fault, f);
             }
             fault
         },

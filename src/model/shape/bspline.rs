@@ -83,6 +83,34 @@ pub fn basis(
     }
 }
 
+/// `basis` for a degree known when compiled: the interior's closed form
+/// inlined into the caller, the spans near the edge out of line. The same
+/// numbers as `basis`.
+#[inline(always)]
+pub fn basis_of<const P: usize>(
+    u: f64,
+    n: usize,
+    e: f64,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    let s = span(u, n, P);
+    if s > 2 * P && s + P + 2 <= n {
+        uniform_basis(u, s, P)
+    } else {
+        edge_basis(u, n, P, e)
+    }
+}
+
+/// `basis` near the grid's edge, out of line (`basis_of`).
+#[inline(never)]
+fn edge_basis(
+    u: f64,
+    n: usize,
+    p: usize,
+    e: f64,
+) -> (usize, [f64; MAX_DEGREE + 1], [f64; MAX_DEGREE + 1]) {
+    basis(u, n, p, e)
+}
+
 /// Whether `table_basis` holds on a grid of `n` nodes: the left edge's
 /// spans (s < 2p) must not reach the right edge's knots (s + p + 1 < n).
 #[inline]
@@ -230,14 +258,14 @@ pub fn table_basis(
 }
 
 /// Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
-#[inline]
+#[inline(always)]
 fn span(u: f64, n: usize, p: usize) -> usize {
-    ((u + 0.5 * (p as f64 + 1.0)).floor() as i64).clamp(p as i64, n as i64 - 1) as usize
+    super::floor_i64(u + 0.5 * (p as f64 + 1.0)).clamp(p as i64, n as i64 - 1) as usize
 }
 
 /// Uniform knots: quadratic with f = u − first in [0.5, 1.5), cubic with
 /// t = u − (first + 1) in [0, 1) (the mpm88 weights and their cubic kin).
-#[inline]
+#[inline(always)]
 fn uniform_basis(
     u: f64,
     s: usize,
