@@ -259,7 +259,7 @@ fn every_pass_validates_in_every_variant() {
             let src = pipelines::expand(pass, &d).unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
             let key = (src, v.atomics == AtomicMode::Float);
             if !validated.contains_key(&key) {
-                let module = pipelines::validate(&key.0, pass.file(), v.atomics)
+                let module = pipelines::validate(&key.0, pass.file().unwrap(), v.atomics)
                     .unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
                 validated.insert(key.clone(), pipelines::bindings(&module));
             }
@@ -380,6 +380,8 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::P2gGather
             | Pass::P2gPatch
             | Pass::Stress
+            | Pass::StressForces
+            | Pass::StressForcesPatch
             | Pass::Forces
             | Pass::ForcesGather
             | Pass::ForcesPatch
@@ -503,7 +505,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
                 let src = pipelines::expand(pass, &d).unwrap();
                 out.push((
                     pass,
-                    pipelines::validate(&src, pass.file(), v.atomics).unwrap(),
+                    pipelines::validate(&src, pass.file().unwrap(), v.atomics).unwrap(),
                 ));
             }
         }

@@ -580,7 +580,7 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                 gpu.run_pass(pass);
             }
         }
-        cpu.run_stage(stage)
+        cpu.run_stage_passes(stage)
             .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
         for pass in gpu.stage_passes(stage) {
             gpu.run_pass(pass);
@@ -1282,7 +1282,7 @@ fn stages_match_boundaries() {
         let mut cpu = CpuBackend::new(m.clone());
         cpu.set_time(0.7);
         for &stage in STEP.iter().take_while(|s| **s != Stage::G2p) {
-            cpu.run_stage(stage).unwrap();
+            cpu.run_stage_passes(stage).unwrap();
         }
         let groups = m.constraints.groups.len();
         for (w, r) in m.walls.list.iter().zip(&cpu.reactions[groups..]) {
@@ -1336,7 +1336,7 @@ fn stages_match_gates_pic_and_damping() {
             .iter()
             .take_while(|s| **s != Stage::G2p)
         {
-            cpu.run_stage(stage).unwrap();
+            cpu.run_stage_passes(stage).unwrap();
         }
         let groups = m.constraints.groups.len();
         for (w, r) in m.walls.list.iter().zip(&cpu.reactions[groups..]) {

@@ -86,8 +86,35 @@ fn half_width(mass: f64, rho: f64) -> f64 {
     0.5 * (mass / rho).sqrt()
 }
 
+/// The mass gradients and volumes per field node (`ContactState::grad`),
+/// which `detect` reads.
+pub fn grad(
+    cache: &ShapeCache,
+    mass: &[f64],
+    rho: &[f64],
+    body: &[u32],
+    c: &Contacts,
+    st: &mut ContactState,
+) {
+    st.grad.fill([0.0; 3]);
+    for p in 0..body.len() {
+        if c.field_of_body[body[p] as usize] == 0 {
+            // Field 0 takes part only in merges, which need no normal.
+            continue;
+        }
+        let (nodes, w) = cache.particle(p);
+        for (&node, wk) in nodes.iter().zip(w) {
+            let g = &mut st.grad[node as usize];
+            g[0] += mass[p] * wk[1];
+            g[1] += mass[p] * wk[2];
+            g[2] += wk[0] * mass[p] / rho[p];
+        }
+    }
+}
+
 /// Finds, per pair and node, the normal and whether the pair's particle
-/// domains meet there (`ContactState`). `mv` holds the scattered masses.
+/// domains meet there (`ContactState`), from the mass gradients `grad`
+/// left. `mv` holds the scattered masses.
 #[allow(clippy::too_many_arguments)]
 pub fn detect(
     cache: &ShapeCache,
@@ -101,21 +128,6 @@ pub fn detect(
     mass_eps: f64,
     st: &mut ContactState,
 ) {
-    // Mass gradients and volumes per field node.
-    st.grad.fill([0.0; 3]);
-    for p in 0..x.len() {
-        if c.field_of_body[body[p] as usize] == 0 {
-            // Field 0 takes part only in merges, which need no normal.
-            continue;
-        }
-        let (nodes, w) = cache.particle(p);
-        for (&node, wk) in nodes.iter().zip(w) {
-            let g = &mut st.grad[node as usize];
-            g[0] += mass[p] * wk[1];
-            g[1] += mass[p] * wk[2];
-            g[2] += wk[0] * mass[p] / rho[p];
-        }
-    }
     // Normals where both fields of a pair have mass.
     for (k, pair) in c.pairs.iter().enumerate() {
         let [a, b] = pair.fields.map(|f| f as usize * n_nodes);

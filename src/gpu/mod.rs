@@ -126,9 +126,9 @@ impl GpuBackend {
         &self.pipelines.plan
     }
 
-    /// The passes of one stage (`StepPlan::passes_for` for this scene).
+    /// The GPU's passes of one stage (`StepPlan::gpu_passes_for` for this scene).
     pub fn stage_passes(&self, stage: crate::step::Stage) -> Vec<Pass> {
-        self.pipelines.plan.passes_for(stage)
+        self.pipelines.plan.gpu_passes_for(stage)
     }
 
     /// Runs one pass on its own (per-stage parity tests).
