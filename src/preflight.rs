@@ -395,7 +395,7 @@ fn memory(
     if !f.walls.is_empty() {
         // model::Walls: the node mask, and at most every node in each
         // wall's node list; the CPU's contact weights and walls' forces
-        // (cpu::grid_update::wall_touch, wall_contact).
+        // (cpu::wall_touch, cpu::wall_contact).
         per_node += 4.0 + 8.0 + 16.0 + 4.0 * f.walls.len() as f64;
         if f.bodies
             .values()

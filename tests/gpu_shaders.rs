@@ -556,7 +556,7 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
         (
             "LINE_WEIGHT_EPS",
-            f(lme_mpm::cpu::grid_update::LINE_WEIGHT_EPS),
+            f(lme_mpm::cpu::wall_touch::LINE_WEIGHT_EPS),
         ),
         (
             "CONTACT_GAP_SLACK",

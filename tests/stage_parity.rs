@@ -1632,7 +1632,7 @@ fn stages_match_contact_pairs() {
 }
 
 /// `solver.volumetric_strain = "cell_average"` (the B-bar of
-/// `cpu::antilock`): the stress stage with each particle's volumetric
+/// `cpu::cell_average`): the stress stage with each particle's volumetric
 /// strain rate replaced by its (cell, body) mean, summed by
 /// cell_average.wgsl with float atomics (CAS in one case) and read by
 /// stress.wgsl; one body on its own field, and the four bodies of

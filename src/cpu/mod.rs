@@ -1,8 +1,11 @@
-//! The CPU reference path: f64, rayon across all cores, one file per stage
-//! mirroring the WGSL twin of the same name. Buffers are allocated once in
-//! `CpuBackend::new`; a step allocates nothing.
+//! The CPU reference path: f64, rayon across all cores, one file per pass
+//! mirroring the WGSL twin of the same name (`shaders/wall_touch.wgsl` ↔
+//! `wall_touch.rs`). A step is the plan's pass list (`StepPlan::cpu_step`),
+//! each pass run by its twin (`CpuBackend::run_pass`, `CpuBackend::twin`).
+//! Buffers are allocated once in `CpuBackend::new`; a step allocates
+//! nothing.
 
-pub mod antilock;
+pub mod cell_average;
 pub mod cfl;
 pub mod clear_grid;
 pub mod constraint_points;
@@ -19,6 +22,8 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stage_inputs;
 pub mod stress;
+pub mod wall_contact;
+pub mod wall_touch;
 
 use crate::backend::{Backend, Halt, Sample, State, stop_requested};
 use crate::error::Result;
@@ -54,12 +59,12 @@ pub struct CpuBackend {
     pub reactions: Vec<[f64; 2]>,
     /// Per node: the weight of the particles in contact with a wall this
     /// step and their friction's weight, [S_I, T_I]
-    /// (`grid_update::wall_touch`); empty without walls.
+    /// (`wall_touch::wall_touch`); empty without walls.
     pub wall_touch: Vec<[f64; 2]>,
-    /// Per node: the walls' forces this step (`grid_update::wall_contact`);
+    /// Per node: the walls' forces this step (`wall_contact::wall_contact`);
     /// empty without walls.
     pub wall_force: Vec<[f64; 2]>,
-    /// Per node: the walls' preloads this step (`grid_update::wall_touch`);
+    /// Per node: the walls' preloads this step (`wall_touch::wall_touch`);
     /// empty unless some particle starts with one (`Walls::preload`).
     pub wall_pre_force: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
@@ -72,8 +77,8 @@ pub struct CpuBackend {
     /// correction `Mls::strain_correction` (empty otherwise).
     mls_dl: Vec<[f64; 4]>,
     /// `solver.volumetric_strain = "cell_average"`: the cells' mean
-    /// volumetric strain rate (`antilock`); None otherwise.
-    cell_average: Option<antilock::CellAverage>,
+    /// volumetric strain rate (`cell_average`); None otherwise.
+    cell_average: Option<cell_average::CellAverage>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -89,8 +94,8 @@ fn contact_particles<'a>(
     p: &'a Particles,
     gravity: Option<&crate::model::Gravity>,
     line: Option<(&'a crate::model::shape::Shape, &'a crate::model::Grid)>,
-) -> grid_update::ContactParticles<'a> {
-    grid_update::ContactParticles {
+) -> wall_touch::ContactParticles<'a> {
+    wall_touch::ContactParticles {
         line,
         x: &p.x,
         mass: &p.mass,
@@ -165,7 +170,7 @@ impl CpuBackend {
             },
             cell_average: model
                 .cell_average_volumetric
-                .then(|| antilock::CellAverage::new(&model.grid, model.body_names.len(), n)),
+                .then(|| cell_average::CellAverage::new(&model.grid, model.body_names.len(), n)),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -470,7 +475,7 @@ impl CpuBackend {
 
     fn wall_touch(&mut self) -> std::result::Result<(), Fault> {
         let m = &self.model;
-        grid_update::wall_touch(
+        wall_touch::wall_touch(
             &self.cache,
             &contact_particles(
                 &m.particles,
@@ -730,7 +735,7 @@ impl CpuBackend {
         );
         let wall_r = &mut self.reactions[groups..groups + walls];
         let m = &self.model;
-        grid_update::wall_contact(
+        wall_contact::wall_contact(
             &self.cache,
             &contact_particles(
                 &m.particles,
