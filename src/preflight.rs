@@ -383,7 +383,7 @@ fn memory(
     let per_thread = if threads > 1 { threads as f64 } else { 0.0 };
     // Contact pairs (model::Contacts): one copy of the nodal fields per
     // paired body beside the shared field 0, each with its mass gradient,
-    // and per pair and node a normal and a gap (cpu::contact::ContactState).
+    // and per pair and node a normal and a gap (cpu::contact_detect::ContactState).
     let (fields, pairs) = contact_fields(scene);
     let mut per_node = (40.0 + 40.0 * per_thread) * fields + 1.0;
     if pairs > 0.0 {

@@ -560,16 +560,19 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ),
         (
             "CONTACT_GAP_SLACK",
-            f(lme_mpm::cpu::contact::CONTACT_GAP_SLACK),
+            f(lme_mpm::cpu::contact_detect::CONTACT_GAP_SLACK),
         ),
-        ("LR_RIDGE", f(lme_mpm::cpu::contact::LR_RIDGE)),
+        ("LR_RIDGE", f(lme_mpm::cpu::contact_detect::LR_RIDGE)),
         (
             "LR_ITERATIONS",
-            u(lme_mpm::cpu::contact::LR_ITERATIONS as u32),
+            u(lme_mpm::cpu::contact_detect::LR_ITERATIONS as u32),
         ),
-        ("LR_MAX_STEP", f(lme_mpm::cpu::contact::LR_MAX_STEP)),
-        ("LR_MIN_SCALE", f(lme_mpm::cpu::contact::LR_MIN_SCALE)),
-        ("LR_FLAT_COS", f(lme_mpm::cpu::contact::LR_FLAT_COS)),
+        ("LR_MAX_STEP", f(lme_mpm::cpu::contact_detect::LR_MAX_STEP)),
+        (
+            "LR_MIN_SCALE",
+            f(lme_mpm::cpu::contact_detect::LR_MIN_SCALE),
+        ),
+        ("LR_FLAT_COS", f(lme_mpm::cpu::contact_detect::LR_FLAT_COS)),
     ];
     let modules = every_pass_module();
     // Every model's code, generated from the registry.

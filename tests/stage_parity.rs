@@ -449,7 +449,7 @@ impl Report {
 /// `normal_tol` and their gaps to `CONTACT_GAP_TOL` h.
 fn check_detect(
     rep: &mut Report,
-    st: &lme_mpm::cpu::contact::ContactState,
+    st: &lme_mpm::cpu::contact_detect::ContactState,
     gpu: &[([f64; 2], Option<f64>)],
     h: f64,
     normal_tol: f64,

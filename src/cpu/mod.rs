@@ -9,7 +9,9 @@ pub mod cell_average;
 pub mod cfl;
 pub mod clear_grid;
 pub mod constraint_points;
-pub mod contact;
+pub mod contact_detect;
+pub mod contact_exchange;
+pub mod contact_grad;
 pub mod energy;
 pub mod forces;
 pub mod g2p;
@@ -68,7 +70,7 @@ pub struct CpuBackend {
     /// empty unless some particle starts with one (`Walls::preload`).
     pub wall_pre_force: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
-    pub contact: Option<contact::ContactState>,
+    pub contact: Option<contact_detect::ContactState>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -151,7 +153,7 @@ impl CpuBackend {
             contact: model
                 .contact
                 .as_ref()
-                .map(|c| contact::ContactState::new(c, grid_nodes)),
+                .map(|c| contact_detect::ContactState::new(c, grid_nodes)),
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -424,7 +426,7 @@ impl CpuBackend {
         let p = &mut m.particles;
         shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
         if let Some(c) = &m.contact {
-            contact::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
+            contact_grad::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
         }
         Ok(())
     }
@@ -493,7 +495,7 @@ impl CpuBackend {
     fn contact_grad(&mut self) -> std::result::Result<(), Fault> {
         let (m, p) = (&self.model, &self.model.particles);
         if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
-            contact::grad(&self.cache, &p.mass, &p.rho, &p.body, c, st);
+            contact_grad::grad(&self.cache, &p.mass, &p.rho, &p.body, c, st);
         }
         Ok(())
     }
@@ -501,7 +503,7 @@ impl CpuBackend {
     fn contact_detect(&mut self) -> std::result::Result<(), Fault> {
         let (m, p) = (&self.model, &self.model.particles);
         if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
-            contact::detect(
+            contact_detect::detect(
                 &self.cache,
                 &p.x,
                 &p.mass,
@@ -555,7 +557,7 @@ impl CpuBackend {
     fn contact_exchange(&mut self) -> std::result::Result<(), Fault> {
         let m = &self.model;
         if let (Some(pairs), Some(st)) = (&m.contact, &self.contact) {
-            contact::exchange(
+            contact_exchange::exchange(
                 pairs,
                 st,
                 &mut self.mv,
@@ -805,13 +807,13 @@ impl CpuBackend {
         let m = &self.model;
         let fixed = m.constraints.groups.len() + m.walls.list.len();
         if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
-            contact::exchange(
+            contact_exchange::exchange(
                 c,
                 st,
                 &mut self.mv,
                 &m.constraints.fix,
                 self.mass_eps,
-                Some(contact::AsForce {
+                Some(contact_exchange::AsForce {
                     force: &mut self.force,
                     gamma_dt,
                     reactions: &mut self.reactions[fixed..],

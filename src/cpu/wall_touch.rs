@@ -77,7 +77,7 @@ impl LineWeights {
 
     /// Evaluates the weights at the point `d` (m) behind `x` along `n`,
     /// in the field of the particle whose first node is `first` (contact
-    /// pairs stack a field per body: `cpu::contact::offset_nodes`); false
+    /// pairs stack a field per body: `cpu::contact_grad::offset_nodes`); false
     /// when there is no shape to evaluate (or it fails there).
     pub(super) fn at(
         &mut self,
