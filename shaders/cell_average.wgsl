@@ -8,7 +8,7 @@
 // (cell · N_BODIES + body), the cell the lattice cell holding the
 // particle's current position (clamped to the grid). Built with CLEAR: one
 // invocation per grid cell zeroes its bodies' slots first.
-// CPU twin: `CellAverage::update` in src/cpu/antilock.rs.
+// CPU twin: `CellAverage::update` in src/cpu/cell_average.rs.
 #include "shared/common.wgsl"
 
 #include "shared/cell_average.wgsl"

@@ -1,7 +1,7 @@
 // Contact pairs, after g2p: each field given back the momentum that the
 // interface's PIC share (g2p.wgsl, CONTACT_PIC_FRACTION) changed, as one
 // velocity shift of all the field's particles: v_p -= Σ m Δv / M_field.
-// CPU twin: `conserve` in src/cpu/contact.rs.
+// CPU twin: src/cpu/contact_conserve.rs.
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_V}}) var<storage, read_write> v: array<vec2<f32>>;

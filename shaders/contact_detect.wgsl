@@ -11,7 +11,7 @@
 // line that separates the two bodies' particles reaching the node);
 // elsewhere the normal is zero. Writes [n_x, n_y, gap] per pair node
 // (`contact_normal`; gap CONTACT_NO_GAP where there is no normal).
-// CPU twin: `detect` in src/cpu/contact.rs.
+// CPU twin: `detect` in src/cpu/contact_detect.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"
@@ -112,7 +112,7 @@ fn det3(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>) -> f32 {
 
 // The logistic-regression normal (Nairn et al. 2018) over the particles of
 // fields fa and fb that reach node (i, j), from n0. CPU twin: `lr_normal`
-// in src/cpu/contact.rs (the same steps: mean position and half-width,
+// in src/cpu/contact_detect.rs (the same steps: mean position and half-width,
 // LR_ITERATIONS Newton steps with the ridge LR_RIDGE from 0, each |Δφ|
 // capped at LR_MAX_STEP, Cramer's rule; n0 where it separates nothing,
 // and where the fit lies within 3° of n0: LR_FLAT_COS).

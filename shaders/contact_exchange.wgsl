@@ -9,7 +9,7 @@
 // CORRECT each m Δv also goes into the nodal force as m Δv / (γ Δt), so
 // g2p sees it, and a pair's share into its reaction (the force on its
 // first body).
-// CPU twin: `exchange` in src/cpu/contact.rs.
+// CPU twin: `exchange` in src/cpu/contact_exchange.rs.
 #include "shared/common.wgsl"
 #include "shared/contact.wgsl"
 #include "shared/constraint_region.wgsl"

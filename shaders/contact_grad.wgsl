@@ -5,7 +5,8 @@
 // float atomics; and the smallest half-width ½ sqrt(m_p / ρ_p) of all the
 // particles (the gap test's slack), kept by atomicMin on its bits.
 // `clear_grid` zeroes both.
-// CPU twin: `detect` in src/cpu/contact.rs (its first loop and the slack).
+// CPU twin: `grad` in src/cpu/contact_grad.rs (the slack: in `detect`,
+// src/cpu/contact_detect.rs).
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"

@@ -17,7 +17,7 @@
 // there to first order, N − d n·∇N, and into the wall's reaction; with
 // WALL_PRE_FIT the preload's fit, N_I min(P, F_n) a_I, too. `clear_grid` zeroes `wall_force`. With GATES only the walls
 // that act at the step's start time t (appear_at <= t < remove_at) push.
-// CPU twin: `wall_contact` in src/cpu/grid_update.rs.
+// CPU twin: src/cpu/wall_contact.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"

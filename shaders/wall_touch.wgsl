@@ -14,7 +14,7 @@
 // (`Walls::pre_fit`, src/model/preload_fit.rs). `wall_contact`
 // reads it; `clear_grid` zeroes it. With GATES only the walls that act at
 // the step's start time t (appear_at <= t < remove_at) are in contact.
-// CPU twin: `wall_touch` in src/cpu/grid_update.rs.
+// CPU twin: src/cpu/wall_touch.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read
 #include "shared/shape.wgsl"

@@ -530,7 +530,7 @@ fn process_cpu_seconds() -> f64 {
 }
 
 /// Per-stage breakdown of the CPU path: `steps` whole steps, each stage
-/// timed on its own (`CpuBackend::run_stage`), after one warm-up step.
+/// timed on its own (`CpuBackend::run_stage_passes`), after one warm-up step.
 pub fn profile_cpu(particles: usize, case: &Case, steps: u64) -> Result<Vec<StageTime>> {
     use crate::cpu::CpuBackend;
     use crate::step::STEP;
@@ -542,7 +542,7 @@ pub fn profile_cpu(particles: usize, case: &Case, steps: u64) -> Result<Vec<Stag
     for _ in 0..steps {
         for (k, stage) in STEP.iter().enumerate() {
             let start = Instant::now();
-            cpu.run_stage(*stage).map_err(|f| halted(f.into()))?;
+            cpu.run_stage_passes(*stage).map_err(|f| halted(f.into()))?;
             t[k] += start.elapsed().as_secs_f64();
         }
     }

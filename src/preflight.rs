@@ -398,7 +398,7 @@ fn memory(
     let per_thread = if threads > 1 { threads as f64 } else { 0.0 };
     // Contact pairs (model::Contacts): one copy of the nodal fields per
     // paired body beside the shared field 0, each with its mass gradient,
-    // and per pair and node a normal and a gap (cpu::contact::ContactState).
+    // and per pair and node a normal and a gap (cpu::contact_detect::ContactState).
     let (fields, pairs) = contact_fields(scene);
     let mut per_node = (40.0 + 40.0 * per_thread) * fields + 1.0;
     if pairs > 0.0 {
@@ -410,7 +410,7 @@ fn memory(
     if !f.walls.is_empty() {
         // model::Walls: the node mask, and at most every node in each
         // wall's node list; the CPU's contact weights and walls' forces
-        // (cpu::grid_update::wall_touch, wall_contact).
+        // (cpu::wall_touch, cpu::wall_contact).
         per_node += 4.0 + 8.0 + 16.0 + 4.0 * f.walls.len() as f64;
         if f.bodies
             .values()

@@ -1,9 +1,11 @@
 //! The step plan: which stages run for a scene, in what order, which of
 //! them fuse into one pass over the particles, and which GPU passes do each
 //! (`StepPlan`), built once from the model and read by both backends and
-//! the driver. Nothing else decides it: the CPU backend runs `StepPlan::cpu`,
-//! the GPU backend records `StepPlan::gpu_step` and builds the pipelines of
-//! `StepPlan::gpu_uses`.
+//! the driver. Nothing else decides it: each pass is described once
+//! (`passes!`: its WGSL file, domain and flags, what the CPU does with it),
+//! the stages' passes are listed once (`StepPlan::stage_passes`), the CPU
+//! backend runs `StepPlan::cpu_step` pass by pass, the GPU backend records
+//! `StepPlan::gpu_step` and builds the pipelines of `StepPlan::gpu_passes`.
 //!
 //! The stage list is the paper's Algorithm 1 (`STEP`; FE and NPC share it
 //! and differ in parameters only: NPC predicts with (1 − γ)Δt a_p in `p2g`
@@ -83,206 +85,261 @@ pub fn stages(integrator: Integrator) -> &'static [Stage] {
     }
 }
 
-/// One piece of a CPU step: a stage alone, or two consecutive stages done
-/// in one pass over the particles (the same numbers as the two one by one:
-/// `tests/fused_step.rs`).
+/// What a GPU pass's invocations run over (`gpu::pipelines` turns it into
+/// a dispatch size).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CpuWork {
-    Stage(Stage),
-    /// `shape_eval` then `p2g` (`cpu::shape_eval::shape_eval_p2g`).
-    ShapeEvalP2g,
-    /// `stress` then `forces` (`cpu::stress::stress_forces`).
-    StressForces,
+pub enum Domain {
+    Particles,
+    /// Nodes (of every field, with contact pairs), and at least 2 per
+    /// reaction (clear_grid zeroes them).
+    Nodes,
+    One,
+    Probes,
+    /// Grid cells or integration cells, whichever are more (MLS).
+    Cells,
+    /// Contact pairs × grid nodes.
+    PairNodes,
+    /// Gauss points (MLS).
+    GaussPoints,
+    /// One workgroup of one invocation per field and component
+    /// (constraint_points.wgsl).
+    PointLanes,
 }
 
-/// One GPU pass: a WGSL file (under `shaders/`) and entry point `main`,
-/// built with the scene's flags and the pass's own (`gpu::pipelines`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Pass {
-    Cfl,
-    StepBegin,
-    ClearGrid,
-    LmeNewton,
+/// A pass on the GPU: its WGSL file (under `shaders/`, entry point
+/// `main`), what it runs over, and the flags it is built with on top of
+/// the scene's (`gpu::pipelines::expand`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GpuPass {
+    pub file: &'static str,
+    pub domain: Domain,
+    pub flags: &'static [&'static str],
+}
+
+/// What the CPU does with a pass of the plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OnCpu {
+    /// Its twin runs it (`cpu::CpuBackend::run_pass`).
+    Twin,
+    /// The CPU's twin of the pass named, in the same stage, does this
+    /// pass's work too (the GPU splits one CPU loop in two).
+    In(Pass),
+    /// GPU bookkeeping the CPU does not need (binning particles by cell):
+    /// left out of the CPU's list.
+    GpuOnly,
+    /// A sample pass, outside the step: `Backend::sample` computes it on
+    /// the CPU (`cpu::energy`, `backend::probe_states`).
+    Sample,
+}
+
+/// Everything about one pass, in one place (`Pass::info`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PassInfo {
+    /// None for a pass only the CPU runs.
+    pub gpu: Option<GpuPass>,
+    pub cpu: OnCpu,
+}
+
+const fn gpu(
+    file: &'static str,
+    domain: Domain,
+    flags: &'static [&'static str],
+) -> Option<GpuPass> {
+    Some(GpuPass {
+        file,
+        domain,
+        flags,
+    })
+}
+
+/// Declares `Pass`, `Pass::ALL` and `Pass::info` from one table: a pass's
+/// facts are written once.
+macro_rules! passes {
+    ($($(#[$doc:meta])* $name:ident => $gpu:expr, $cpu:expr;)*) => {
+        /// One pass of a step: a WGSL file the GPU runs, the CPU twin that
+        /// does the same work, or both (`Pass::info`).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub enum Pass {
+            $($(#[$doc])* $name,)*
+        }
+
+        impl Pass {
+            /// Every pass, in declaration order (`pass as usize` indexes it).
+            pub const ALL: [Pass; [$(Pass::$name),*].len()] = [$(Pass::$name),*];
+
+            /// Where the pass runs and how it is built.
+            pub const fn info(self) -> PassInfo {
+                use Domain::*;
+                use OnCpu::*;
+                match self {
+                    $(Pass::$name => PassInfo { gpu: $gpu, cpu: $cpu },)*
+                }
+            }
+        }
+    };
+}
+
+passes! {
+    /// Δt from the Courant condition: the GPU's reduction of the wave
+    /// speed over the particles (cpu/cfl.rs).
+    Cfl => gpu("cfl.wgsl", Particles, &[]), Twin;
+    /// The GPU's Δt and stop logic from the reduction (the CPU's `Cfl`
+    /// decides both).
+    StepBegin => gpu("step_begin.wgsl", One, &[]), In(Pass::Cfl);
+    ClearGrid => gpu("clear_grid.wgsl", Nodes, &[]), Twin;
+    /// N, ∇N at every particle into the CPU's shape cache (cpu/shape_eval.rs;
+    /// LME: the Newton solve on λ), and with contact pairs the nodes offset
+    /// into each body's field. The GPU evaluates the weights inline where
+    /// they are used; LME's Newton is `LmeNewton`.
+    ShapeEval => None, Twin;
+    /// `ShapeEval` then `P2g` in one loop over the particles
+    /// (`cpu::shape_eval::shape_eval_p2g`; `FUSED`).
+    ShapeEvalP2g => None, Twin;
+    LmeNewton => gpu("lme_newton.wgsl", Particles, &[]), In(Pass::ShapeEval);
     /// Particles binned by cell (shared/bins.wgsl): for MLS in `p2g`, for
     /// the gather passes in `shape_eval`.
-    BinClear,
-    BinCount,
-    BinScan,
-    BinFill,
+    BinClear => gpu("bin_clear.wgsl", Cells, &[]), GpuOnly;
+    BinCount => gpu("bin_count.wgsl", Particles, &[]), GpuOnly;
+    BinScan => gpu("bin_scan.wgsl", One, &[]), GpuOnly;
+    BinFill => gpu("bin_fill.wgsl", Particles, &[]), GpuOnly;
     /// p2g.wgsl as a scatter with float atomics, or built with GATHER as
     /// one invocation per node over the binned particles (no atomics).
-    P2g,
-    P2gGather,
+    /// The CPU twin of all three is cpu/p2g.rs.
+    P2g => gpu("p2g.wgsl", Particles, &["WALK"]), Twin;
+    P2gGather => gpu("p2g.wgsl", Nodes, &["WALK", "GATHER"]), Twin;
     /// p2g.wgsl built with PATCH: one invocation per bin of particles that
     /// share a stencil (linear and B-splines on a regular grid, LME), summing
     /// their contributions in registers, then one atomic per node and
     /// component of the stencil.
-    P2gPatch,
-    MlsP2g,
+    P2gPatch => gpu("p2g.wgsl", Cells, &["WALK", "PATCH"]), Twin;
+    MlsP2g => gpu("mls_p2g.wgsl", GaussPoints, &[]), Twin;
     /// Walls only: the weight of the particles in contact per node
     /// (wall_touch.wgsl), before `GridPredict`.
-    WallTouch,
-    GridPredict,
-    Stress,
-    /// `stress` then `forces` in one pass (stress.wgsl built with FORCES):
-    /// what a whole step runs without MLS. Not in `ALL`, which lists the
-    /// passes of the stages one by one.
-    StressForces,
-    /// `StressForces` built with PATCH: per bin, as `P2gPatch`. Not in `ALL`.
-    StressForcesPatch,
+    WallTouch => gpu("wall_touch.wgsl", Particles, &[]), Twin;
+    GridPredict => gpu("grid_update.wgsl", Nodes, &[]), Twin;
+    Stress => gpu("stress.wgsl", Particles, &[]), Twin;
+    /// `stress` then `forces` in one pass (stress.wgsl built with FORCES;
+    /// on the CPU `cpu::stress::stress_forces`): what a whole step runs
+    /// without MLS (`FUSED`).
+    StressForces => gpu("stress.wgsl", Particles, &["WALK", "FORCES"]), Twin;
+    /// `StressForces` built with PATCH: per bin, as `P2gPatch`.
+    StressForcesPatch => gpu("stress.wgsl", Cells, &["WALK", "FORCES", "PATCH"]), Twin;
     /// forces.wgsl as a scatter, or built with GATHER as `P2gGather` is.
-    Forces,
-    ForcesGather,
+    Forces => gpu("forces.wgsl", Particles, &["WALK"]), Twin;
+    ForcesGather => gpu("forces.wgsl", Nodes, &["WALK", "GATHER"]), Twin;
     /// forces.wgsl built with PATCH, as `P2gPatch`.
-    ForcesPatch,
-    MlsForces,
+    ForcesPatch => gpu("forces.wgsl", Cells, &["WALK", "PATCH"]), Twin;
+    MlsForces => gpu("mls_forces.wgsl", GaussPoints, &[]), Twin;
     /// `solver.mls_scope = "force"`: the fit of σ at each Gauss point
     /// (mls_fit.wgsl, one invocation per Gauss point), then at each
     /// particle (built with PARTICLES); `Forces` then scatters the
     /// particles' −V_p (σ_p − σ_h(x_p)) ∇N_I(x_p) and `MlsForceGauss` the
-    /// Gauss points' −ω_g σ_h(x_g) ∇N_I(x_g).
-    MlsFitGauss,
-    MlsFitParticles,
-    MlsForceGauss,
+    /// Gauss points' −ω_g σ_h(x_g) ∇N_I(x_g). On the CPU `Mls::fit_stress`
+    /// does both fits, `Mls::corrected_forces` both scatters.
+    MlsFitGauss => gpu("mls_fit.wgsl", GaussPoints, &[]), Twin;
+    MlsFitParticles => gpu("mls_fit.wgsl", Particles, &["PARTICLES"]), In(Pass::MlsFitGauss);
+    MlsForceGauss => gpu("mls_force_gauss.wgsl", GaussPoints, &[]), In(Pass::Forces);
     /// `solver.mls_scope = "force"`, stage `stress`: ω_g L(x_g) at each
     /// Gauss point (mls_grad.wgsl), then V_p L_p at each particle (built
     /// with PARTICLES), then each particle's strain-rate correction, the
     /// transpose of the force's bracket (mls_strain.wgsl), which `Stress`
-    /// (built with MLS_FORCE) adds to L_p.
-    MlsGradGauss,
-    MlsGradParticles,
-    MlsStrain,
+    /// (built with MLS_FORCE) adds to L_p. On the CPU
+    /// `Mls::strain_correction` does the three.
+    MlsGradGauss => gpu("mls_grad.wgsl", GaussPoints, &[]), In(Pass::MlsStrain);
+    MlsGradParticles => gpu("mls_grad.wgsl", Particles, &["PARTICLES"]), In(Pass::MlsStrain);
+    MlsStrain => gpu("mls_strain.wgsl", Particles, &[]), Twin;
     /// `solver.volumetric_strain = "cell_average"`, stage `stress`: zero
     /// the (cell, body) sums (cell_average.wgsl built with CLEAR, one
     /// invocation per cell), add each particle's V tr L and V to its
     /// slot (`CellAverage`), then `Stress` (built with CELL_AVERAGE)
     /// replaces tr L by its slot's mean.
-    CellAverageClear,
-    CellAverage,
+    CellAverageClear => gpu("cell_average.wgsl", Nodes, &["CLEAR"]), In(Pass::CellAverage);
+    CellAverage => gpu("cell_average.wgsl", Particles, &[]), Twin;
     /// Walls only: the walls' forces at the contact points
     /// (wall_contact.wgsl), before `GridCorrect`.
-    WallContact,
-    GridCorrect,
-    /// Contact pairs only (`cpu::contact`): `detect` as the fields' mass
-    /// gradients and volumes (contact_grad.wgsl, a scatter per particle)
-    /// then each pair node's normal and gap (contact_detect.wgsl, over the
-    /// particles binned in `shape_eval`), before `GridPredict`; `exchange`
-    /// after `GridPredict` (contact_exchange.wgsl) and, as forces, after
+    WallContact => gpu("wall_contact.wgsl", Particles, &[]), Twin;
+    GridCorrect => gpu("grid_update.wgsl", Nodes, &["CORRECT"]), Twin;
+    /// Contact pairs only: the fields' mass gradients and volumes
+    /// (contact_grad.wgsl, a scatter per particle) then each pair node's
+    /// normal and gap (contact_detect.wgsl, over the particles binned in
+    /// `shape_eval`), before `GridPredict`; the exchange after
+    /// `GridPredict` (contact_exchange.wgsl) and, as forces, after
     /// `GridCorrect` (`ContactExchangeForce`, built with CORRECT).
-    ContactGrad,
-    ContactDetect,
-    ContactExchange,
-    ContactExchangeForce,
+    ContactGrad => gpu("contact_grad.wgsl", Particles, &[]), Twin;
+    ContactDetect => gpu("contact_detect.wgsl", PairNodes, &[]), Twin;
+    ContactExchange => gpu("contact_exchange.wgsl", Nodes, &[]), Twin;
+    ContactExchangeForce => gpu("contact_exchange.wgsl", Nodes, &["CORRECT"]), Twin;
     /// Contact pairs only, after `G2p`: each field given back the momentum
-    /// the interface's PIC share changed (`cpu::contact::conserve`,
-    /// contact_conserve.wgsl).
-    ContactConserve,
+    /// the interface's PIC share changed (`cpu::contact_conserve`).
+    ContactConserve => gpu("contact_conserve.wgsl", Particles, &[]), Twin;
     /// Constraint points only (`cpu::constraint_points::hold`): the
     /// projection that holds the points at their group's velocity
     /// (constraint_points.wgsl), right after each `GridPredict` pass, and
     /// as forces with the groups' reactions right after `GridCorrect`
     /// (`ConstraintPointsForce`, built with CORRECT): before the contact
-    /// exchange, as on the CPU.
-    ConstraintPoints,
-    ConstraintPointsForce,
-    G2p,
+    /// exchange.
+    ConstraintPoints => gpu("constraint_points.wgsl", PointLanes, &[]), Twin;
+    ConstraintPointsForce => gpu("constraint_points.wgsl", PointLanes, &["CORRECT"]), Twin;
+    G2p => gpu("g2p.wgsl", Particles, &[]), Twin;
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
     /// then scatter the new velocities from particles (`Remap`) or Gauss
     /// points (`MlsRemap`).
-    RemapClear,
-    Remap,
-    MlsRemap,
-    StepEnd,
-    Probes,
-    Energy,
+    RemapClear => gpu("remap.wgsl", Nodes, &["CLEAR"]), Twin;
+    Remap => gpu("remap.wgsl", Particles, &[]), Twin;
+    MlsRemap => gpu("mls_remap.wgsl", GaussPoints, &[]), Twin;
+    /// Commit the step's time (and count it).
+    StepEnd => gpu("step_end.wgsl", One, &[]), Twin;
+    Probes => gpu("probes.wgsl", Probes, &[]), Sample;
+    Energy => gpu("energy.wgsl", Particles, &[]), Sample;
 }
 
 impl Pass {
-    /// Every pass of the stages one by one, and the sample passes.
-    pub const ALL: [Pass; 43] = [
-        Pass::Cfl,
-        Pass::StepBegin,
-        Pass::ClearGrid,
-        Pass::LmeNewton,
-        Pass::BinClear,
-        Pass::BinCount,
-        Pass::BinScan,
-        Pass::BinFill,
-        Pass::P2g,
-        Pass::P2gGather,
-        Pass::P2gPatch,
-        Pass::MlsP2g,
-        Pass::WallTouch,
-        Pass::GridPredict,
-        Pass::Stress,
-        Pass::Forces,
-        Pass::ForcesGather,
-        Pass::ForcesPatch,
-        Pass::MlsForces,
-        Pass::MlsFitGauss,
-        Pass::MlsFitParticles,
-        Pass::MlsForceGauss,
-        Pass::MlsGradGauss,
-        Pass::MlsGradParticles,
-        Pass::MlsStrain,
-        Pass::CellAverageClear,
-        Pass::CellAverage,
-        Pass::WallContact,
-        Pass::GridCorrect,
-        Pass::ContactGrad,
-        Pass::ContactDetect,
-        Pass::ContactExchange,
-        Pass::ContactExchangeForce,
-        Pass::ContactConserve,
-        Pass::ConstraintPoints,
-        Pass::ConstraintPointsForce,
-        Pass::G2p,
-        Pass::RemapClear,
-        Pass::Remap,
-        Pass::MlsRemap,
-        Pass::StepEnd,
-        Pass::Probes,
-        Pass::Energy,
-    ];
-
-    /// The WGSL file (under shaders/).
-    pub fn file(self) -> &'static str {
-        match self {
-            Pass::Cfl => "cfl.wgsl",
-            Pass::StepBegin => "step_begin.wgsl",
-            Pass::ClearGrid => "clear_grid.wgsl",
-            Pass::LmeNewton => "lme_newton.wgsl",
-            Pass::P2g | Pass::P2gGather | Pass::P2gPatch => "p2g.wgsl",
-            Pass::WallTouch => "wall_touch.wgsl",
-            Pass::WallContact => "wall_contact.wgsl",
-            Pass::GridPredict | Pass::GridCorrect => "grid_update.wgsl",
-            Pass::ContactGrad => "contact_grad.wgsl",
-            Pass::ContactDetect => "contact_detect.wgsl",
-            Pass::ContactExchange | Pass::ContactExchangeForce => "contact_exchange.wgsl",
-            Pass::ContactConserve => "contact_conserve.wgsl",
-            Pass::ConstraintPoints | Pass::ConstraintPointsForce => "constraint_points.wgsl",
-            Pass::Stress | Pass::StressForces | Pass::StressForcesPatch => "stress.wgsl",
-            Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => "forces.wgsl",
-            Pass::G2p => "g2p.wgsl",
-            Pass::StepEnd => "step_end.wgsl",
-            Pass::Probes => "probes.wgsl",
-            Pass::Energy => "energy.wgsl",
-            Pass::BinClear => "bin_clear.wgsl",
-            Pass::BinCount => "bin_count.wgsl",
-            Pass::BinScan => "bin_scan.wgsl",
-            Pass::BinFill => "bin_fill.wgsl",
-            Pass::MlsP2g => "mls_p2g.wgsl",
-            Pass::MlsForces => "mls_forces.wgsl",
-            Pass::MlsFitGauss | Pass::MlsFitParticles => "mls_fit.wgsl",
-            Pass::MlsForceGauss => "mls_force_gauss.wgsl",
-            Pass::MlsGradGauss | Pass::MlsGradParticles => "mls_grad.wgsl",
-            Pass::MlsStrain => "mls_strain.wgsl",
-            Pass::CellAverageClear | Pass::CellAverage => "cell_average.wgsl",
-            Pass::RemapClear | Pass::Remap => "remap.wgsl",
-            Pass::MlsRemap => "mls_remap.wgsl",
-        }
+    /// The WGSL file (under shaders/); None for a pass only the CPU runs.
+    pub fn file(self) -> Option<&'static str> {
+        self.info().gpu.map(|g| g.file)
     }
 }
+
+/// Two consecutive passes that a backend runs as one pass where both are
+/// in its list side by side and `apart` does not hold. Applied to the
+/// stages' passes to give each backend's whole step (`StepPlan`); the
+/// fused pass gives the same numbers as the two one by one
+/// (`tests/fused_step.rs`).
+pub struct Fusion {
+    pub first: Pass,
+    pub then: Pass,
+    pub fused: Pass,
+    /// When the two must stay apart although they follow each other.
+    pub apart: fn(&PlanInputs) -> bool,
+}
+
+/// The fusions of both backends. The CPU's `ShapeEvalP2g` (the GPU
+/// evaluates shapes inline, so it has no `ShapeEval` to fuse): not with
+/// contact pairs, whose nodes `shape_eval` offsets into each body's field
+/// before `p2g` scatters. `stress` with `forces` where both scatter: not
+/// with the cell average, which needs every particle's L before any
+/// stress (on the GPU, the gather keeps them apart: `ForcesGather` has no
+/// fusion).
+pub const FUSED: [Fusion; 3] = [
+    Fusion {
+        first: Pass::ShapeEval,
+        then: Pass::P2g,
+        fused: Pass::ShapeEvalP2g,
+        apart: |i| i.contact,
+    },
+    Fusion {
+        first: Pass::Stress,
+        then: Pass::Forces,
+        fused: Pass::StressForces,
+        apart: |i| i.cell_average,
+    },
+    Fusion {
+        first: Pass::Stress,
+        then: Pass::ForcesPatch,
+        fused: Pass::StressForcesPatch,
+        apart: |i| i.cell_average,
+    },
+];
 
 /// What a plan is decided from: the shape, the integrator, MLS, and how
 /// the GPU puts particle terms on nodes (its options' choice: the gather
@@ -311,7 +368,7 @@ pub struct PlanInputs {
     pub contact: bool,
     /// Constraint points (`model::constraint_points`): the GPU adds the
     /// points' projection after every `GridPredict` and `GridCorrect`
-    /// pass (the CPU's `grid_update` stages call it themselves).
+    /// pass.
     pub points: bool,
     /// `solver.volumetric_strain = "cell_average"`: `stress` averages the
     /// volumetric strain rate over each cell first (on the GPU, the
@@ -320,23 +377,55 @@ pub struct PlanInputs {
     pub cell_average: bool,
 }
 
-/// The step of one scene, for both backends.
+/// The step of one scene, for both backends: the stages' passes
+/// (`stage_passes`), each backend's share of them (`Pass::info`), fused
+/// where `FUSED` says. The CPU runs `cpu_step` pass by pass
+/// (`cpu::CpuBackend::run_pass`), the GPU records `gpu_step`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StepPlan {
     pub inputs: PlanInputs,
     /// The stages in order (`STEP` or `STEP_MUSL`).
     pub stages: &'static [Stage],
-    /// The CPU's step: without MLS, `shape_eval` and `p2g` fuse, and
-    /// `stress` and `forces` where they follow each other (not in MUSL).
-    pub cpu: Vec<CpuWork>,
-    /// The GPU's passes of one whole step, in order: each stage's passes
-    /// (`passes_for`), with `stress` and `forces` fused into `StressForces`
-    /// (per bin: `StressForcesPatch`) where both scatter (no MLS, not
-    /// MUSL, not gathering), then `StepEnd` (commit the time).
+    /// The CPU's passes of one whole step, in order: each stage's CPU
+    /// passes (`cpu_passes_for`), fused (`ShapeEvalP2g` without MLS or
+    /// contact pairs, `StressForces` where `stress` and `forces` follow
+    /// each other), then `StepEnd`.
+    pub cpu_step: Vec<Pass>,
+    /// The GPU's passes of one whole step, in order: each stage's GPU
+    /// passes (`gpu_passes_for`), with `stress` and `forces` fused into
+    /// `StressForces` (per bin: `StressForcesPatch`) where both scatter (no
+    /// MLS, not MUSL, not gathering), then `StepEnd` (commit the time).
     pub gpu_step: Vec<Pass>,
 }
 
 const BINS: [Pass; 4] = [Pass::BinClear, Pass::BinCount, Pass::BinScan, Pass::BinFill];
+
+/// Whether the GPU runs `pass`.
+pub fn on_gpu(pass: Pass) -> bool {
+    pass.info().gpu.is_some()
+}
+
+/// Whether the CPU's `run_pass` runs `pass`.
+pub fn on_cpu(pass: Pass) -> bool {
+    pass.info().cpu == OnCpu::Twin
+}
+
+/// `passes` with each `FUSED` pair that follows each other replaced by its
+/// fused pass (where the backend runs it).
+fn fuse(passes: Vec<Pass>, inputs: &PlanInputs, runs: fn(Pass) -> bool) -> Vec<Pass> {
+    let mut out: Vec<Pass> = Vec::with_capacity(passes.len());
+    for pass in passes {
+        let last = out.last().copied();
+        let fusion = FUSED.iter().find(|f| {
+            Some(f.first) == last && f.then == pass && runs(f.fused) && !(f.apart)(inputs)
+        });
+        match fusion {
+            Some(f) => *out.last_mut().expect("a fusion follows its first pass") = f.fused,
+            None => out.push(pass),
+        }
+    }
+    out
+}
 
 impl StepPlan {
     /// The plan of `model` with the GPU's `gather` / `patch` choice (both
@@ -357,51 +446,27 @@ impl StepPlan {
     }
 
     pub fn new(inputs: PlanInputs) -> StepPlan {
-        let PlanInputs {
-            mls,
-            mls_force,
-            musl,
-            gather,
-            contact,
-            cell_average,
-            ..
-        } = inputs;
-        let stages = if musl { STEP_MUSL } else { STEP };
-        let fuse_stress = !mls && !mls_force && !musl && !cell_average;
-        let fuse_p2g = !mls && !contact;
-        let cpu = stages
-            .iter()
-            .filter_map(|&s| match s {
-                Stage::ShapeEval if fuse_p2g => Some(CpuWork::ShapeEvalP2g),
-                Stage::P2g if fuse_p2g => None,
-                Stage::Stress if fuse_stress => Some(CpuWork::StressForces),
-                Stage::Forces if fuse_stress => None,
-                s => Some(CpuWork::Stage(s)),
-            })
-            .collect();
+        let stages = if inputs.musl { STEP_MUSL } else { STEP };
         let mut plan = StepPlan {
             inputs,
             stages,
-            cpu,
+            cpu_step: Vec::new(),
             gpu_step: Vec::new(),
         };
-        let fuse_gpu = fuse_stress && !gather;
-        plan.gpu_step = stages
-            .iter()
-            .flat_map(|&s| plan.passes_for(s))
-            .filter_map(|pass| match pass {
-                Pass::Stress if fuse_gpu && inputs.patch => Some(Pass::StressForcesPatch),
-                Pass::Stress if fuse_gpu => Some(Pass::StressForces),
-                Pass::Forces | Pass::ForcesPatch if fuse_gpu => None,
-                p => Some(p),
-            })
-            .chain([Pass::StepEnd])
-            .collect();
+        let whole = |per_stage: &dyn Fn(Stage) -> Vec<Pass>| -> Vec<Pass> {
+            stages.iter().flat_map(|&s| per_stage(s)).collect()
+        };
+        let mut cpu = fuse(whole(&|s| plan.cpu_passes_for(s)), &inputs, on_cpu);
+        let mut gpu = fuse(whole(&|s| plan.gpu_passes_for(s)), &inputs, on_gpu);
+        cpu.push(Pass::StepEnd);
+        gpu.push(Pass::StepEnd);
+        (plan.cpu_step, plan.gpu_step) = (cpu, gpu);
         plan
     }
 
-    /// The GPU passes that do `stage` on its own (`stage_passes`, and with
-    /// constraint points their projection after each grid update).
+    /// The passes that do `stage` on its own on either backend, in order
+    /// (`stage_passes`, and with constraint points their projection after
+    /// each grid update).
     pub fn passes_for(&self, stage: Stage) -> Vec<Pass> {
         let passes = self.stage_passes(stage);
         if !self.inputs.points {
@@ -417,11 +482,40 @@ impl StepPlan {
             .collect()
     }
 
-    /// The GPU passes that do `stage` on its own, constraint points aside.
-    /// `Cfl` is the reduction
-    /// plus the one-invocation Δt/stop pass; shape evaluation is LME's
-    /// Newton solve and, for the gather and per-bin passes, the binning
-    /// (the weights themselves are evaluated inline where used). With MLS,
+    /// The GPU's passes of `stage` on its own (the parity tests run them).
+    pub fn gpu_passes_for(&self, stage: Stage) -> Vec<Pass> {
+        let mut passes = self.passes_for(stage);
+        passes.retain(|&p| on_gpu(p));
+        passes
+    }
+
+    /// The CPU's passes of `stage` on its own, unfused (the parity tests
+    /// and `fused_step` run them). The CPU scatters per particle whatever
+    /// the GPU's choice: its passes are those of the plan without the
+    /// gather and the per-bin scatter (the twins of their passes are the
+    /// scatter's all the same).
+    pub fn cpu_passes_for(&self, stage: Stage) -> Vec<Pass> {
+        let scatter = StepPlan {
+            inputs: PlanInputs {
+                gather: false,
+                patch: false,
+                ..self.inputs
+            },
+            stages: self.stages,
+            cpu_step: Vec::new(),
+            gpu_step: Vec::new(),
+        };
+        let mut passes = scatter.passes_for(stage);
+        passes.retain(|&p| on_cpu(p));
+        passes
+    }
+
+    /// The passes that do `stage` on its own, constraint points aside,
+    /// on both backends (each runs those `Pass::info` gives it).
+    /// `Cfl` is the reduction plus the one-invocation Δt/stop pass; shape
+    /// evaluation is the CPU's shape cache, LME's Newton solve on the GPU
+    /// and, for the gather and per-bin passes, the binning (the GPU
+    /// evaluates the weights themselves inline where used). With MLS,
     /// `p2g` and `forces` work at Gauss points.
     fn stage_passes(&self, stage: Stage) -> &'static [Pass] {
         let PlanInputs {
@@ -437,15 +531,16 @@ impl StepPlan {
             cell_average,
         } = self.inputs;
         let binned = gather || patch || contact;
+        const SHAPES: Pass = Pass::ShapeEval;
         match stage {
             Stage::Cfl => &[Pass::Cfl, Pass::StepBegin],
             Stage::ClearGrid => &[Pass::ClearGrid],
             Stage::ShapeEval if binned && lme => {
-                &[Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
+                &[SHAPES, Pass::LmeNewton, BINS[0], BINS[1], BINS[2], BINS[3]]
             }
-            Stage::ShapeEval if binned => &BINS,
-            Stage::ShapeEval if lme => &[Pass::LmeNewton],
-            Stage::ShapeEval => &[],
+            Stage::ShapeEval if binned => &[SHAPES, BINS[0], BINS[1], BINS[2], BINS[3]],
+            Stage::ShapeEval if lme => &[SHAPES, Pass::LmeNewton],
+            Stage::ShapeEval => &[SHAPES],
             Stage::P2g if mls => &[BINS[0], BINS[1], BINS[2], BINS[3], Pass::MlsP2g],
             Stage::P2g if gather => &[Pass::P2gGather],
             Stage::P2g if patch => &[Pass::P2gPatch],
@@ -530,12 +625,21 @@ impl StepPlan {
     /// (the parity tests run stages one by one), of the whole step, or a
     /// sample pass (probes, energy).
     pub fn gpu_uses(&self, pass: Pass) -> bool {
-        matches!(pass, Pass::Probes | Pass::Energy)
-            || self.gpu_step.contains(&pass)
-            || self
-                .stages
-                .iter()
-                .any(|&s| self.passes_for(s).contains(&pass))
+        on_gpu(pass)
+            && (pass.info().cpu == OnCpu::Sample
+                || self.gpu_step.contains(&pass)
+                || self
+                    .stages
+                    .iter()
+                    .any(|&s| self.gpu_passes_for(s).contains(&pass)))
+    }
+
+    /// The passes the GPU builds a pipeline for (`gpu_uses`), in `Pass::ALL`'s order.
+    pub fn gpu_passes(&self) -> Vec<Pass> {
+        Pass::ALL
+            .into_iter()
+            .filter(|&p| self.gpu_uses(p))
+            .collect()
     }
 }
 
@@ -561,18 +665,18 @@ mod tests {
     #[test]
     fn both_backends_fuse_stress_and_forces_only_without_mls_and_musl() {
         let p = plan(false, false, false, false, false);
-        assert!(p.cpu.contains(&CpuWork::StressForces));
+        assert!(p.cpu_step.contains(&Pass::StressForces));
         assert!(p.gpu_step.contains(&Pass::StressForces));
         assert!(!p.gpu_step.contains(&Pass::Stress) && !p.gpu_step.contains(&Pass::Forces));
         for (mls, musl) in [(true, true), (false, true)] {
             let p = plan(false, mls, musl, false, false);
-            assert!(!p.cpu.contains(&CpuWork::StressForces));
+            assert!(!p.cpu_step.contains(&Pass::StressForces));
             assert!(!p.gpu_step.contains(&Pass::StressForces));
             assert!(p.gpu_uses(Pass::Stress));
         }
         // The gather keeps stress and forces apart on the GPU only.
         let p = plan(false, false, false, true, false);
-        assert!(p.cpu.contains(&CpuWork::StressForces));
+        assert!(p.cpu_step.contains(&Pass::StressForces));
         assert!(p.gpu_step.contains(&Pass::ForcesGather) && !p.gpu_uses(Pass::StressForces));
         let p = plan(true, false, false, false, true);
         assert!(p.gpu_step.contains(&Pass::StressForcesPatch));
@@ -582,8 +686,9 @@ mod tests {
         let mut inputs = plan(false, false, false, false, false).inputs;
         inputs.cell_average = true;
         let p = StepPlan::new(inputs);
-        assert!(!p.cpu.contains(&CpuWork::StressForces));
-        assert!(p.cpu.contains(&CpuWork::Stage(Stage::Stress)));
+        assert!(!p.cpu_step.contains(&Pass::StressForces));
+        assert!(p.cpu_step.contains(&Pass::Stress));
+        assert!(!p.gpu_step.contains(&Pass::StressForces));
     }
 
     /// `solver.mls_scope = "force"` changes `forces` alone: p2g, the remap
@@ -603,9 +708,9 @@ mod tests {
                 points: false,
                 cell_average: false,
             });
-            assert_eq!(p.cpu[2], CpuWork::ShapeEvalP2g);
-            assert!(!p.cpu.contains(&CpuWork::StressForces));
-            assert!(p.cpu.contains(&CpuWork::Stage(Stage::Forces)));
+            assert_eq!(p.cpu_step[2], Pass::ShapeEvalP2g);
+            assert!(!p.cpu_step.contains(&Pass::StressForces));
+            assert!(p.cpu_step.contains(&Pass::Forces));
             for pass in [Pass::MlsP2g, Pass::MlsForces, Pass::MlsRemap] {
                 assert!(!p.gpu_uses(pass), "{pass:?}");
             }
@@ -634,16 +739,32 @@ mod tests {
                 continue; // the GPU options never pick these
             }
             let p = plan(lme, mls, musl, gather, patch);
-            let cpu: Vec<Stage> = p
-                .cpu
-                .iter()
-                .flat_map(|w| match w {
-                    CpuWork::Stage(s) => vec![*s],
-                    CpuWork::ShapeEvalP2g => vec![Stage::ShapeEval, Stage::P2g],
-                    CpuWork::StressForces => vec![Stage::Stress, Stage::Forces],
-                })
-                .collect();
-            assert_eq!(cpu, p.stages, "{bits:05b}");
+            // Each backend's step, unfused, is its stages' passes in turn.
+            let unfused = |step: &[Pass]| -> Vec<Pass> {
+                step.iter()
+                    .flat_map(|&q| match FUSED.iter().find(|f| f.fused == q) {
+                        Some(f) => vec![f.first, f.then],
+                        None => vec![q],
+                    })
+                    .collect()
+            };
+            let stages = |per: &dyn Fn(Stage) -> Vec<Pass>| -> Vec<Pass> {
+                let mut v: Vec<Pass> = p.stages.iter().flat_map(|&s| per(s)).collect();
+                v.push(Pass::StepEnd);
+                v
+            };
+            assert_eq!(
+                unfused(&p.cpu_step),
+                stages(&|s| p.cpu_passes_for(s)),
+                "{bits:05b}"
+            );
+            assert_eq!(
+                unfused(&p.gpu_step),
+                stages(&|s| p.gpu_passes_for(s)),
+                "{bits:05b}"
+            );
+            assert_eq!(p.cpu_step[..2], [Pass::Cfl, Pass::ClearGrid]);
+            assert_eq!(p.cpu_step[2] == Pass::ShapeEvalP2g, !mls, "{bits:05b}");
             assert_eq!(p.gpu_step.last(), Some(&Pass::StepEnd));
             assert_eq!(p.gpu_step[..2], [Pass::Cfl, Pass::StepBegin]);
             assert_eq!(p.gpu_uses(Pass::LmeNewton), lme, "{bits:05b}");
@@ -695,7 +816,7 @@ mod tests {
                 assert!(at(Pass::GridCorrect) < at(Pass::ContactExchangeForce));
                 assert!(at(Pass::ContactExchangeForce) < at(Pass::G2p));
                 if musl {
-                    let remap = with.passes_for(Stage::Remap);
+                    let remap = with.gpu_passes_for(Stage::Remap);
                     assert_eq!(remap.last(), Some(&Pass::ContactExchange));
                 }
                 let stripped: Vec<Pass> = with

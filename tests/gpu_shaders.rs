@@ -259,7 +259,7 @@ fn every_pass_validates_in_every_variant() {
             let src = pipelines::expand(pass, &d).unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
             let key = (src, v.atomics == AtomicMode::Float);
             if !validated.contains_key(&key) {
-                let module = pipelines::validate(&key.0, pass.file(), v.atomics)
+                let module = pipelines::validate(&key.0, pass.file().unwrap(), v.atomics)
                     .unwrap_or_else(|e| panic!("{pass:?} {v:?}: {e}"));
                 validated.insert(key.clone(), pipelines::bindings(&module));
             }
@@ -380,6 +380,8 @@ fn pass_uses_shape(pass: Pass) -> bool {
             | Pass::P2gGather
             | Pass::P2gPatch
             | Pass::Stress
+            | Pass::StressForces
+            | Pass::StressForcesPatch
             | Pass::Forces
             | Pass::ForcesGather
             | Pass::ForcesPatch
@@ -503,7 +505,7 @@ fn every_pass_module() -> Vec<(Pass, naga::Module)> {
                 let src = pipelines::expand(pass, &d).unwrap();
                 out.push((
                     pass,
-                    pipelines::validate(&src, pass.file(), v.atomics).unwrap(),
+                    pipelines::validate(&src, pass.file().unwrap(), v.atomics).unwrap(),
                 ));
             }
         }
@@ -554,20 +556,23 @@ fn constants_mirrored_in_wgsl_match_rust() {
         ("STICK_MU", f(lme_mpm::model::walls::STICK_MU)),
         (
             "LINE_WEIGHT_EPS",
-            f(lme_mpm::cpu::grid_update::LINE_WEIGHT_EPS),
+            f(lme_mpm::cpu::wall_touch::LINE_WEIGHT_EPS),
         ),
         (
             "CONTACT_GAP_SLACK",
-            f(lme_mpm::cpu::contact::CONTACT_GAP_SLACK),
+            f(lme_mpm::cpu::contact_detect::CONTACT_GAP_SLACK),
         ),
-        ("LR_RIDGE", f(lme_mpm::cpu::contact::LR_RIDGE)),
+        ("LR_RIDGE", f(lme_mpm::cpu::contact_detect::LR_RIDGE)),
         (
             "LR_ITERATIONS",
-            u(lme_mpm::cpu::contact::LR_ITERATIONS as u32),
+            u(lme_mpm::cpu::contact_detect::LR_ITERATIONS as u32),
         ),
-        ("LR_MAX_STEP", f(lme_mpm::cpu::contact::LR_MAX_STEP)),
-        ("LR_MIN_SCALE", f(lme_mpm::cpu::contact::LR_MIN_SCALE)),
-        ("LR_FLAT_COS", f(lme_mpm::cpu::contact::LR_FLAT_COS)),
+        ("LR_MAX_STEP", f(lme_mpm::cpu::contact_detect::LR_MAX_STEP)),
+        (
+            "LR_MIN_SCALE",
+            f(lme_mpm::cpu::contact_detect::LR_MIN_SCALE),
+        ),
+        ("LR_FLAT_COS", f(lme_mpm::cpu::contact_detect::LR_FLAT_COS)),
         (
             "CONTACT_PIC_FRACTION",
             f(lme_mpm::model::contact::CONTACT_PIC_FRACTION),

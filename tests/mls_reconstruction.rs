@@ -273,7 +273,7 @@ fn projection_at(shape: &str, mls: bool, cells: usize, t: f64, support: f64) -> 
         Stage::GridPredict,
         Stage::Forces,
     ] {
-        cpu.run_stage(s).unwrap();
+        cpu.run_stage_passes(s).unwrap();
     }
     let g = &cpu.model.grid;
     let n = g.nx;
@@ -414,12 +414,12 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
                 Stage::GridCorrect => {
                     vi = cpu.mv.clone();
                     fi = cpu.force.clone();
-                    cpu.run_stage(stage).unwrap();
+                    cpu.run_stage_passes(stage).unwrap();
                 }
                 Stage::G2p => {
                     before = energy(&cpu);
                     let v0 = cpu.model.particles.v.clone();
-                    cpu.run_stage(stage).unwrap();
+                    cpu.run_stage_passes(stage).unwrap();
                     let dt = cpu.dt();
                     if adjoint {
                         // Nodal Δv = Δt f/m, as [m, Δvx, Δvy].
@@ -476,7 +476,7 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
                         p.rho[i] /= j;
                     }
                 }
-                _ => cpu.run_stage(stage).unwrap(),
+                _ => cpu.run_stage_passes(stage).unwrap(),
             }
         }
         let after = energy(&cpu);
@@ -565,7 +565,7 @@ fn the_fits_quadrature_volumes_are_not_the_particles_near_an_edge() {
         let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
         let mut cpu = CpuBackend::new(model(CASE, &sets));
         for s in [Stage::Cfl, Stage::ClearGrid, Stage::ShapeEval, Stage::P2g] {
-            cpu.run_stage(s).unwrap();
+            cpu.run_stage_passes(s).unwrap();
         }
         let mls = cpu.mls.as_ref().unwrap();
         let n = cpu.model.particles.len();

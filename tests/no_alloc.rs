@@ -71,7 +71,7 @@ fn allocations(threads: usize) -> Vec<(String, usize)> {
             ),
             ("aligned_vibration.toml", &["grid.h=0.125"]),
             // B-splines on walls with a geostatic preload: the preload's
-            // weights at the wall's line (`grid_update::LineWeights`).
+            // weights at the wall's line (`wall_touch::LineWeights`).
             ("granular_collapse.toml", &["grid.h=0.1"]),
         ] {
             let scene = common::scene(case, sets);

@@ -449,7 +449,7 @@ impl Report {
 /// `normal_tol` and their gaps to `CONTACT_GAP_TOL` h.
 fn check_detect(
     rep: &mut Report,
-    st: &lme_mpm::cpu::contact::ContactState,
+    st: &lme_mpm::cpu::contact_detect::ContactState,
     gpu: &[([f64; 2], Option<f64>)],
     h: f64,
     normal_tol: f64,
@@ -580,7 +580,7 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                 gpu.run_pass(pass);
             }
         }
-        cpu.run_stage(stage)
+        cpu.run_stage_passes(stage)
             .unwrap_or_else(|f| panic!("{label}: CPU {stage:?}: {f}"));
         for pass in gpu.stage_passes(stage) {
             gpu.run_pass(pass);
@@ -1282,7 +1282,7 @@ fn stages_match_boundaries() {
         let mut cpu = CpuBackend::new(m.clone());
         cpu.set_time(0.7);
         for &stage in STEP.iter().take_while(|s| **s != Stage::G2p) {
-            cpu.run_stage(stage).unwrap();
+            cpu.run_stage_passes(stage).unwrap();
         }
         let groups = m.constraints.groups.len();
         for (w, r) in m.walls.list.iter().zip(&cpu.reactions[groups..]) {
@@ -1336,7 +1336,7 @@ fn stages_match_gates_pic_and_damping() {
             .iter()
             .take_while(|s| **s != Stage::G2p)
         {
-            cpu.run_stage(stage).unwrap();
+            cpu.run_stage_passes(stage).unwrap();
         }
         let groups = m.constraints.groups.len();
         for (w, r) in m.walls.list.iter().zip(&cpu.reactions[groups..]) {
@@ -1632,7 +1632,7 @@ fn stages_match_contact_pairs() {
 }
 
 /// `solver.volumetric_strain = "cell_average"` (the B-bar of
-/// `cpu::antilock`): the stress stage with each particle's volumetric
+/// `cpu::cell_average`): the stress stage with each particle's volumetric
 /// strain rate replaced by its (cell, body) mean, summed by
 /// cell_average.wgsl with float atomics (CAS in one case) and read by
 /// stress.wgsl; one body on its own field, and the four bodies of

@@ -51,6 +51,8 @@ mod mls_force;
 mod mls_reconstruction;
 #[path = "modified_cam_clay.rs"]
 mod modified_cam_clay;
+#[path = "plan_coverage.rs"]
+mod plan_coverage;
 #[path = "preflight.rs"]
 mod preflight;
 #[path = "readme.rs"]

@@ -4,7 +4,7 @@
 const N_BODIES: u32 = {{N_BODIES}}u;
 
 // The lattice cell holding grid-relative position x, clamped to the grid
-// (CPU: `antilock::cell_of`).
+// (CPU: `cell_average::cell_of`).
 fn cell_of(x: vec2<f32>) -> u32 {
     let cx = params.nx - 1u;
     let cy = params.ny - 1u;

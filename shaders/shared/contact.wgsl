@@ -1,5 +1,6 @@
 // Contact between bodies (multi-field MPM): what the contact passes share.
-// CPU twin: src/cpu/contact.rs.
+// CPU twins: src/cpu/contact_detect.rs (the normal rule) and
+// src/cpu/contact_exchange.rs (`pair_impulse`).
 
 // A declared pair (src/gpu/layout.rs `GpuContactPair`): the fields of its
 // first and second body, its law (CONTACT_*), Coulomb μ (friction only)
@@ -15,7 +16,7 @@ struct ContactPair {
 
 // Slack of the gap test relative to the smallest particle half-width:
 // domains seeded flush against each other touch whatever the round-off.
-// Keep in sync with `CONTACT_GAP_SLACK` in src/cpu/contact.rs.
+// Keep in sync with `CONTACT_GAP_SLACK` in src/cpu/contact_detect.rs.
 const CONTACT_GAP_SLACK: f32 = 1e-3;
 
 // Least share of PIC in g2p for particles at a node in contact. Keep in
@@ -24,7 +25,7 @@ const CONTACT_PIC_FRACTION: f32 = 0.05;
 
 // The logistic-regression normal: ridge, Newton steps, step cap, least scale.
 // Keep in sync with `LR_RIDGE`, `LR_ITERATIONS`, `LR_MAX_STEP`, `LR_MIN_SCALE` in
-// src/cpu/contact.rs (tests/gpu_shaders.rs checks).
+// src/cpu/contact_detect.rs (tests/gpu_shaders.rs checks).
 const LR_RIDGE: f32 = 1e-9;
 const LR_ITERATIONS: u32 = 10u;
 const LR_MAX_STEP: f32 = 4.0;

@@ -11,7 +11,7 @@
 // than 1 − PRELOAD_HOLD of it) and the
 // weight of its material between its centre and the line (d:
 // `wall_depth`), times 2 l_p. In contact while positive.
-// CPU twins: `contact_spring` in src/cpu/grid_update.rs and
+// CPU twins: `contact_spring` in src/cpu/wall_touch.rs and
 // `preload_force` in src/model/walls.rs.
 #if WALL_PRELOAD
 @group(0) @binding({{B_STRESS}}) var<storage, read> stress: array<f32>;
@@ -30,13 +30,13 @@ fn wall_depth(x: vec2<f32>, lp: f32, w: Wall) -> f32 {
 const PRELOAD_HOLD: f32 = 0.99;
 
 // Round-off allowance of `line_weights_positive` (f32 weights of O(1)).
-// Keep in sync with src/cpu/grid_update.rs.
+// Keep in sync with src/cpu/wall_touch.rs.
 const LINE_WEIGHT_EPS: f32 = 1e-6;
 
 // Whether the particle's weights at the wall's line, N − d n·∇N (d:
 // `wall_depth`), are all non-negative (linear shapes while the line is in
 // the particle's cell): its friction then acts on the line.
-// CPU twin: `line_weights_positive` in src/cpu/grid_update.rs.
+// CPU twin: `line_weights_positive` in src/cpu/wall_touch.rs.
 fn line_weights_positive(c: ShapeCtx, n: vec2<f32>, d: f32) -> bool {
     var positive = true;
     for (var r = 0u; r < SHAPE_ROWS; r++) {

@@ -97,7 +97,7 @@ pub fn g2p(
             *dp = [0.0; 2];
             if alpha > prm.pic_fraction {
                 // The interface's share over the scene's: its momentum
-                // change, which `contact::conserve` gives back.
+                // change, which `contact_conserve::conserve` gives back.
                 let flip = [v[0] + dt * acc[0], v[1] + dt * acc[1]];
                 let scene = [
                     (1.0 - prm.pic_fraction) * flip[0] + prm.pic_fraction * vel[0],

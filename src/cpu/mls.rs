@@ -757,8 +757,9 @@ impl Mls {
     /// points with this step's coefficients and the particles' positions at
     /// the step's start (as `p2g` packed them; the particles have moved
     /// since), ρ the density at the step's start (ρ_p^t, not yet updated),
-    /// v the particles' new velocities, and replaces the nodal momentum of
-    /// `mv` by its quadrature Σ_g N_I(x_g) (ρv)_g ω_g. The masses stay
+    /// v the particles' new velocities, and adds its quadrature
+    /// Σ_g N_I(x_g) (ρv)_g ω_g to the nodal momentum of `mv` (zeroed
+    /// first by pass `RemapClear`, `remap::clear_momentum`). The masses stay
     /// m_I^t, so `grid_update::predict` then gives v^L (eq. 33).
     pub fn remap(&mut self, grid: &Grid, rho: &[f64], v: &[[f64; 2]], mv: &mut [[f64; 3]]) {
         let order = &self.order;
@@ -774,7 +775,6 @@ impl Mls {
         let mut vals = std::mem::take(&mut self.gp_remap);
         self.fit(grid, &mut vals);
         self.gp_remap = vals;
-        super::remap::clear_momentum(mv);
         let (shape, gw, gv) = (&self.gp_shape, &self.gp_w, &self.gp_remap);
         let coef = &self.coef;
         self.mv_scatter.run(mv, gv.len(), |g, acc| {

@@ -1,12 +1,18 @@
-//! The CPU reference path: f64, rayon across all cores, one file per stage
-//! mirroring the WGSL twin of the same name. Buffers are allocated once in
-//! `CpuBackend::new`; a step allocates nothing.
+//! The CPU reference path: f64, rayon across all cores, one file per pass
+//! mirroring the WGSL twin of the same name (`shaders/wall_touch.wgsl` ↔
+//! `wall_touch.rs`). A step is the plan's pass list (`StepPlan::cpu_step`),
+//! each pass run by its twin (`CpuBackend::run_pass`, `CpuBackend::twin`).
+//! Buffers are allocated once in `CpuBackend::new`; a step allocates
+//! nothing.
 
-pub mod antilock;
+pub mod cell_average;
 pub mod cfl;
 pub mod clear_grid;
 pub mod constraint_points;
-pub mod contact;
+pub mod contact_conserve;
+pub mod contact_detect;
+pub mod contact_exchange;
+pub mod contact_grad;
 pub mod energy;
 pub mod forces;
 pub mod g2p;
@@ -19,16 +25,21 @@ pub mod scatter;
 pub mod shape_eval;
 pub mod stage_inputs;
 pub mod stress;
+pub mod wall_contact;
+pub mod wall_touch;
 
 use crate::backend::{Backend, Halt, Sample, State, stop_requested};
 use crate::error::Result;
 use crate::model::fault::Fault;
 use crate::model::{Integrator, Model, Particles};
-use crate::step::{CpuWork, Stage, StepPlan};
+use crate::step::{Pass, Stage, StepPlan};
 use scatter::Scatter;
 pub(crate) use stage_inputs::body_force;
 pub use stage_inputs::{ShapeCache, Slots, Weights};
 use std::sync::atomic::AtomicBool;
+
+/// A pass's CPU twin (`CpuBackend::twin`).
+pub type Twin = fn(&mut CpuBackend) -> std::result::Result<(), Fault>;
 
 /// Runs a `Model` on the CPU.
 pub struct CpuBackend {
@@ -40,7 +51,7 @@ pub struct CpuBackend {
     /// 38 s beside another).
     own_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     pub model: Model,
-    /// What a step runs (`StepPlan::cpu`).
+    /// What a step runs (`StepPlan::cpu_step`).
     pub plan: StepPlan,
     pub cache: ShapeCache,
     /// Per node: [mass, momentum or velocity x, y].
@@ -51,16 +62,16 @@ pub struct CpuBackend {
     pub reactions: Vec<[f64; 2]>,
     /// Per node: the weight of the particles in contact with a wall this
     /// step and their friction's weight, [S_I, T_I]
-    /// (`grid_update::wall_touch`); empty without walls.
+    /// (`wall_touch::wall_touch`); empty without walls.
     pub wall_touch: Vec<[f64; 2]>,
-    /// Per node: the walls' forces this step (`grid_update::wall_contact`);
+    /// Per node: the walls' forces this step (`wall_contact::wall_contact`);
     /// empty without walls.
     pub wall_force: Vec<[f64; 2]>,
-    /// Per node: the walls' preloads this step (`grid_update::wall_touch`);
+    /// Per node: the walls' preloads this step (`wall_touch::wall_touch`);
     /// empty unless some particle starts with one (`Walls::preload`).
     pub wall_pre_force: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
-    pub contact: Option<contact::ContactState>,
+    pub contact: Option<contact_detect::ContactState>,
     p2g_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
@@ -69,8 +80,8 @@ pub struct CpuBackend {
     /// correction `Mls::strain_correction` (empty otherwise).
     mls_dl: Vec<[f64; 4]>,
     /// `solver.volumetric_strain = "cell_average"`: the cells' mean
-    /// volumetric strain rate (`antilock`); None otherwise.
-    cell_average: Option<antilock::CellAverage>,
+    /// volumetric strain rate (`cell_average`); None otherwise.
+    cell_average: Option<cell_average::CellAverage>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -86,8 +97,8 @@ fn contact_particles<'a>(
     p: &'a Particles,
     gravity: Option<&crate::model::Gravity>,
     line: Option<(&'a crate::model::shape::Shape, &'a crate::model::Grid)>,
-) -> grid_update::ContactParticles<'a> {
-    grid_update::ContactParticles {
+) -> wall_touch::ContactParticles<'a> {
+    wall_touch::ContactParticles {
         line,
         x: &p.x,
         mass: &p.mass,
@@ -143,7 +154,7 @@ impl CpuBackend {
             contact: model
                 .contact
                 .as_ref()
-                .map(|c| contact::ContactState::new(c, grid_nodes, n)),
+                .map(|c| contact_detect::ContactState::new(c, grid_nodes, n)),
             p2g_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
@@ -162,7 +173,7 @@ impl CpuBackend {
             },
             cell_average: model
                 .cell_average_volumetric
-                .then(|| antilock::CellAverage::new(&model.grid, model.body_names.len(), n)),
+                .then(|| cell_average::CellAverage::new(&model.grid, model.body_names.len(), n)),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -289,24 +300,87 @@ impl CpuBackend {
         self.t = t;
     }
 
-    /// One step: the plan's work in order (`StepPlan::cpu`: the stages,
-    /// some fused in one pass over the particles). The time advances only
-    /// when every stage succeeded.
+    /// One step: the plan's passes in order (`StepPlan::cpu_step`, some
+    /// fused in one pass over the particles), each by its twin
+    /// (`run_pass`). The time advances (`StepEnd`) only when every pass
+    /// before it succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
-        for i in 0..self.plan.cpu.len() {
-            match self.plan.cpu[i] {
-                CpuWork::ShapeEvalP2g => self.shape_eval_p2g()?,
-                CpuWork::StressForces => self.stress_forces()?,
-                CpuWork::Stage(stage) => self.run_stage(stage)?,
-            }
+        for i in 0..self.plan.cpu_step.len() {
+            self.run_pass(self.plan.cpu_step[i])?;
         }
-        self.t = if self.final_step {
-            self.model.t_end
-        } else {
-            self.t + self.dt
-        };
-        self.steps += 1;
         Ok(())
+    }
+
+    /// Runs the plan's CPU passes of `stage` one by one, unfused
+    /// (`StepPlan::cpu_passes_for`): what the parity tests compare with the
+    /// GPU's passes of the same stage.
+    pub fn run_stage_passes(&mut self, stage: Stage) -> std::result::Result<(), Fault> {
+        for pass in self.plan.cpu_passes_for(stage) {
+            self.run_pass(pass)?;
+        }
+        Ok(())
+    }
+
+    /// Runs one pass of the plan by its CPU twin.
+    ///
+    /// # Panics
+    /// On a pass the CPU does not run (`step::OnCpu` other than `Twin`):
+    /// the plan never lists one (`tests/plan_coverage.rs`).
+    pub fn run_pass(&mut self, pass: Pass) -> std::result::Result<(), Fault> {
+        match Self::twin(pass) {
+            Some(twin) => twin(self),
+            None => panic!("{pass:?} has no CPU twin ({:?})", pass.info().cpu),
+        }
+    }
+
+    /// The CPU twin of `pass`, None for a pass the CPU does not run
+    /// (`Pass::info` says why). The GPU's variants of one pass (gather,
+    /// per bin) share its twin.
+    pub fn twin(pass: Pass) -> Option<Twin> {
+        Some(match pass {
+            Pass::Cfl => Self::cfl,
+            Pass::ClearGrid => Self::clear_grid,
+            Pass::ShapeEval => Self::shape_eval,
+            Pass::ShapeEvalP2g => Self::shape_eval_p2g,
+            Pass::P2g | Pass::P2gGather | Pass::P2gPatch => Self::p2g,
+            Pass::MlsP2g => Self::mls_p2g,
+            Pass::WallTouch => Self::wall_touch,
+            Pass::ContactGrad => Self::contact_grad,
+            Pass::ContactDetect => Self::contact_detect,
+            Pass::GridPredict => Self::grid_predict,
+            Pass::ConstraintPoints => Self::constraint_points,
+            Pass::ContactExchange => Self::contact_exchange,
+            Pass::MlsFitGauss => Self::mls_fit,
+            Pass::MlsStrain => Self::mls_strain,
+            Pass::CellAverage => Self::cell_average,
+            Pass::Stress => Self::stress,
+            Pass::StressForces | Pass::StressForcesPatch => Self::stress_forces,
+            Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => Self::forces,
+            Pass::MlsForces => Self::mls_forces,
+            Pass::WallContact => Self::wall_contact,
+            Pass::GridCorrect => Self::grid_correct,
+            Pass::ConstraintPointsForce => Self::constraint_points_force,
+            Pass::ContactExchangeForce => Self::contact_exchange_force,
+            Pass::G2p => Self::g2p,
+            Pass::ContactConserve => Self::contact_conserve,
+            Pass::RemapClear => Self::remap_clear,
+            Pass::Remap => Self::remap,
+            Pass::MlsRemap => Self::mls_remap,
+            Pass::StepEnd => Self::step_end,
+            Pass::StepBegin
+            | Pass::LmeNewton
+            | Pass::BinClear
+            | Pass::BinCount
+            | Pass::BinScan
+            | Pass::BinFill
+            | Pass::MlsFitParticles
+            | Pass::MlsForceGauss
+            | Pass::MlsGradGauss
+            | Pass::MlsGradParticles
+            | Pass::CellAverageClear
+            | Pass::Probes
+            | Pass::Energy => return None,
+        })
     }
 
     /// Factor of a_p in p2g's predicted momentum: (1 − γ)Δt for NPC, 0 for FE and MUSL.
@@ -319,7 +393,53 @@ impl CpuBackend {
         }
     }
 
-    /// Stages `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
+    /// γ of the corrector: NPC's, 1 for FE and MUSL.
+    fn gamma(&self) -> f64 {
+        match self.model.integrator {
+            Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => 1.0,
+            Integrator::Npc { gamma, .. } => gamma,
+        }
+    }
+
+    /// The forces' loads' time: at the step's end where the stress already
+    /// is (update stress first), at its start for MUSL (σ^t, b^t: eq. 24).
+    fn t_load(&self) -> f64 {
+        if self.model.integrator == Integrator::Musl {
+            self.t
+        } else {
+            self.t + self.dt
+        }
+    }
+
+    fn cfl(&mut self) -> std::result::Result<(), Fault> {
+        (self.dt, self.final_step) = cfl::time_step(&self.model, self.t);
+        Ok(())
+    }
+
+    fn clear_grid(&mut self) -> std::result::Result<(), Fault> {
+        clear_grid::clear_grid(&mut self.mv, &mut self.force);
+        Ok(())
+    }
+
+    /// N, ∇N into the shape cache, then with contact pairs each particle's
+    /// nodes moved into its body's field.
+    fn shape_eval(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        // Passes run one by one store the weights even where a whole
+        // step evaluates them on the spot (allocated here, once; then
+        // every shape evaluation fills the cache).
+        if !self.cache.is_stored(p.len()) {
+            self.cache = ShapeCache::new(p.len(), m.shape.max_nodes());
+        }
+        shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
+        if let Some(c) = &m.contact {
+            contact_grad::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
+        }
+        Ok(())
+    }
+
+    /// Passes `shape_eval` and `p2g` fused (`shape_eval::shape_eval_p2g`).
     fn shape_eval_p2g(&mut self) -> std::result::Result<(), Fault> {
         let a_factor = self.p2g_accel();
         let m = &mut self.model;
@@ -339,25 +459,198 @@ impl CpuBackend {
         )
     }
 
-    /// The predictor's nodal rule, after P2G and after MUSL's remap: the
-    /// constraints at `t_end` on the nodes, then at their points, then the
-    /// contact pairs' exchange (with the contacts `detect` found).
-    fn predict_nodes(
-        mv: &mut [[f64; 3]],
-        m: &Model,
-        contact: Option<&contact::ContactState>,
-        t_end: f64,
-        mass_eps: f64,
-    ) {
-        let c = &m.constraints;
-        grid_update::predict(mv, &c.fix, &c.groups, t_end, mass_eps);
-        constraint_points::hold(mv, &c.fix, &c.points, &c.groups, t_end, mass_eps, None);
-        if let (Some(pairs), Some(st)) = (&m.contact, contact) {
-            contact::exchange(pairs, st, mv, &c.fix, mass_eps, None);
+    fn p2g(&mut self) -> std::result::Result<(), Fault> {
+        let a_factor = self.p2g_accel();
+        let m = &self.model;
+        let p = &m.particles;
+        p2g::p2g(
+            Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+            &p.x,
+            &p.mass,
+            &p.v,
+            &p.a,
+            a_factor,
+            &mut self.mv,
+            &mut self.p2g_scatter,
+        )
+    }
+
+    fn mls_p2g(&mut self) -> std::result::Result<(), Fault> {
+        let a_factor = self.p2g_accel();
+        let (m, p) = (&self.model, &self.model.particles);
+        match self.mls.as_mut() {
+            Some(mls) => mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv),
+            None => Ok(()),
         }
     }
 
-    /// Stages `stress` and `forces` fused (`stress::stress_forces`).
+    fn wall_touch(&mut self) -> std::result::Result<(), Fault> {
+        let m = &self.model;
+        wall_touch::wall_touch(
+            &self.cache,
+            &contact_particles(
+                &m.particles,
+                m.gravity.as_ref(),
+                line_shape(&m.shape, &m.grid),
+            ),
+            &m.walls,
+            self.t,
+            &mut self.wall_touch,
+            &mut self.wall_pre_force,
+        );
+        Ok(())
+    }
+
+    fn contact_grad(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
+            contact_grad::grad(&self.cache, &p.mass, &p.rho, &p.body, c, st);
+        }
+        Ok(())
+    }
+
+    fn contact_detect(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
+            contact_detect::detect(
+                &self.cache,
+                &p.x,
+                &p.mass,
+                &p.rho,
+                &p.body,
+                c,
+                &self.mv,
+                m.grid.n_nodes(),
+                self.mass_eps,
+                st,
+            );
+        }
+        Ok(())
+    }
+
+    /// The predictor's nodal rule, after P2G and after MUSL's remap:
+    /// moving regions where their velocity has taken them by the step's
+    /// end (the time their velocity is taken at), then the nodes'
+    /// velocities and Dirichlet conditions.
+    fn grid_predict(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let g = &m.grid;
+        m.constraints.move_to(self.t + self.dt, g.h, g.nx, g.ny);
+        let c = &m.constraints;
+        grid_update::predict(
+            &mut self.mv,
+            &c.fix,
+            &c.groups,
+            self.t + self.dt,
+            self.mass_eps,
+        );
+        Ok(())
+    }
+
+    fn constraint_points(&mut self) -> std::result::Result<(), Fault> {
+        let c = &self.model.constraints;
+        constraint_points::hold(
+            &mut self.mv,
+            &c.fix,
+            &c.points,
+            &c.groups,
+            self.t + self.dt,
+            self.mass_eps,
+            None,
+        );
+        Ok(())
+    }
+
+    /// The contact pairs' exchange on the velocities, with the contacts
+    /// `contact_detect` found (after MUSL's remap, those of the step's start).
+    fn contact_exchange(&mut self) -> std::result::Result<(), Fault> {
+        let m = &self.model;
+        if let (Some(pairs), Some(st)) = (&m.contact, &self.contact) {
+            contact_exchange::exchange(
+                pairs,
+                st,
+                &mut self.mv,
+                &m.constraints.fix,
+                self.mass_eps,
+                None,
+            );
+        }
+        Ok(())
+    }
+
+    /// `solver.mls_scope = "force"`: σ fitted at the Gauss points and
+    /// particles (`Mls::fit_stress`).
+    fn mls_fit(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let Some(mls) = self.mls.as_mut() {
+            mls.fit_stress(&m.grid, &p.x, &p.stress);
+        }
+        Ok(())
+    }
+
+    /// `solver.mls_scope = "force"`: each particle's strain-rate correction
+    /// (`Mls::strain_correction`), which `stress` adds to L_p.
+    fn mls_strain(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let Some(mls) = self.mls.as_mut() {
+            mls.strain_correction(
+                &m.grid,
+                &self.cache,
+                &self.mv,
+                &p.mass,
+                &p.rho,
+                &mut self.mls_dl,
+            );
+        }
+        Ok(())
+    }
+
+    /// `solver.volumetric_strain = "cell_average"`: the cells' mean
+    /// volumetric strain rate, which `stress` puts in place of each
+    /// particle's own.
+    fn cell_average(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let Some(ca) = &mut self.cell_average {
+            ca.update(
+                &m.grid,
+                &self.cache,
+                &self.mv,
+                &p.x,
+                &p.mass,
+                &p.rho,
+                &p.body,
+            );
+        }
+        Ok(())
+    }
+
+    /// The stress, L_p corrected by the cell average or by MLS's strain
+    /// correction where the scene has one (stress.wgsl built with
+    /// CELL_AVERAGE or MLS_FORCE).
+    fn stress(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        let dl = match &self.cell_average {
+            Some(ca) => &ca.dl,
+            None => &self.mls_dl,
+        };
+        stress::stress(
+            Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+            &p.x,
+            &self.mv,
+            self.dt,
+            &p.body,
+            &m.materials,
+            &m.body_material,
+            &mut p.stress,
+            &mut p.rho,
+            &mut p.f,
+            &mut p.plastic,
+            dl,
+        )
+    }
+
+    /// Passes `stress` and `forces` fused (`stress::stress_forces`).
     fn stress_forces(&mut self) -> std::result::Result<(), Fault> {
         let m = &mut self.model;
         let p = &mut m.particles;
@@ -389,280 +682,229 @@ impl CpuBackend {
         )
     }
 
-    /// Runs one stage of the step (public so tests can compare stages one by one).
-    pub fn run_stage(&mut self, stage: Stage) -> std::result::Result<(), Fault> {
-        let a_factor = self.p2g_accel();
+    /// The internal and external forces at the particles; with
+    /// `solver.mls_scope = "force"` corrected by the fit (`mls_fit`) and
+    /// with the Gauss points' share (forces.wgsl built with MLS_FORCE,
+    /// then mls_force_gauss.wgsl).
+    fn forces(&mut self) -> std::result::Result<(), Fault> {
+        let t_load = self.t_load();
+        let m = &self.model;
+        let p = &m.particles;
+        let body = body_force(
+            m.gravity,
+            &m.manufactured,
+            &m.external,
+            &p.x0,
+            &p.mass,
+            t_load,
+        );
+        match self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
+            Some(mls) => mls.corrected_forces(
+                &self.cache,
+                &p.stress,
+                &p.mass,
+                &p.rho,
+                &body,
+                &mut self.force,
+                &mut self.force_scatter,
+            ),
+            None => forces::forces(
+                Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+                &p.x,
+                &p.stress,
+                &p.mass,
+                &p.rho,
+                &body,
+                &mut self.force,
+                &mut self.force_scatter,
+            )?,
+        }
+        Ok(())
+    }
+
+    fn mls_forces(&mut self) -> std::result::Result<(), Fault> {
+        let t_load = self.t_load();
+        let m = &self.model;
+        let p = &m.particles;
+        let body = body_force(
+            m.gravity,
+            &m.manufactured,
+            &m.external,
+            &p.x0,
+            &p.mass,
+            t_load,
+        );
+        if let Some(mls) = self.mls.as_mut() {
+            mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+        }
+        Ok(())
+    }
+
+    fn wall_contact(&mut self) -> std::result::Result<(), Fault> {
+        let gamma = self.gamma();
+        let (dt, t, mass_eps) = (self.dt, self.t, self.mass_eps);
+        let (groups, walls) = (
+            self.model.constraints.groups.len(),
+            self.model.walls.list.len(),
+        );
+        let wall_r = &mut self.reactions[groups..groups + walls];
+        let m = &self.model;
+        wall_contact::wall_contact(
+            &self.cache,
+            &contact_particles(
+                &m.particles,
+                m.gravity.as_ref(),
+                line_shape(&m.shape, &m.grid),
+            ),
+            &self.mv,
+            &self.force,
+            &m.walls,
+            t,
+            &self.wall_touch,
+            &self.wall_pre_force,
+            &mut self.wall_force,
+            wall_r,
+            gamma * dt,
+            (2.0 - gamma) * dt,
+            mass_eps,
+        );
+        Ok(())
+    }
+
+    fn grid_correct(&mut self) -> std::result::Result<(), Fault> {
+        let gamma_dt = self.gamma() * self.dt;
+        let groups = self.model.constraints.groups.len();
+        let group_r = &mut self.reactions[..groups];
+        let m = &self.model;
+        grid_update::correct(
+            &mut self.mv,
+            &mut self.force,
+            &m.constraints.fix,
+            &m.constraints.groups,
+            &self.wall_force,
+            group_r,
+            gamma_dt,
+            m.local_damping,
+            self.mass_eps,
+        );
+        Ok(())
+    }
+
+    /// The constraint points' projection as forces, into the groups'
+    /// reactions.
+    fn constraint_points_force(&mut self) -> std::result::Result<(), Fault> {
+        let gamma_dt = self.gamma() * self.dt;
+        let groups = self.model.constraints.groups.len();
+        let group_r = &mut self.reactions[..groups];
+        let c = &self.model.constraints;
+        constraint_points::hold(
+            &mut self.mv,
+            &c.fix,
+            &c.points,
+            &c.groups,
+            self.t + self.dt,
+            self.mass_eps,
+            Some(constraint_points::AsForce {
+                force: &mut self.force,
+                reactions: group_r,
+                gamma_dt,
+            }),
+        );
+        Ok(())
+    }
+
+    /// The contact pairs' exchange as forces, into the pairs' reactions.
+    fn contact_exchange_force(&mut self) -> std::result::Result<(), Fault> {
+        let gamma_dt = self.gamma() * self.dt;
+        let m = &self.model;
+        let fixed = m.constraints.groups.len() + m.walls.list.len();
+        if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
+            contact_exchange::exchange(
+                c,
+                st,
+                &mut self.mv,
+                &m.constraints.fix,
+                self.mass_eps,
+                Some(contact_exchange::AsForce {
+                    force: &mut self.force,
+                    gamma_dt,
+                    reactions: &mut self.reactions[fixed..],
+                }),
+            );
+        }
+        Ok(())
+    }
+
+    fn g2p(&mut self) -> std::result::Result<(), Fault> {
         let m = &mut self.model;
         let p = &mut m.particles;
-        let gamma = match m.integrator {
-            Integrator::Fe | Integrator::Musl | Integrator::Implicit(_) => 1.0,
-            Integrator::Npc { gamma, .. } => gamma,
+        let prm = g2p::G2pParams {
+            dt: self.dt,
+            integrator: m.integrator,
+            mass_eps: self.mass_eps,
+            edge_margin: m.shape.edge_margin(m.grid.h),
+            pic_fraction: m.pic_fraction,
         };
-        // The forces' loads: at the step's end where the stress already is
-        // (update stress first), at its start for MUSL (σ^t, b^t: eq. 24).
-        let t_load = if m.integrator == Integrator::Musl {
-            self.t
+        g2p::g2p(
+            Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+            &self.mv,
+            &self.force,
+            &m.grid,
+            prm,
+            self.contact
+                .as_mut()
+                .map(|c| (&c.touched[..], &p.mass[..], &mut c.pic_dp[..])),
+            &mut p.x,
+            &mut p.v,
+            &mut p.a,
+        )
+    }
+
+    /// Contact pairs, after `g2p`: each field's momentum as it was before
+    /// the interface's PIC share (`contact_conserve::conserve`).
+    fn contact_conserve(&mut self) -> std::result::Result<(), Fault> {
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
+            contact_conserve::conserve(c, st, &p.mass, &p.body, &mut p.v);
+        }
+        Ok(())
+    }
+
+    /// MUSL's remap, first: the nodal momentum zeroed, the masses kept.
+    fn remap_clear(&mut self) -> std::result::Result<(), Fault> {
+        remap::clear_momentum(&mut self.mv);
+        Ok(())
+    }
+
+    fn remap(&mut self) -> std::result::Result<(), Fault> {
+        let p = &self.model.particles;
+        remap::remap(
+            &self.cache,
+            &p.mass,
+            &p.v,
+            &mut self.mv,
+            &mut self.p2g_scatter,
+        );
+        Ok(())
+    }
+
+    fn mls_remap(&mut self) -> std::result::Result<(), Fault> {
+        let (m, p) = (&self.model, &self.model.particles);
+        if let Some(mls) = self.mls.as_mut() {
+            mls.remap(&m.grid, &p.rho, &p.v, &mut self.mv);
+        }
+        Ok(())
+    }
+
+    /// The step's time committed (on t_end for the last step) and counted.
+    fn step_end(&mut self) -> std::result::Result<(), Fault> {
+        self.t = if self.final_step {
+            self.model.t_end
         } else {
             self.t + self.dt
         };
-        match stage {
-            Stage::Cfl => (self.dt, self.final_step) = cfl::time_step(m, self.t),
-            Stage::ClearGrid => clear_grid::clear_grid(&mut self.mv, &mut self.force),
-            Stage::ShapeEval => {
-                // Stages run one by one store the weights even where a
-                // whole step evaluates them on the spot (allocated here,
-                // once; then every shape evaluation fills the cache).
-                if !self.cache.is_stored(p.len()) {
-                    self.cache = ShapeCache::new(p.len(), m.shape.max_nodes());
-                }
-                shape_eval::shape_eval(&m.shape, &m.grid, &p.x, &mut p.lambda, &mut self.cache)?;
-                if let Some(c) = &m.contact {
-                    contact::offset_nodes(&mut self.cache, &p.body, c, m.grid.n_nodes());
-                }
-            }
-            Stage::P2g => {
-                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
-                    return mls.p2g(&m.grid, &p.x, &p.rho, &p.v, &p.a, a_factor, &mut self.mv);
-                }
-                p2g::p2g(
-                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
-                    &p.x,
-                    &p.mass,
-                    &p.v,
-                    &p.a,
-                    a_factor,
-                    &mut self.mv,
-                    &mut self.p2g_scatter,
-                )?;
-            }
-            Stage::GridPredict => {
-                // Moving regions go where their velocity has taken them by
-                // the step's end, the time their velocity is taken at.
-                let g = &m.grid;
-                m.constraints.move_to(self.t + self.dt, g.h, g.nx, g.ny);
-                if !m.walls.is_empty() {
-                    grid_update::wall_touch(
-                        &self.cache,
-                        &contact_particles(p, m.gravity.as_ref(), line_shape(&m.shape, &m.grid)),
-                        &m.walls,
-                        self.t,
-                        &mut self.wall_touch,
-                        &mut self.wall_pre_force,
-                    );
-                }
-                if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
-                    contact::detect(
-                        &self.cache,
-                        &p.x,
-                        &p.mass,
-                        &p.rho,
-                        &p.body,
-                        c,
-                        &self.mv,
-                        m.grid.n_nodes(),
-                        self.mass_eps,
-                        st,
-                    );
-                }
-                Self::predict_nodes(
-                    &mut self.mv,
-                    m,
-                    self.contact.as_ref(),
-                    self.t + self.dt,
-                    self.mass_eps,
-                );
-            }
-            Stage::Stress => {
-                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls_force) {
-                    // MUSL's forces fitted at this step's start, where the
-                    // shape cache still is; update-stress-first fits here.
-                    if m.integrator != Integrator::Musl {
-                        mls.fit_stress(&m.grid, &p.x, &p.stress);
-                    }
-                    mls.strain_correction(
-                        &m.grid,
-                        &self.cache,
-                        &self.mv,
-                        &p.mass,
-                        &p.rho,
-                        &mut self.mls_dl,
-                    );
-                }
-                let dl = if let Some(ca) = &mut self.cell_average {
-                    ca.update(
-                        &m.grid,
-                        &self.cache,
-                        &self.mv,
-                        &p.x,
-                        &p.mass,
-                        &p.rho,
-                        &p.body,
-                    );
-                    &ca.dl
-                } else {
-                    &self.mls_dl
-                };
-                stress::stress(
-                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
-                    &p.x,
-                    &self.mv,
-                    self.dt,
-                    &p.body,
-                    &m.materials,
-                    &m.body_material,
-                    &mut p.stress,
-                    &mut p.rho,
-                    &mut p.f,
-                    &mut p.plastic,
-                    dl,
-                )?
-            }
-            Stage::Forces => {
-                let body = body_force(
-                    m.gravity,
-                    &m.manufactured,
-                    &m.external,
-                    &p.x0,
-                    &p.mass,
-                    t_load,
-                );
-                if let Some(mls) = &mut self.mls {
-                    if self.plan.inputs.mls_force {
-                        mls.fit_stress(&m.grid, &p.x, &p.stress);
-                        mls.corrected_forces(
-                            &self.cache,
-                            &p.stress,
-                            &p.mass,
-                            &p.rho,
-                            &body,
-                            &mut self.force,
-                            &mut self.force_scatter,
-                        );
-                    } else {
-                        mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
-                    }
-                    return Ok(());
-                }
-                forces::forces(
-                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
-                    &p.x,
-                    &p.stress,
-                    &p.mass,
-                    &p.rho,
-                    &body,
-                    &mut self.force,
-                    &mut self.force_scatter,
-                )?;
-            }
-            Stage::GridCorrect => {
-                let (fixed, pairs) = self
-                    .reactions
-                    .split_at_mut(m.constraints.groups.len() + m.walls.list.len());
-                let (group_r, wall_r) = fixed.split_at_mut(m.constraints.groups.len());
-                if !m.walls.is_empty() {
-                    grid_update::wall_contact(
-                        &self.cache,
-                        &contact_particles(p, m.gravity.as_ref(), line_shape(&m.shape, &m.grid)),
-                        &self.mv,
-                        &self.force,
-                        &m.walls,
-                        self.t,
-                        &self.wall_touch,
-                        &self.wall_pre_force,
-                        &mut self.wall_force,
-                        wall_r,
-                        gamma * self.dt,
-                        (2.0 - gamma) * self.dt,
-                        self.mass_eps,
-                    );
-                }
-                grid_update::correct(
-                    &mut self.mv,
-                    &mut self.force,
-                    &m.constraints.fix,
-                    &m.constraints.groups,
-                    &self.wall_force,
-                    group_r,
-                    gamma * self.dt,
-                    m.local_damping,
-                    self.mass_eps,
-                );
-                constraint_points::hold(
-                    &mut self.mv,
-                    &m.constraints.fix,
-                    &m.constraints.points,
-                    &m.constraints.groups,
-                    self.t + self.dt,
-                    self.mass_eps,
-                    Some(constraint_points::AsForce {
-                        force: &mut self.force,
-                        reactions: group_r,
-                        gamma_dt: gamma * self.dt,
-                    }),
-                );
-                if let (Some(c), Some(st)) = (&m.contact, &self.contact) {
-                    contact::exchange(
-                        c,
-                        st,
-                        &mut self.mv,
-                        &m.constraints.fix,
-                        self.mass_eps,
-                        Some(contact::AsForce {
-                            force: &mut self.force,
-                            gamma_dt: gamma * self.dt,
-                            reactions: pairs,
-                        }),
-                    );
-                }
-            }
-            Stage::G2p => {
-                let prm = g2p::G2pParams {
-                    dt: self.dt,
-                    integrator: m.integrator,
-                    mass_eps: self.mass_eps,
-                    edge_margin: m.shape.edge_margin(m.grid.h),
-                    pic_fraction: m.pic_fraction,
-                };
-                g2p::g2p(
-                    Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
-                    &self.mv,
-                    &self.force,
-                    &m.grid,
-                    prm,
-                    self.contact
-                        .as_mut()
-                        .map(|c| (&c.touched[..], &p.mass[..], &mut c.pic_dp[..])),
-                    &mut p.x,
-                    &mut p.v,
-                    &mut p.a,
-                )?;
-                if let (Some(c), Some(st)) = (&m.contact, &mut self.contact) {
-                    contact::conserve(c, st, &p.mass, &p.body, &mut p.v);
-                }
-            }
-            Stage::Remap => {
-                if let Some(mls) = self.mls.as_mut().filter(|_| self.plan.inputs.mls) {
-                    mls.remap(&m.grid, &p.rho, &p.v, &mut self.mv);
-                } else {
-                    remap::remap(
-                        &self.cache,
-                        &p.mass,
-                        &p.v,
-                        &mut self.mv,
-                        &mut self.p2g_scatter,
-                    );
-                }
-                // The contacts stay those of the step's start
-                // (`GridPredict`).
-                Self::predict_nodes(
-                    &mut self.mv,
-                    m,
-                    self.contact.as_ref(),
-                    self.t + self.dt,
-                    self.mass_eps,
-                );
-            }
-        }
+        self.steps += 1;
         Ok(())
     }
 }

@@ -8,8 +8,9 @@
 
 use super::{scatter::Scatter, stage_inputs::ShapeCache};
 
-/// Zeroes the nodal momentum of `mv`, keeping the masses (the first step
-/// of the remap on both paths; GPU twin: `remap.wgsl` built with `CLEAR`).
+/// Zeroes the nodal momentum of `mv`, keeping the masses (pass
+/// `RemapClear`, before `remap` or `Mls::remap` adds to it; GPU twin:
+/// `remap.wgsl` built with `CLEAR`).
 pub fn clear_momentum(mv: &mut [[f64; 3]]) {
     for n in mv.iter_mut() {
         n[1] = 0.0;
@@ -17,6 +18,8 @@ pub fn clear_momentum(mv: &mut [[f64; 3]]) {
     }
 }
 
+/// Adds Σ_p N_I(x_p^t) m_p v_p to the nodal momentum (zeroed by
+/// `clear_momentum`).
 pub fn remap(
     cache: &ShapeCache,
     mass: &[f64],
@@ -24,7 +27,6 @@ pub fn remap(
     mv: &mut [[f64; 3]],
     scatter: &mut Scatter<3>,
 ) {
-    clear_momentum(mv);
     scatter.run(mv, mass.len(), |p, acc| {
         let (nodes, w) = cache.particle(p);
         for (&node, wk) in nodes.iter().zip(w) {

@@ -101,7 +101,7 @@ pub enum Buf {
     /// Contact pairs only: per field, [mass, Σ m_p Δv_p] (f32): the field's
     /// mass (uploaded) and the momentum the interface's PIC share changed
     /// in g2p (float atomics; zeroed by clear_grid), which
-    /// contact_conserve.wgsl gives back (`cpu::contact::conserve`).
+    /// contact_conserve.wgsl gives back (`cpu::contact_conserve::conserve`).
     ContactPic,
     /// Constraint points only: their tables (u32; `gpu::constraint_points`),
     /// the last of which, per grid node the groups that freed it, is read

@@ -126,9 +126,9 @@ impl GpuBackend {
         &self.pipelines.plan
     }
 
-    /// The passes of one stage (`StepPlan::passes_for` for this scene).
+    /// The GPU's passes of one stage (`StepPlan::gpu_passes_for` for this scene).
     pub fn stage_passes(&self, stage: crate::step::Stage) -> Vec<Pass> {
-        self.pipelines.plan.passes_for(stage)
+        self.pipelines.plan.gpu_passes_for(stage)
     }
 
     /// Runs one pass on its own (per-stage parity tests).
@@ -218,7 +218,7 @@ impl GpuBackend {
     /// Contact pairs' detection as last computed on the device: per pair
     /// and grid node (`pair · n_nodes + node`), the normal (zero where the
     /// pair is not in contact) and the gap (m; `None` where none was
-    /// measured), as the CPU's `contact::ContactState`. Empty without pairs.
+    /// measured), as the CPU's `contact_detect::ContactState`. Empty without pairs.
     pub fn read_contact(&self) -> Result<Vec<([f64; 2], Option<f64>)>> {
         if self.buffers.n_pairs == 0 {
             return Ok(Vec::new());

@@ -12,57 +12,9 @@ use crate::error::{Error, Result};
 use crate::model::shape::Shape;
 use crate::model::{Integrator, Model};
 use crate::scene::NpcPosition;
-use crate::step::{PlanInputs, StepPlan};
+use crate::step::{Domain, PlanInputs, StepPlan};
 
 pub use crate::step::Pass;
-
-/// What a pass's invocations run over.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Domain {
-    Particles,
-    /// Nodes (of every field, with contact pairs), and at least 2 per
-    /// reaction (clear_grid zeroes them).
-    Nodes,
-    One,
-    Probes,
-    /// Grid cells or integration cells, whichever are more (MLS).
-    Cells,
-    /// Contact pairs × grid nodes.
-    PairNodes,
-    /// Gauss points (MLS).
-    GaussPoints,
-    /// One workgroup of one invocation per field and component
-    /// (constraint_points.wgsl).
-    PointLanes,
-}
-
-/// What `pass`'s invocations run over.
-fn domain(pass: Pass) -> Domain {
-    match pass {
-        Pass::StepBegin | Pass::StepEnd | Pass::BinScan => Domain::One,
-        Pass::BinClear | Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch => {
-            Domain::Cells
-        }
-        Pass::MlsP2g
-        | Pass::MlsForces
-        | Pass::MlsRemap
-        | Pass::MlsFitGauss
-        | Pass::MlsForceGauss
-        | Pass::MlsGradGauss => Domain::GaussPoints,
-        Pass::ClearGrid
-        | Pass::GridPredict
-        | Pass::GridCorrect
-        | Pass::RemapClear
-        | Pass::CellAverageClear
-        | Pass::P2gGather
-        | Pass::ForcesGather => Domain::Nodes,
-        Pass::ContactExchange | Pass::ContactExchangeForce => Domain::Nodes,
-        Pass::ContactDetect => Domain::PairNodes,
-        Pass::ConstraintPoints | Pass::ConstraintPointsForce => Domain::PointLanes,
-        Pass::Probes => Domain::Probes,
-        _ => Domain::Particles,
-    }
-}
 
 /// Everything that selects a shader variant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -305,56 +257,21 @@ pub fn lme_side(model: &Model) -> u32 {
     }
 }
 
-/// Expands a pass's WGSL for `d`, adding the pass's own flags: WALK where
-/// the pass puts per-particle terms on nodes through shared/bins.wgsl's
-/// walks, GATHER or PATCH for which walk.
+/// Expands a pass's WGSL for `d`, adding the pass's own flags
+/// (`Pass::info`): WALK where the pass puts per-particle terms on nodes
+/// through shared/bins.wgsl's walks, GATHER or PATCH for which walk,
+/// CORRECT, FORCES, CLEAR, PARTICLES for a file's second pass.
 pub fn expand(pass: Pass, d: &Defines) -> Result<String> {
+    let Some(gpu) = pass.info().gpu else {
+        return Err(Error::Gpu(format!(
+            "{pass:?} has no WGSL: only the CPU runs it"
+        )));
+    };
     let mut d = d.clone();
-    d.flag(
-        "WALK",
-        matches!(
-            pass,
-            Pass::P2g
-                | Pass::P2gGather
-                | Pass::P2gPatch
-                | Pass::Forces
-                | Pass::ForcesGather
-                | Pass::ForcesPatch
-                | Pass::StressForces
-                | Pass::StressForcesPatch
-        ),
-    )
-    .flag(
-        "GATHER",
-        matches!(pass, Pass::P2gGather | Pass::ForcesGather),
-    )
-    .flag(
-        "CORRECT",
-        matches!(
-            pass,
-            Pass::GridCorrect | Pass::ContactExchangeForce | Pass::ConstraintPointsForce
-        ),
-    )
-    .flag(
-        "PATCH",
-        matches!(
-            pass,
-            Pass::P2gPatch | Pass::ForcesPatch | Pass::StressForcesPatch
-        ),
-    )
-    .flag(
-        "FORCES",
-        matches!(pass, Pass::StressForces | Pass::StressForcesPatch),
-    )
-    .flag(
-        "CLEAR",
-        matches!(pass, Pass::RemapClear | Pass::CellAverageClear),
-    )
-    .flag(
-        "PARTICLES",
-        matches!(pass, Pass::MlsFitParticles | Pass::MlsGradParticles),
-    );
-    preprocess::expand(pass.file(), &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
+    for flag in gpu.flags {
+        d.flag(flag, true);
+    }
+    preprocess::expand(gpu.file, &d).map_err(|e| Error::Gpu(format!("WGSL preprocessing: {e}")))
 }
 
 /// Parses and validates WGSL with naga (no GPU needed).
@@ -415,7 +332,6 @@ pub fn bindings(module: &naga::Module) -> Vec<Binding> {
 }
 
 struct Built {
-    pass: Pass,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     domain: Domain,
@@ -423,7 +339,8 @@ struct Built {
 
 /// Every pass the scene needs, ready to dispatch.
 pub struct Pipelines {
-    built: Vec<Built>,
+    /// Indexed by `pass as usize`: the passes of `plan.gpu_passes()`.
+    built: Vec<Option<Built>>,
     n_particles: u32,
     n_nodes_or_groups: u32,
     n_pair_nodes: u32,
@@ -446,14 +363,11 @@ impl Pipelines {
         let variant = Variant::of(model, ctx.atomics, opts);
         let plan = variant.plan();
         let d = variant.defines();
-        let mut built = Vec::new();
-        for pass in Pass::ALL
-            .into_iter()
-            .chain([Pass::StressForces, Pass::StressForcesPatch])
-        {
-            if !plan.gpu_uses(pass) {
-                continue;
-            }
+        let mut built: Vec<Option<Built>> = Pass::ALL.iter().map(|_| None).collect();
+        for pass in plan.gpu_passes() {
+            let Some(gpu) = pass.info().gpu else {
+                continue; // gpu_passes holds GPU passes only
+            };
             let src = expand(pass, &d)?;
             if let Some(dir) = std::env::var_os("LME_MPM_DUMP_WGSL") {
                 let _ = std::fs::create_dir_all(&dir);
@@ -462,13 +376,13 @@ impl Pipelines {
                     &src,
                 );
             }
-            let module = validate(&src, pass.file(), ctx.atomics)?;
+            let module = validate(&src, gpu.file, ctx.atomics)?;
             let binds = bindings(&module);
             let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let shader = ctx
                 .device
                 .create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(pass.file()),
+                    label: Some(gpu.file),
                     source: wgpu::ShaderSource::Wgsl(src.into()),
                 });
             let entries: Vec<wgpu::BindGroupLayoutEntry> = binds
@@ -493,13 +407,13 @@ impl Pipelines {
             let bgl = ctx
                 .device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some(pass.file()),
+                    label: Some(gpu.file),
                     entries: &entries,
                 });
             let layout = ctx
                 .device
                 .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(pass.file()),
+                    label: Some(gpu.file),
                     bind_group_layouts: &[Some(&bgl)],
                     immediate_size: 0,
                 });
@@ -528,11 +442,10 @@ impl Pipelines {
             if let Some(e) = pollster::block_on(scope.pop()) {
                 return Err(Error::Gpu(format!("building the {pass:?} pipeline: {e}")));
             }
-            built.push(Built {
-                pass,
+            built[pass as usize] = Some(Built {
                 pipeline,
                 bind_group,
-                domain: domain(pass),
+                domain: gpu.domain,
             });
         }
         Ok(Pipelines {
@@ -551,10 +464,14 @@ impl Pipelines {
         })
     }
 
-    /// Records one dispatch of `pass` (nothing if the scene does not use it).
+    /// Records one dispatch of `pass`, a pass of `plan.gpu_passes()`.
+    ///
+    /// # Panics
+    /// On a pass the scene's plan does not use: no pipeline was built for
+    /// it (`tests/plan_coverage.rs` holds every plan's passes built).
     pub fn dispatch(&self, cpass: &mut wgpu::ComputePass<'_>, pass: Pass) {
-        let Some(b) = self.built.iter().find(|b| b.pass == pass) else {
-            return;
+        let Some(b) = &self.built[pass as usize] else {
+            panic!("{pass:?} is not a pass of this scene's StepPlan: no pipeline was built");
         };
         let (x, y) = match b.domain {
             Domain::One => (1, 1),
@@ -595,8 +512,9 @@ mod tests {
     use super::*;
     use crate::scene::ShapeKind;
 
-    /// `StressForces` is outside `Pass::ALL` (which tests/gpu_shaders.rs
-    /// validates in every variant), so it is validated here.
+    /// `StressForces` and its per-bin variant validate in every shape,
+    /// integrator and material mix, walls and loads on and off (wider than
+    /// the variants of tests/gpu_shaders.rs that fuse them).
     #[test]
     fn fused_stress_forces_validates() {
         let npc = Integrator::Npc {

@@ -4,9 +4,9 @@
 //! node `i` of field `f` is entry `f · n_nodes + i` of every nodal array,
 //! so the stages that scatter and gather through the particles' node lists
 //! run unchanged once `shape_eval` has offset each particle's nodes into
-//! its field (`cpu::contact::offset_nodes`). Where two fields of a declared
+//! its field (`cpu::contact_grad::offset_nodes`). Where two fields of a declared
 //! pair both have mass and their particles' domains meet, the pair's law
-//! acts on their relative velocity (`cpu::contact`); where two fields that
+//! acts on their relative velocity (`cpu::contact_exchange`); where two fields that
 //! are not a declared pair meet, they move together (their centre of mass
 //! velocity), which is what one shared field does.
 

@@ -325,7 +325,7 @@ pub struct Model {
     pub local_damping: f64,
     /// `solver.volumetric_strain = "cell_average"`: each particle's
     /// volumetric strain rate is its cell's mean over its body
-    /// (`cpu::antilock`).
+    /// (`cpu::cell_average`).
     pub cell_average_volumetric: bool,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at

@@ -1,8 +1,8 @@
 //! The walls' preload fitted to the body's discrete reaction at rest
 //! (`Walls::pre_fit`), computed once when the model is built, for both
 //! backends. It evaluates the shapes, the forces and the preload's
-//! weights as the CPU stages do (`cpu::forces`, `cpu::grid_update::
-//! wall_touch`), here at the model layer, below both backends.
+//! weights as the CPU stages do (`cpu::forces`,
+//! `cpu::wall_touch`), here at the model layer, below both backends.
 //!
 //! A body that starts in equilibrium against its walls (a geostatic
 //! start) is in equilibrium on the grid only if the walls give each node
@@ -89,7 +89,7 @@ pub fn preload_fit(
             f[1] += fi[1];
         }
         // The preloads at the start and their nodal force, as
-        // `cpu::grid_update::wall_touch` puts them (B-splines: their basis
+        // `cpu::wall_touch` puts them (B-splines: their basis
         // at the line's point; else N − d n·∇N).
         let lp = half_width(p.mass[i], p.rho[i]);
         for (k, wl) in walls.list.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! nodes are the grid nodes behind its line, (x_node − point)·n ≤ 0, tested
 //! on the unperturbed lattice (as constraints are), so a perturbed grid has
 //! the same wall nodes as the regular one. Both backends apply the
-//! contact (`cpu::grid_update::wall_touch` / `wall_contact` and their WGSL
+//! contact (`cpu::wall_touch` / `cpu::wall_contact` and their WGSL
 //! twins) from this list, with each wall's penalty stiffness and offset
 //! and the particles' preloads (`Walls::set_contact`).
 
@@ -30,7 +30,7 @@ pub const WALL_PENALTY: f64 = 0.025;
 
 /// Normal damping of the contact, as the fraction of the body's normal
 /// velocity at a contact point that one step's damping force would stop
-/// (F_d = −WALL_DAMPING v_n / w; `cpu::grid_update::wall_contact`). Without
+/// (F_d = −WALL_DAMPING v_n / w; `cpu::wall_contact`). Without
 /// it the elastic block rings on the penalty spring, and at each release
 /// gravity pulls it down the slope; 0.1 and more slows the rolling disk
 /// (the force grows where the rim approaches the wall, ahead of the
