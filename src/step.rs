@@ -775,8 +775,8 @@ mod tests {
 
     /// Contact pairs add their passes where the CPU does its work (detect
     /// before `predict`, the exchange after it, after `correct` and after
-    /// MUSL's remap) and the binning in `shape_eval`; without pairs the
-    /// step is the same, pass for pass.
+    /// MUSL's remap, the momentum given back after `g2p`) and the binning
+    /// in `shape_eval`; without pairs the step is the same, pass for pass.
     #[test]
     fn contact_pairs_add_their_passes_only_with_pairs() {
         let contact_passes = [
@@ -784,6 +784,7 @@ mod tests {
             Pass::ContactDetect,
             Pass::ContactExchange,
             Pass::ContactExchangeForce,
+            Pass::ContactConserve,
         ];
         for musl in [false, true] {
             for walls in [false, true] {
@@ -815,6 +816,7 @@ mod tests {
                 assert!(at(Pass::GridPredict) < at(Pass::ContactExchange));
                 assert!(at(Pass::GridCorrect) < at(Pass::ContactExchangeForce));
                 assert!(at(Pass::ContactExchangeForce) < at(Pass::G2p));
+                assert_eq!(at(Pass::G2p) + 1, at(Pass::ContactConserve));
                 if musl {
                     let remap = with.gpu_passes_for(Stage::Remap);
                     assert_eq!(remap.last(), Some(&Pass::ContactExchange));

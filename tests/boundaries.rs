@@ -474,8 +474,8 @@ fn rolled_disk(
     };
     let sets = [
         format!("grid.h={h}"),
+        // The case's lme_gamma = 2.8 stays for LME (dropped for the others).
         format!("solver.shape={shape}"),
-        "solver.lme_gamma=2.8".to_string(),
     ];
     let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
     let scene = scene_of(&text, &sets);

@@ -212,7 +212,6 @@ fn jacobian_is_the_derivative_of_the_residual_with_friction_contact() {
                 &[
                     "solver.integrator=implicit",
                     &format!("solver.shape={shape}"),
-                    "solver.lme_gamma=2.8",
                     &format!("solver.implicit_mass={mass}"),
                     "grid.h=0.1",
                 ],
@@ -280,7 +279,6 @@ fn short_implicit_rolling_disk_follows_the_exact_motion() {
     for (shape, h, bound) in SHORT_DISK {
         let r = implicit_disk(&[
             &format!("solver.shape={shape}"),
-            "solver.lme_gamma=2.8",
             &format!("grid.h={h}"),
             "solver.dt=2e-3",
             "solver.t_end=0.1",
@@ -324,11 +322,7 @@ fn implicit_rolling_disk_table() {
     println!("|---|---|---|---|---|---|---|");
     for shape in ["linear", "ugimp", "lme", "bspline2"] {
         for dt in dts {
-            let r = implicit_disk(&[
-                &format!("solver.shape={shape}"),
-                "solver.lme_gamma=2.8",
-                &format!("solver.dt={dt}"),
-            ]);
+            let r = implicit_disk(&[&format!("solver.shape={shape}"), &format!("solver.dt={dt}")]);
             let end = match &r.status {
                 RunStatus::Completed => String::new(),
                 other => format!(" ({other:?})"),

@@ -14,7 +14,9 @@ use crate::model::walls::{CONTACT_FRICTION, CONTACT_SLIP, CONTACT_STICK};
 use crate::scene::{Contact, Scene};
 
 /// Share of PIC in the velocity update of every particle that reaches a
-/// node where one of its body's pairs is in contact (g2p, both backends):
+/// node where one of its body's pairs with a tangential force (stick,
+/// friction) is in contact (g2p, both backends; the momentum it changes
+/// is given back to the body by `contact_conserve`):
 /// the blend `solver.pic_fraction` gives the whole scene, here at least
 /// 0.05 and only at the interface. Pure FLIP keeps the interface nodes'
 /// noise: two elastic bodies in contact ring there at about a kilohertz,

@@ -39,6 +39,7 @@ impl Scene {
             path: origin.to_string(),
             message: message.trim_end().to_string(),
         };
+        let mut dropped = Vec::new();
         let file: SceneFile = if overrides.is_empty() {
             // Straight from the text: messages carry line, column and a caret.
             toml::from_str(text).map_err(|e| parse_err(e.to_string()))?
@@ -49,12 +50,50 @@ impl Scene {
             for o in overrides {
                 o.apply(&mut table)?;
             }
+            dropped = drop_replaced_shape_keys(&mut table, overrides);
             // From the table: messages carry the full key path instead of a line.
             serde::Deserialize::deserialize(table)
                 .map_err(|e: toml::de::Error| parse_err(e.to_string()))?
         };
-        validate::check(file, default_name)
+        let mut scene = validate::check(file, default_name)?;
+        scene.chosen.extend(dropped);
+        Ok(scene)
     }
+}
+
+/// The scene file's keys of its own shape function that an override of
+/// `solver.shape` (or `solver.method`) has made meaningless, removed from
+/// `table`, one note per key: `--set solver.shape=linear` on an LME scene
+/// runs it with linear shapes, and its `lme_gamma` was written for the
+/// shape replaced. A key that an override sets itself stays (and is
+/// refused where it does not apply), so is a key the file's own shape
+/// does not read.
+fn drop_replaced_shape_keys(table: &mut toml::Table, overrides: &[Override]) -> Vec<String> {
+    let set = |key: &str| overrides.iter().any(|o| o.path == ["solver", key]);
+    if !(set("shape") || set("method") || set("gmm_basis")) {
+        return Vec::new();
+    }
+    let Some(toml::Value::Table(solver)) = table.get_mut("solver") else {
+        return Vec::new();
+    };
+    let text = |k: &str| solver.get(k).and_then(|v| v.as_str().map(str::to_string));
+    let shape = text("shape").unwrap_or_else(|| "lme".to_string());
+    let gmm = text("method").as_deref() == Some("gmm");
+    let lme = shape == "lme" || (gmm && text("gmm_basis").as_deref().unwrap_or("lme") == "lme");
+    let bspline = shape.starts_with("bspline");
+    let mut notes = Vec::new();
+    for (key, reads) in [
+        ("lme_gamma", lme),
+        ("lme_tol", lme),
+        ("bspline_knots", bspline),
+    ] {
+        if !reads && !set(key) && solver.remove(key).is_some() {
+            notes.push(format!(
+                "solver.{key} of the scene file dropped: the override of the shape function ({shape}) does not read it"
+            ));
+        }
+    }
+    notes
 }
 
 /// Reads at most `cap` bytes of `path` as UTF-8; a longer file (or an

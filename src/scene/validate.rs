@@ -1012,8 +1012,11 @@ fn check_keys_apply(file: &SceneFile) -> Result<(), SceneError> {
     const NPC: &str = "solver.integrator = \"npc\"";
     const MLS: &str = "solver.mls = true";
     const GMM: &str = "solver.method = \"gmm\" (with integrator = \"implicit\")";
+    // LME on the grid, or GMM's LME basis over its cloud.
+    let lme = s.shape == ShapeKind::Lme || (gmm && s.gmm_basis == GmmBasis::Lme);
+    const LME: &str = "solver.shape = \"lme\", or method = \"gmm\" with gmm_basis = \"lme\"";
     // (key, set, read under the scene's settings, what makes it read)
-    let keys: [(&str, bool, bool, &str); 17] = [
+    let keys: [(&str, bool, bool, &str); 19] = [
         (
             "gravity.ramp_period",
             file.gravity
@@ -1090,6 +1093,8 @@ fn check_keys_apply(file: &SceneFile) -> Result<(), SceneError> {
             implicit,
             IMPLICIT,
         ),
+        ("solver.lme_gamma", s.lme_gamma != d.lme_gamma, lme, LME),
+        ("solver.lme_tol", s.lme_tol != d.lme_tol, lme, LME),
         ("solver.gmm_basis", s.gmm_basis != d.gmm_basis, gmm, GMM),
         (
             "solver.gmm_search_radius",

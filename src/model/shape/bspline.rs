@@ -260,7 +260,7 @@ pub fn table_basis(
 /// Knot span s: t_s ≤ u < t_{s+1}, s in [p, n − 1].
 #[inline(always)]
 fn span(u: f64, n: usize, p: usize) -> usize {
-    super::floor_i64(u + 0.5 * (p as f64 + 1.0)).clamp(p as i64, n as i64 - 1) as usize
+    super::index::floor_i64(u + 0.5 * (p as f64 + 1.0)).clamp(p as i64, n as i64 - 1) as usize
 }
 
 /// Uniform knots: quadratic with f = u − first in [0.5, 1.5), cubic with

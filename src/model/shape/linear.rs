@@ -28,7 +28,7 @@ pub fn locate(grid: &Grid, x: [f64; 2]) -> Option<CellPoint> {
         return None;
     }
     let q = grid.logical(x);
-    let clamp = |v: f64, n: usize| (super::floor_i64(v).max(0) as usize).min(n - 2);
+    let clamp = |v: f64, n: usize| (super::index::floor_i64(v).max(0) as usize).min(n - 2);
     let (mut i, mut j) = (clamp(q[0], grid.nx), clamp(q[1], grid.ny));
     if !grid.is_perturbed() {
         let h = grid.h;

@@ -4,6 +4,7 @@
 
 pub mod bspline;
 mod fault;
+pub mod index;
 pub mod linear;
 pub mod lme;
 pub mod separable;
@@ -13,13 +14,6 @@ pub use fault::ShapeFault;
 
 use crate::model::Grid;
 use crate::scene::{BsplineKnots, ShapeKind, SolverSpec};
-
-/// `v.floor() as i64`, by truncation where `v` is not negative (a point
-/// inside the grid): `floor` is a library call in baseline x86-64 code.
-#[inline(always)]
-pub fn floor_i64(v: f64) -> i64 {
-    if v >= 0.0 { v as i64 } else { v.floor() as i64 }
-}
 
 /// A shape function, with its parameters resolved for one scene.
 #[derive(Debug, Clone, PartialEq)]

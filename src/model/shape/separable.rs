@@ -67,7 +67,7 @@ impl Shape {
     }
 }
 
-use super::floor_i64 as floor_nonneg;
+use super::index::floor_i64 as floor_nonneg;
 
 impl Separable {
     /// Writes the nodes and [N, ∂N/∂x, ∂N/∂y] at `x` as `Shape::eval` does
