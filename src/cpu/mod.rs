@@ -247,11 +247,14 @@ impl CpuBackend {
                         .sum::<usize>() as f64
         };
         // Contact pairs: one copy of the nodes per field, and per field node
-        // the mass gradient and volume (24), per pair node normal and gap (24).
+        // the mass gradient and volume (24) and the touched flag (1), per
+        // pair node normal and gap (24); per particle the interface blend's
+        // momentum (16, `contact_conserve`).
         let fields = model.n_fields() as f64;
         let pairs = model.contact.as_ref().map_or(0, |c| c.pairs.len()) as f64;
         let contact = if model.contact.is_some() {
-            model.grid.n_nodes() as f64 * (24.0 * fields + 24.0 * pairs)
+            per += 16.0;
+            model.grid.n_nodes() as f64 * (25.0 * fields + 24.0 * pairs)
         } else {
             0.0
         };

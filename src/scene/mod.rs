@@ -62,12 +62,12 @@ impl Scene {
 }
 
 /// The scene file's keys of its own shape function that an override of
-/// `solver.shape` (or `solver.method`) has made meaningless, removed from
+/// `solver.shape` (or `method`, `gmm_basis`) has made meaningless, removed from
 /// `table`, one note per key: `--set solver.shape=linear` on an LME scene
 /// runs it with linear shapes, and its `lme_gamma` was written for the
 /// shape replaced. A key that an override sets itself stays (and is
-/// refused where it does not apply), so is a key the file's own shape
-/// does not read.
+/// refused where it does not apply); without such an override the file's
+/// keys stay and `validate` refuses those its shape does not read.
 fn drop_replaced_shape_keys(table: &mut toml::Table, overrides: &[Override]) -> Vec<String> {
     let set = |key: &str| overrides.iter().any(|o| o.path == ["solver", key]);
     if !(set("shape") || set("method") || set("gmm_basis")) {
