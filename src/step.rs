@@ -281,6 +281,12 @@ passes! {
     ConstraintPoints => gpu("constraint_points.wgsl", PointLanes, &[]), Twin;
     ConstraintPointsForce => gpu("constraint_points.wgsl", PointLanes, &["CORRECT"]), Twin;
     G2p => gpu("g2p.wgsl", Particles, &[]), Twin;
+    /// CPU only, where nothing between a step's `g2p` and the next step's
+    /// `p2g` reads or writes the particles or the grid (`StepPlan::primes`):
+    /// `g2p`, then the next step's `cfl` reduction, `clear_grid` and `p2g`
+    /// at the new positions, in one loop over the particles
+    /// (`cpu::g2p_p2g`); the next step runs `StepPlan::cpu_primed`.
+    G2pP2g => None, Twin;
     /// MUSL's remap: zero the nodal momentum (remap.wgsl built with CLEAR),
     /// then scatter the new velocities from particles (`Remap`) or Gauss
     /// points (`MlsRemap`).
@@ -396,6 +402,10 @@ pub struct StepPlan {
     /// `StressForces` (per bin: `StressForcesPatch`) where both scatter (no
     /// MLS, not MUSL, not gathering), then `StepEnd` (commit the time).
     pub gpu_step: Vec<Pass>,
+    /// Where the plan `primes`: the CPU's step after one whose `G2pP2g`
+    /// already did this step's `Cfl`, `ClearGrid` and `P2g` (`cpu_step`
+    /// without them); empty otherwise.
+    pub cpu_primed: Vec<Pass>,
 }
 
 const BINS: [Pass; 4] = [Pass::BinClear, Pass::BinCount, Pass::BinScan, Pass::BinFill];
@@ -452,16 +462,42 @@ impl StepPlan {
             stages,
             cpu_step: Vec::new(),
             gpu_step: Vec::new(),
+            cpu_primed: Vec::new(),
         };
         let whole = |per_stage: &dyn Fn(Stage) -> Vec<Pass>| -> Vec<Pass> {
             stages.iter().flat_map(|&s| per_stage(s)).collect()
         };
         let mut cpu = fuse(whole(&|s| plan.cpu_passes_for(s)), &inputs, on_cpu);
         let mut gpu = fuse(whole(&|s| plan.gpu_passes_for(s)), &inputs, on_gpu);
+        if plan.primes() {
+            // The step from the particles ends with the next one's P2G;
+            // the steps after it start where that left the grid.
+            let last = cpu.last_mut().expect("a step has passes");
+            debug_assert_eq!(*last, Pass::G2p);
+            *last = Pass::G2pP2g;
+            let p2g = cpu
+                .iter()
+                .position(|&p| p == Pass::ShapeEvalP2g)
+                .expect("a plan that primes scatters in ShapeEvalP2g");
+            debug_assert_eq!(cpu[..p2g], [Pass::Cfl, Pass::ClearGrid]);
+            plan.cpu_primed = cpu[p2g + 1..].to_vec();
+            plan.cpu_primed.push(Pass::StepEnd);
+        }
         cpu.push(Pass::StepEnd);
         gpu.push(Pass::StepEnd);
         (plan.cpu_step, plan.gpu_step) = (cpu, gpu);
         plan
+    }
+
+    /// Whether the CPU's step ends with the next one's `Cfl`, `ClearGrid`
+    /// and `P2g` (`Pass::G2pP2g`): where nothing but those runs between a
+    /// step's `G2p` and the next `P2g`, and no shape cache is stored (the
+    /// next P2G needs the weights at the new positions, the cache holds
+    /// those of the old: `cpu::ShapeCache::needed`). Not with LME, MLS,
+    /// MUSL, walls, contact pairs or the cell average.
+    pub fn primes(&self) -> bool {
+        let i = &self.inputs;
+        !(i.lme || i.mls || i.mls_force || i.musl || i.walls || i.contact || i.cell_average)
     }
 
     /// The passes that do `stage` on its own on either backend, in order
@@ -504,6 +540,7 @@ impl StepPlan {
             stages: self.stages,
             cpu_step: Vec::new(),
             gpu_step: Vec::new(),
+            cpu_primed: Vec::new(),
         };
         let mut passes = scatter.passes_for(stage);
         passes.retain(|&p| on_cpu(p));
@@ -740,10 +777,13 @@ mod tests {
             }
             let p = plan(lme, mls, musl, gather, patch);
             // Each backend's step, unfused, is its stages' passes in turn.
+            // (`G2pP2g` is the step's `G2p`; its next step's share is
+            // what `cpu_primed` leaves out.)
             let unfused = |step: &[Pass]| -> Vec<Pass> {
                 step.iter()
                     .flat_map(|&q| match FUSED.iter().find(|f| f.fused == q) {
                         Some(f) => vec![f.first, f.then],
+                        None if q == Pass::G2pP2g => vec![Pass::G2p],
                         None => vec![q],
                     })
                     .collect()
@@ -765,6 +805,15 @@ mod tests {
             );
             assert_eq!(p.cpu_step[..2], [Pass::Cfl, Pass::ClearGrid]);
             assert_eq!(p.cpu_step[2] == Pass::ShapeEvalP2g, !mls, "{bits:05b}");
+            // Only the plans without a shape cache prime, and their primed
+            // step is the whole one less what the last step's `G2pP2g` did.
+            assert_eq!(p.primes(), !(lme || mls || musl), "{bits:05b}");
+            assert_eq!(p.cpu_step.contains(&Pass::G2pP2g), p.primes(), "{bits:05b}");
+            if p.primes() {
+                assert_eq!(p.cpu_primed, p.cpu_step[3..], "{bits:05b}");
+            } else {
+                assert!(p.cpu_primed.is_empty(), "{bits:05b}");
+            }
             assert_eq!(p.gpu_step.last(), Some(&Pass::StepEnd));
             assert_eq!(p.gpu_step[..2], [Pass::Cfl, Pass::StepBegin]);
             assert_eq!(p.gpu_uses(Pass::LmeNewton), lme, "{bits:05b}");

@@ -154,7 +154,7 @@ fn free_fall(position: &str, shape: &str) -> (f64, f64) {
     )
     .unwrap();
     assert_eq!(status, RunStatus::Completed);
-    let p = &b.model.particles;
+    let p = &b.model().particles;
     let worst = (0..p.len())
         .map(|i| {
             let dy = p.x[i][1] - p.x0[i][1];

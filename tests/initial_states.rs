@@ -457,7 +457,10 @@ fn pic_blend_is_the_stated_mix() {
                 m.particles.v[i] = [-(x[1] - 0.5), x[0] - 0.25];
             }
             let mut cpu = CpuBackend::new(m);
-            let start = (cpu.model.particles.v.clone(), cpu.model.particles.x.clone());
+            let start = (
+                cpu.model().particles.v.clone(),
+                cpu.model().particles.x.clone(),
+            );
             cpu.step().unwrap();
             (cpu, start)
         };
@@ -465,7 +468,7 @@ fn pic_blend_is_the_stated_mix() {
         let (pic, (v_start, x_start)) = step(1.0);
         let (mix, _) = step(0.25);
         // The step's weights: stored (MUSL) or evaluated at the start.
-        let m = &pic.model;
+        let m = pic.model();
         let weights = Weights::of(&pic.cache, v_start.len(), &m.shape, &m.grid);
         let mut slots = Slots::default();
         let mut worst: f64 = 0.0;
@@ -482,12 +485,12 @@ fn pic_blend_is_the_stated_mix() {
                     v_pic[1] += wk[0] * node[2];
                 }
             }
-            let vp = pic.model.particles.v[p];
+            let vp = pic.model().particles.v[p];
             if integrator != "musl" {
                 worst = worst.max((vp[0] - v_pic[0]).hypot(vp[1] - v_pic[1]));
             }
-            let vf = flip.model.particles.v[p];
-            let vm = mix.model.particles.v[p];
+            let vf = flip.model().particles.v[p];
+            let vm = mix.model().particles.v[p];
             let want = [0.75 * vf[0] + 0.25 * vp[0], 0.75 * vf[1] + 0.25 * vp[1]];
             worst = worst.max((vm[0] - want[0]).hypot(vm[1] - want[1]));
             differ = differ.max((vf[0] - vp[0]).hypot(vf[1] - vp[1]));

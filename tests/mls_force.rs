@@ -141,7 +141,7 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
             &stress,
             &mass,
             &rho,
-            &body,
+            &lme_mpm::cpu::stage_inputs::BodyForce::uniform([0.0, 0.0]),
             &mut plain,
             &mut Scatter::default(),
         )
@@ -375,7 +375,7 @@ fn free_energy(cells: usize, sets: &[&str], t_end: f64) -> (f64, f64, bool) {
     m.manufactured = None;
     let mut cpu = CpuBackend::new(m);
     let energy = |c: &CpuBackend| {
-        let e = lme_mpm::cpu::energy::energy(&c.model);
+        let e = lme_mpm::cpu::energy::energy(c.model());
         e.kinetic + e.strain
     };
     let e0 = energy(&cpu);

@@ -56,7 +56,7 @@ fn step_with(shape: &str, mls: bool, v: impl Fn([f64; 2]) -> [f64; 2]) -> CpuBac
     let sets = [format!("solver.shape={shape}"), format!("solver.mls={mls}")];
     let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
     let mut cpu = CpuBackend::new(model(FREE_SQUARE, &sets));
-    let p = &mut cpu.model.particles;
+    let p = &mut cpu.model_mut().particles;
     for i in 0..p.len() {
         p.v[i] = v(p.x[i]);
     }
@@ -74,7 +74,7 @@ fn uniform_velocity_passes_the_full_musl_step_exactly() {
     let vel = [2.0, -1.0];
     for shape in ["bspline2", "bspline3", "linear"] {
         let cpu = step_with(shape, true, |_| vel);
-        let p = &cpu.model.particles;
+        let p = &cpu.model().particles;
         let dt = cpu.dt();
         for i in 0..p.len() {
             for (k, vk) in vel.iter().enumerate() {
@@ -133,7 +133,7 @@ fn linear_velocity_is_exact_away_from_open_edges_with_or_without_mls() {
                 2.0 * mu * exy,
             ];
             let scale = s[0].abs().max(s[1].abs());
-            let p = &cpu.model.particles;
+            let p = &cpu.model().particles;
             let (mut inner, mut outer): (f64, f64) = (0.0, 0.0);
             for i in 0..p.len() {
                 let x = p.x0[i];
@@ -253,7 +253,7 @@ fn projection_at(shape: &str, mls: bool, cells: usize, t: f64, support: f64) -> 
     let mut cpu = CpuBackend::new(m);
     cpu.set_time(t);
     {
-        let p = &mut cpu.model.particles;
+        let p = &mut cpu.model_mut().particles;
         for i in 0..p.len() {
             let x0 = p.x0[i];
             let u = field.displacement(x0, t);
@@ -275,7 +275,7 @@ fn projection_at(shape: &str, mls: bool, cells: usize, t: f64, support: f64) -> 
     ] {
         cpu.run_stage_passes(s).unwrap();
     }
-    let g = &cpu.model.grid;
+    let g = &cpu.model().grid;
     let n = g.nx;
     let degree = if shape == "bspline3" { 3 } else { 2 };
     // The reference X of a current x along the x axis (Newton).
@@ -301,7 +301,7 @@ fn projection_at(shape: &str, mls: bool, cells: usize, t: f64, support: f64) -> 
         count += 1;
     }
     let mass: f64 = cpu.mv.iter().map(|m| m[0]).sum();
-    let mp: f64 = cpu.model.particles.mass.iter().sum();
+    let mp: f64 = cpu.model().particles.mass.iter().sum();
     (mass / mp - 1.0, (sum / count as f64).sqrt() / peak)
 }
 
@@ -394,7 +394,7 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
     let mass_eps = lme_mpm::cpu::grid_update::MASS_EPS_REL * m.particles.min_mass();
     let mut cpu = CpuBackend::new(m);
     let energy = |c: &CpuBackend| {
-        let e = lme_mpm::cpu::energy::energy(&c.model);
+        let e = lme_mpm::cpu::energy::energy(c.model());
         (e.kinetic, e.strain)
     };
     let (k0, w0) = energy(&cpu);
@@ -405,7 +405,7 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
         transfer: 0.0,
         mismatch: 0.0,
     };
-    let n = cpu.model.particles.len();
+    let n = cpu.model().particles.len();
     let (mut before, mut vi, mut fi) = ((0.0, 0.0), Vec::new(), Vec::new());
     let mut t = 0.0;
     while t < t_end - 1e-12 {
@@ -418,7 +418,7 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
                 }
                 Stage::G2p => {
                     before = energy(&cpu);
-                    let v0 = cpu.model.particles.v.clone();
+                    let v0 = cpu.model().particles.v.clone();
                     cpu.run_stage_passes(stage).unwrap();
                     let dt = cpu.dt();
                     if adjoint {
@@ -437,8 +437,8 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
                         mls.at_gauss_points(&dv, &mut at_g);
                         let at_g: Vec<[f64; 2]> = at_g.iter().map(|g| [g[0], g[1]]).collect();
                         let (mut sum, mut vhat) = (vec![[0.0; 2]; n], vec![0.0; n]);
-                        mls.transpose(&cpu.model.grid, &at_g, &mut sum, &mut vhat);
-                        let p = &mut cpu.model.particles;
+                        mls.transpose(&cpu.model().grid, &at_g, &mut sum, &mut vhat);
+                        let p = &mut cpu.model_mut().particles;
                         for i in 0..n {
                             let vol = p.volume(i);
                             p.v[i] = [v0[i][0] + sum[i][0] / vol, v0[i][1] + sum[i][1] / vol];
@@ -464,9 +464,9 @@ fn free_vibration(cells: usize, mls: bool, adjoint: bool, t_end: f64) -> FreeTra
                     let grad: Vec<[f64; 4]> =
                         at_g.iter().map(|g| [g[2], g[3], g[4], g[5]]).collect();
                     let (mut sum, mut vhat) = (vec![[0.0; 4]; n], vec![0.0; n]);
-                    mls.transpose(&cpu.model.grid, &grad, &mut sum, &mut vhat);
+                    mls.transpose(&cpu.model().grid, &grad, &mut sum, &mut vhat);
                     let dt = cpu.dt();
-                    let p = &mut cpu.model.particles;
+                    let p = &mut cpu.model_mut().particles;
                     for (i, s) in sum.iter().enumerate() {
                         let vol = p.volume(i);
                         let l = s.map(|x| x / vol);
@@ -568,15 +568,15 @@ fn the_fits_quadrature_volumes_are_not_the_particles_near_an_edge() {
             cpu.run_stage_passes(s).unwrap();
         }
         let mls = cpu.mls.as_ref().unwrap();
-        let n = cpu.model.particles.len();
+        let n = cpu.model().particles.len();
         let (mut none, mut vhat) = (vec![[0.0; 0]; n], vec![0.0; n]);
         mls.transpose(
-            &cpu.model.grid,
+            &cpu.model().grid,
             &vec![[0.0; 0]; mls.n_gauss_points()],
             &mut none,
             &mut vhat,
         );
-        let p = &cpu.model.particles;
+        let p = &cpu.model().particles;
         let h = 1.0 / cells as f64;
         // Over all particles, along the particle row nearest y = 1/2, and
         // over those more than 5 cells from every edge.

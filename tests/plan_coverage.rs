@@ -160,7 +160,8 @@ fn every_pass_of_every_plan_has_a_pipeline_and_a_cpu_twin() {
                     .unwrap_or_else(|e| panic!("{pass:?} {i:?}: {e}"));
             }
         }
-        let cpu_lists = std::iter::once(plan.cpu_step.clone())
+        let cpu_lists = [plan.cpu_step.clone(), plan.cpu_primed.clone()]
+            .into_iter()
             .chain(plan.stages.iter().map(|&s| plan.cpu_passes_for(s)));
         for pass in cpu_lists.flatten() {
             assert!(

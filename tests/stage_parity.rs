@@ -560,16 +560,16 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
     cpu.set_time(t);
     let mut gpu = GpuBackend::with_options(ctx, model, opts).unwrap();
     let mut rep = Report { family, worst: 0.0 };
-    for &stage in stages(cpu.model.integrator) {
+    for &stage in stages(cpu.model().integrator) {
         // The state every stage starts from is the CPU's. (MUSL's remap and
         // stress also read what this step's p2g left on the GPU: the
         // positions at the step's start and, with MLS, the fit.)
         gpu.upload_state(&cpu.state());
-        let before_p = cpu.model.particles.clone();
+        let before_p = cpu.model().particles.clone();
         let before_mv = cpu.mv.clone();
         // MUSL's remap and stress run after g2p at the step's start
         // positions: they read the LME cache made there, not a new one.
-        let musl_late = cpu.model.integrator == lme_mpm::model::Integrator::Musl
+        let musl_late = cpu.model().integrator == lme_mpm::model::Integrator::Musl
             && matches!(stage, Stage::Remap | Stage::Stress);
         let needs_shapes =
             !musl_late && !matches!(stage, Stage::Cfl | Stage::ClearGrid | Stage::ShapeEval);
@@ -618,8 +618,8 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
             ),
             Stage::ShapeEval if lme => {
                 let gp = gpu.particles().unwrap().clone();
-                let g = &cpu.model.grid;
-                let cp = &cpu.model.particles;
+                let g = &cpu.model().grid;
+                let cp = &cpu.model().particles;
                 let err = (0..cp.len())
                     .filter(|&i| g.contains(cp.x[i], 0.1 * g.h))
                     .map(|i| {
@@ -655,7 +655,7 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
                         CONTACT_NORMAL_TOL
                     };
                     let g = gpu.read_contact().unwrap();
-                    check_detect(&mut rep, st, &g, cpu.model.grid.h, normal_tol);
+                    check_detect(&mut rep, st, &g, cpu.model().grid.h, normal_tol);
                 }
                 rep.check(
                     "grid_update predict: vx",
@@ -670,7 +670,7 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
             }
             Stage::Stress => {
                 let gp = gpu.particles().unwrap().clone();
-                let cp = &cpu.model.particles;
+                let cp = &cpu.model().particles;
                 rep.check(
                     "stress: stress change",
                     rel_err(
@@ -747,7 +747,7 @@ fn parity_of(label: &str, model: Model, force_cas: bool, opts: GpuOptions, t: f6
             }
             Stage::G2p => {
                 let gp = gpu.particles().unwrap().clone();
-                let cp = &cpu.model.particles;
+                let cp = &cpu.model().particles;
                 rep.check(
                     "g2p: position change",
                     rel_err(&flat2(&gp.x), &flat2(&cp.x), Some(&flat2(&before_p.x))),

@@ -3,12 +3,12 @@
 //! GPU twin: `shaders/forces.wgsl`.
 
 use super::scatter::Scatter;
-use super::stage_inputs::{Slots, Weights};
+use super::stage_inputs::{BodyForce, ParticleWeights, Weights, with_weights};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::node_force;
 use rayon::prelude::*;
 
-/// `body(p)` is particle p's body force per unit mass at this step (m/s²):
+/// `body` gives particle p's body force per unit mass at this step (m/s²):
 /// gravity, plus a manufactured solution's source term when there is one.
 /// `x` is where `weights` are evaluated when not stored.
 #[allow(clippy::too_many_arguments)]
@@ -18,7 +18,23 @@ pub fn forces(
     stress: &[[f64; 3]],
     mass: &[f64],
     rho: &[f64],
-    body: &(dyn Fn(usize) -> [f64; 2] + Sync),
+    body: &BodyForce<'_>,
+    force: &mut [[f64; 2]],
+    scatter: &mut Scatter<2>,
+) -> Result<(), Fault> {
+    with_weights!(weights, |w| forces_with(
+        w, x, stress, mass, rho, body, force, scatter
+    ))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn forces_with<W: ParticleWeights>(
+    weights: &W,
+    x: &[[f64; 2]],
+    stress: &[[f64; 3]],
+    mass: &[f64],
+    rho: &[f64],
+    body: &BodyForce<'_>,
     force: &mut [[f64; 2]],
     scatter: &mut Scatter<2>,
 ) -> Result<(), Fault> {
@@ -29,14 +45,14 @@ pub fn forces(
         n,
         (0..n.div_ceil(len)).into_par_iter(),
         |first, _, acc| {
-            let mut slots = Slots::default();
+            let mut slots = W::Scratch::default();
             let mut fault = None;
             for p in first..(first + len).min(n) {
                 let vol = mass[p] / rho[p];
                 let s = stress[p];
-                let g = body(p);
+                let g = body.at(p);
                 let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
-                match weights.particle(p, x[p], &mut slots) {
+                match weights.get::<true>(p, x[p], &mut slots) {
                     Ok((nodes, w)) => add_particle_forces(nodes, w, vol, s, [bx, by], acc),
                     Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
@@ -51,7 +67,7 @@ pub fn forces(
 
 /// Adds a particle's −V_p σ_p ∇N + N m_p b to its nodes in `acc` (`mb` is
 /// m_p b). Shared with the fused `stress::stress_forces`.
-#[inline]
+#[inline(always)]
 pub fn add_particle_forces(
     nodes: &[u32],
     w: &[[f64; 3]],

@@ -13,7 +13,7 @@
 //! contact takes at least `CONTACT_PIC_FRACTION` of PIC.
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::stage_inputs::{Slots, Weights};
+use super::stage_inputs::{ParticleWeights, Weights, with_weights};
 use crate::model::contact::CONTACT_PIC_FRACTION;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
@@ -25,7 +25,6 @@ use rayon::prelude::*;
 pub struct G2pParams {
     pub dt: f64,
     pub integrator: Integrator,
-    pub mass_eps: f64,
     /// Distance (m) a particle must keep from the grid's edge.
     pub edge_margin: f64,
     /// Share α of PIC in the velocity update, in [0, 1]; 0 = FLIP.
@@ -40,47 +39,45 @@ pub struct G2pParams {
 /// is smaller.
 pub type Touched<'a> = Option<(&'a [bool], &'a [f64], &'a mut [[f64; 2]])>;
 
-/// `weights` not stored are evaluated at each particle's position before
-/// it moves (where this step's shape evaluation was).
-#[allow(clippy::too_many_arguments)]
-pub fn g2p(
-    weights: Weights<'_>,
-    mv: &[[f64; 3]],
-    force: &[[f64; 2]],
-    grid: &Grid,
-    prm: G2pParams,
-    touched: Touched,
-    x: &mut [[f64; 2]],
-    v: &mut [[f64; 2]],
-    a: &mut [[f64; 2]],
-) -> Result<(), Fault> {
-    let dt = prm.dt;
-    let (touched, mass, pic_dp): (_, &[f64], &mut [[f64; 2]]) = match touched {
-        Some((t, m, dp)) => (Some(t), m, dp),
-        None => (None, &[], &mut []),
-    };
-    let kernel = |slots: &mut Slots,
-                  p: usize,
-                  x: &mut [f64; 2],
-                  v: &mut [f64; 2],
-                  a: Option<&mut [f64; 2]>,
-                  dp: Option<&mut [f64; 2]>|
-     -> Option<Fault> {
-        let (nodes, w) = match weights.particle_values(p, *x, slots) {
-            Ok(nw) => nw,
-            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
-        };
-        // Σ N f/m and Σ N v_I over nodes with mass.
+/// One particle's update from its nodes and weights (`g2p`'s body, also
+/// run by `g2p_p2g`).
+pub struct Update<'a> {
+    /// `nodal`'s per node.
+    pub nodal: &'a [[f64; 4]],
+    pub grid: &'a Grid,
+    pub prm: G2pParams,
+    /// Contact pairs: `Touched`'s flags per field node and the particles'
+    /// masses; None and empty without.
+    pub touched: Option<&'a [bool]>,
+    pub mass: &'a [f64],
+}
+
+impl Update<'_> {
+    /// Moves particle `p` (`dp`: the interface blend's momentum change,
+    /// with contact pairs).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn particle(
+        &self,
+        p: usize,
+        nodes: &[u32],
+        w: &[[f64; 3]],
+        x: &mut [f64; 2],
+        v: &mut [f64; 2],
+        a: Option<&mut [f64; 2]>,
+        dp: Option<&mut [f64; 2]>,
+    ) -> Option<Fault> {
+        let (nodal, grid, prm, touched, mass) =
+            (self.nodal, self.grid, self.prm, self.touched, self.mass);
+        let dt = prm.dt;
+        // Σ N f/m and Σ N v_I (nodes without mass hold zeros).
         let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
         for (&node, wk) in nodes.iter().zip(w) {
-            let n = &mv[node as usize];
-            if n[0] > prm.mass_eps {
-                let f = &force[node as usize];
-                acc[0] += wk[0] * f[0] / n[0];
-                acc[1] += wk[0] * f[1] / n[0];
-                vel[0] += wk[0] * n[1];
-                vel[1] += wk[0] * n[2];
-            }
+            let n = &nodal[node as usize];
+            vel[0] += wk[0] * n[0];
+            vel[1] += wk[0] * n[1];
+            acc[0] += wk[0] * n[2];
+            acc[1] += wk[0] * n[3];
         }
         let alpha = match touched {
             Some(t)
@@ -157,30 +154,98 @@ pub fn g2p(
             return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
         }
         None
+    }
+}
+
+/// Per node the velocity and acceleration g2p interpolates,
+/// [v_x, v_y, f_x/m, f_y/m], zero on nodes without mass: one division per
+/// node rather than one per particle and node.
+pub fn nodal(mv: &[[f64; 3]], force: &[[f64; 2]], mass_eps: f64, out: &mut [[f64; 4]]) {
+    out.par_iter_mut()
+        .zip(mv.par_iter().zip(force))
+        .with_min_len(4096)
+        .for_each(|(o, (n, f))| {
+            *o = if n[0] > mass_eps {
+                [n[1], n[2], f[0] / n[0], f[1] / n[0]]
+            } else {
+                [0.0; 4]
+            };
+        });
+}
+
+/// `weights` not stored are evaluated at each particle's position before
+/// it moves (where this step's shape evaluation was). `nodal` is `nodal`'s.
+#[allow(clippy::too_many_arguments)]
+pub fn g2p(
+    weights: Weights<'_>,
+    nodal: &[[f64; 4]],
+    grid: &Grid,
+    prm: G2pParams,
+    touched: Touched,
+    x: &mut [[f64; 2]],
+    v: &mut [[f64; 2]],
+    a: &mut [[f64; 2]],
+) -> Result<(), Fault> {
+    with_weights!(weights, |w| g2p_with(w, nodal, grid, prm, touched, x, v, a))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn g2p_with<W: ParticleWeights>(
+    weights: &W,
+    nodal: &[[f64; 4]],
+    grid: &Grid,
+    prm: G2pParams,
+    touched: Touched,
+    x: &mut [[f64; 2]],
+    v: &mut [[f64; 2]],
+    a: &mut [[f64; 2]],
+) -> Result<(), Fault> {
+    let (touched, mass, pic_dp): (_, &[f64], &mut [[f64; 2]]) = match touched {
+        Some((t, m, dp)) => (Some(t), m, dp),
+        None => (None, &[], &mut []),
+    };
+    let update = Update {
+        nodal,
+        grid,
+        prm,
+        touched,
+        mass,
+    };
+    let kernel = |slots: &mut W::Scratch,
+                  p: usize,
+                  x: &mut [f64; 2],
+                  v: &mut [f64; 2],
+                  a: Option<&mut [f64; 2]>,
+                  dp: Option<&mut [f64; 2]>|
+     -> Option<Fault> {
+        match weights.get::<false>(p, *x, slots) {
+            Ok((nodes, w)) => update.particle(p, nodes, w, x, v, a, dp),
+            Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
+        }
     };
     let fault = match (a.is_empty(), pic_dp.is_empty()) {
         (true, true) => (x.par_iter_mut(), v.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map_init(Slots::default, |sl, (p, (x, v))| {
-                kernel(sl, p, x, v, None, None)
+            .map_init(W::Scratch::default, |sl, (p, (x, v))| {
+                crate::cpu::isa::vector(|| kernel(sl, p, x, v, None, None))
             })
             .reduce(|| None, Fault::first),
         (false, true) => (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map_init(Slots::default, |sl, (p, (x, v, a))| {
-                kernel(sl, p, x, v, Some(a), None)
+            .map_init(W::Scratch::default, |sl, (p, (x, v, a))| {
+                crate::cpu::isa::vector(|| kernel(sl, p, x, v, Some(a), None))
             })
             .reduce(|| None, Fault::first),
         (true, false) => (x.par_iter_mut(), v.par_iter_mut(), pic_dp.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map_init(Slots::default, |sl, (p, (x, v, d))| {
-                kernel(sl, p, x, v, None, Some(d))
+            .map_init(W::Scratch::default, |sl, (p, (x, v, d))| {
+                crate::cpu::isa::vector(|| kernel(sl, p, x, v, None, Some(d)))
             })
             .reduce(|| None, Fault::first),
         (false, false) => (
@@ -192,8 +257,8 @@ pub fn g2p(
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
-            .map_init(Slots::default, |sl, (p, (x, v, a, d))| {
-                kernel(sl, p, x, v, Some(a), Some(d))
+            .map_init(W::Scratch::default, |sl, (p, (x, v, a, d))| {
+                crate::cpu::isa::vector(|| kernel(sl, p, x, v, Some(a), Some(d)))
             })
             .reduce(|| None, Fault::first),
     };

@@ -16,8 +16,10 @@ pub mod contact_grad;
 pub mod energy;
 pub mod forces;
 pub mod g2p;
+pub mod g2p_p2g;
 pub mod grid_update;
 pub mod implicit;
+pub mod isa;
 pub mod mls;
 pub mod p2g;
 pub mod remap;
@@ -50,7 +52,9 @@ pub struct CpuBackend {
     /// behind the other simulation's work there (a test of 7 s alone took
     /// 38 s beside another).
     own_pool: Option<std::sync::Arc<rayon::ThreadPool>>,
-    pub model: Model,
+    /// Read by `model()`; changed through `model_mut()`, which drops the
+    /// next step's grid (`primed`).
+    pub(crate) model: Model,
     /// What a step runs (`StepPlan::cpu_step`).
     pub plan: StepPlan,
     pub cache: ShapeCache,
@@ -58,6 +62,8 @@ pub struct CpuBackend {
     pub mv: Vec<[f64; 3]>,
     /// Per node: force.
     pub force: Vec<[f64; 2]>,
+    /// Per node: what g2p interpolates, [v, f/m] (`g2p::nodal`).
+    nodal: Vec<[f64; 4]>,
     /// Per constraint group: reaction (N per unit thickness).
     pub reactions: Vec<[f64; 2]>,
     /// Per node: the weight of the particles in contact with a wall this
@@ -72,7 +78,10 @@ pub struct CpuBackend {
     pub wall_pre_force: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
     pub contact: Option<contact_detect::ContactState>,
-    p2g_scatter: Scatter<3>,
+    /// `p2g`'s (and `G2pP2g`'s) per-thread node sums.
+    p2g_scatter: Scatter<5>,
+    /// MUSL's remap.
+    remap_scatter: Scatter<3>,
     force_scatter: Scatter<2>,
     /// Gauss points and fits when the scene asks for MLS reconstruction.
     pub mls: Option<mls::Mls>,
@@ -89,6 +98,12 @@ pub struct CpuBackend {
     dt: f64,
     /// The step in progress lands on t_end.
     final_step: bool,
+    /// The next step's Δt and last-step flag where the last step's
+    /// `G2pP2g` already did its `Cfl`, `ClearGrid` and `P2g`: that step
+    /// runs `StepPlan::cpu_primed`. Dropped whenever the particles may
+    /// change from outside the steps (`model_mut`, `restore`,
+    /// `set_time`, `run_stage_passes`) or a step fails.
+    primed: Option<(f64, bool)>,
 }
 
 /// The particles' fields the walls' contact reads, and the scene's full
@@ -135,6 +150,7 @@ impl CpuBackend {
             cache: ShapeCache::for_model(&model),
             mv: vec![[0.0; 3]; nodes],
             force: vec![[0.0; 2]; nodes],
+            nodal: vec![[0.0; 4]; nodes],
             reactions: vec![[0.0; 2]; model.reaction_names().len()],
             wall_touch: if model.walls.is_empty() {
                 Vec::new()
@@ -156,6 +172,7 @@ impl CpuBackend {
                 .as_ref()
                 .map(|c| contact_detect::ContactState::new(c, grid_nodes, n)),
             p2g_scatter: Scatter::default(),
+            remap_scatter: Scatter::default(),
             force_scatter: Scatter::default(),
             mls: model.mls.then(|| {
                 let m = mls::Mls::new(&model.shape, &model.grid, n)
@@ -179,6 +196,7 @@ impl CpuBackend {
             steps: 0,
             dt: 0.0,
             final_step: false,
+            primed: None,
             own_pool: None,
             plan: StepPlan::of(&model, false, false),
             model,
@@ -232,7 +250,7 @@ impl CpuBackend {
         if model.cell_average_volumetric {
             per += 16.0 + 32.0 + 16.0 * (model.grid.n_nodes() * model.body_names.len()) as f64 / n;
         }
-        // Nodes: [m, qx, qy] and [fx, fy] in f64; the walls' node mask,
+        // Nodes: [m, qx, qy], [fx, fy] and g2p's [v, f/m] in f64; the walls' node mask,
         // contact weights, forces and node lists.
         let walls = if model.walls.is_empty() {
             0.0
@@ -258,7 +276,7 @@ impl CpuBackend {
         } else {
             0.0
         };
-        per + (model.grid.n_nodes() as f64 * 40.0 * fields + walls + contact) / n
+        per + (model.grid.n_nodes() as f64 * 72.0 * fields + walls + contact) / n
     }
 
     /// `Backend::advance`'s steps, on the calling thread's pool.
@@ -267,7 +285,10 @@ impl CpuBackend {
             && self.t < self.model.t_end
             && !stop_requested(stop)
         {
-            self.step()?;
+            if let Err(f) = self.step() {
+                self.primed = None;
+                return Err(f.into());
+            }
         }
         self.t = crate::model::time_step::settle_on_stop(self.t, t_stop, self.model.t_end, self.dt);
         Ok(())
@@ -301,6 +322,31 @@ impl CpuBackend {
     /// chosen instant.
     pub fn set_time(&mut self, t: f64) {
         self.t = t;
+        self.primed = None;
+    }
+
+    /// Whether the last step left the next one's grid (`G2pP2g`): `mv`
+    /// then holds the next step's scatter, not this one's nodal solution.
+    pub fn primed(&self) -> bool {
+        self.primed.is_some()
+    }
+
+    /// Forgets the next step's grid, so the next step starts from the
+    /// particles alone (`cpu_step`), as after a restore.
+    pub fn unprime(&mut self) {
+        self.primed = None;
+    }
+
+    /// The model, particles included.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The model to change between steps: the next step then starts from
+    /// the particles alone (`unprime`), whatever it changes.
+    pub fn model_mut(&mut self) -> &mut Model {
+        self.primed = None;
+        &mut self.model
     }
 
     /// One step: the plan's passes in order (`StepPlan::cpu_step`, some
@@ -308,8 +354,25 @@ impl CpuBackend {
     /// (`run_pass`). The time advances (`StepEnd`) only when every pass
     /// before it succeeded.
     pub fn step(&mut self) -> std::result::Result<(), Fault> {
-        for i in 0..self.plan.cpu_step.len() {
-            self.run_pass(self.plan.cpu_step[i])?;
+        let primed = self.primed.take();
+        if let Some(next) = primed {
+            (self.dt, self.final_step) = next;
+        }
+        let n = if primed.is_some() {
+            self.plan.cpu_primed.len()
+        } else {
+            self.plan.cpu_step.len()
+        };
+        for i in 0..n {
+            let pass = if primed.is_some() {
+                self.plan.cpu_primed[i]
+            } else {
+                self.plan.cpu_step[i]
+            };
+            if let Err(f) = self.run_pass(pass) {
+                self.primed = None;
+                return Err(f);
+            }
         }
         Ok(())
     }
@@ -318,6 +381,7 @@ impl CpuBackend {
     /// (`StepPlan::cpu_passes_for`): what the parity tests compare with the
     /// GPU's passes of the same stage.
     pub fn run_stage_passes(&mut self, stage: Stage) -> std::result::Result<(), Fault> {
+        self.primed = None;
         for pass in self.plan.cpu_passes_for(stage) {
             self.run_pass(pass)?;
         }
@@ -365,6 +429,7 @@ impl CpuBackend {
             Pass::ConstraintPointsForce => Self::constraint_points_force,
             Pass::ContactExchangeForce => Self::contact_exchange_force,
             Pass::G2p => Self::g2p,
+            Pass::G2pP2g => Self::g2p_p2g,
             Pass::ContactConserve => Self::contact_conserve,
             Pass::RemapClear => Self::remap_clear,
             Pass::Remap => Self::remap,
@@ -388,9 +453,14 @@ impl CpuBackend {
 
     /// Factor of a_p in p2g's predicted momentum: (1 − γ)Δt for NPC, 0 for FE and MUSL.
     fn p2g_accel(&self) -> f64 {
+        self.p2g_accel_for(self.dt)
+    }
+
+    /// `p2g_accel` for a step of `dt`.
+    fn p2g_accel_for(&self, dt: f64) -> f64 {
         match self.model.integrator {
             Integrator::Fe | Integrator::Musl => 0.0,
-            Integrator::Npc { gamma, .. } => (1.0 - gamma) * self.dt,
+            Integrator::Npc { gamma, .. } => (1.0 - gamma) * dt,
             // Implicit models run on `implicit::ImplicitBackend`, never here.
             Integrator::Implicit(_) => 0.0,
         }
@@ -707,7 +777,7 @@ impl CpuBackend {
                 &p.stress,
                 &p.mass,
                 &p.rho,
-                &body,
+                &|i| body.at(i),
                 &mut self.force,
                 &mut self.force_scatter,
             ),
@@ -738,7 +808,14 @@ impl CpuBackend {
             t_load,
         );
         if let Some(mls) = self.mls.as_mut() {
-            mls.forces(&m.grid, &p.x, &p.rho, &p.stress, &body, &mut self.force);
+            mls.forces(
+                &m.grid,
+                &p.x,
+                &p.rho,
+                &p.stress,
+                &|i| body.at(i),
+                &mut self.force,
+            );
         }
         Ok(())
     }
@@ -844,14 +921,13 @@ impl CpuBackend {
         let prm = g2p::G2pParams {
             dt: self.dt,
             integrator: m.integrator,
-            mass_eps: self.mass_eps,
             edge_margin: m.shape.edge_margin(m.grid.h),
             pic_fraction: m.pic_fraction,
         };
+        g2p::nodal(&self.mv, &self.force, self.mass_eps, &mut self.nodal);
         g2p::g2p(
             Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
-            &self.mv,
-            &self.force,
+            &self.nodal,
             &m.grid,
             prm,
             self.contact
@@ -861,6 +937,60 @@ impl CpuBackend {
             &mut p.v,
             &mut p.a,
         )
+    }
+
+    /// `g2p`, then the next step's `cfl`, `clear_grid` and `p2g` in the
+    /// same loop (`g2p_p2g`): leaves the next step's grid and Δt
+    /// (`primed`).
+    fn g2p_p2g(&mut self) -> std::result::Result<(), Fault> {
+        debug_assert!(!self.cache.is_stored(self.model.particles.len()));
+        let m = &mut self.model;
+        let p = &mut m.particles;
+        let prm = g2p::G2pParams {
+            dt: self.dt,
+            integrator: m.integrator,
+            edge_margin: m.shape.edge_margin(m.grid.h),
+            pic_fraction: m.pic_fraction,
+        };
+        g2p::nodal(&self.mv, &self.force, self.mass_eps, &mut self.nodal);
+        let speed = g2p_p2g::SpeedInputs {
+            materials: &m.materials,
+            body_material: &m.body_material,
+            body: &p.body,
+            rho: &p.rho,
+            stress: &p.stress,
+            plastic: &p.plastic,
+            mass: &p.mass,
+            fixed_dt: m.fixed_dt.is_some(),
+        };
+        let (c, used) = g2p_p2g::g2p_p2g(
+            Weights::of(&self.cache, p.x.len(), &m.shape, &m.grid),
+            &self.nodal,
+            &m.grid,
+            prm,
+            &speed,
+            &mut p.x,
+            &mut p.v,
+            &mut p.a,
+            self.mv.len(),
+            &mut self.p2g_scatter,
+        )?;
+        // The next step's `cfl` (as `cfl::time_step` at the time `StepEnd`
+        // commits), `clear_grid` and the end of its `p2g`.
+        let t_next = if self.final_step {
+            self.model.t_end
+        } else {
+            self.t + self.dt
+        };
+        let next = crate::model::time_step::step_of(&self.model, c, t_next);
+        let a_factor = self.p2g_accel_for(next.0);
+        if !self.model.particles.x.is_empty() {
+            self.p2g_scatter
+                .reduce_map(&mut self.mv, used, |s| p2g::combine(s, a_factor));
+        }
+        self.force.fill([0.0; 2]);
+        self.primed = Some(next);
+        Ok(())
     }
 
     /// Contact pairs, after `g2p`: each field's momentum as it was before
@@ -887,7 +1017,7 @@ impl CpuBackend {
             &p.mass,
             &p.v,
             &mut self.mv,
-            &mut self.p2g_scatter,
+            &mut self.remap_scatter,
         );
         Ok(())
     }
@@ -946,7 +1076,10 @@ impl Backend for CpuBackend {
             if self.t >= self.model.t_end {
                 break;
             }
-            self.step()?;
+            if let Err(f) = self.step() {
+                self.primed = None;
+                return Err(f.into());
+            }
         }
         Ok(())
     }
@@ -982,6 +1115,7 @@ impl Backend for CpuBackend {
         self.dt = state.dt;
         self.steps = steps;
         self.final_step = false;
+        self.primed = None;
         Ok(())
     }
 }

@@ -1,10 +1,13 @@
 //! Stage `p2g`: scatter particle mass and momentum to the nodes.
 //! FE: m_I = Σ N m_p, q_I = Σ N m_p v_p.
-//! NPC: q_I = Σ N m_p (v_p + (1 − γ) Δt a_p) (paper eq. 27, the stable form).
+//! NPC: q_I = Σ N m_p (v_p + (1 − γ) Δt a_p) (paper eq. 27, the stable form),
+//!      summed as Σ N m_p v_p + (1 − γ) Δt Σ N m_p a_p (`combine`), so that
+//!      the fused `g2p_p2g` can scatter before the next Δt is known and
+//!      give the same sums.
 //! GPU twin: `shaders/p2g.wgsl`.
 
 use super::scatter::Scatter;
-use super::stage_inputs::{Slots, Weights};
+use super::stage_inputs::{ParticleWeights, Weights, with_weights};
 use crate::model::fault::{Fault, FaultKind};
 use rayon::prelude::*;
 
@@ -19,23 +22,36 @@ pub fn p2g(
     a: &[[f64; 2]],
     a_factor: f64,
     mv: &mut [[f64; 3]],
-    scatter: &mut Scatter<3>,
+    scatter: &mut Scatter<5>,
+) -> Result<(), Fault> {
+    with_weights!(weights, |w| p2g_with(
+        w, x, mass, v, a, a_factor, mv, scatter
+    ))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn p2g_with<W: ParticleWeights>(
+    weights: &W,
+    x: &[[f64; 2]],
+    mass: &[f64],
+    v: &[[f64; 2]],
+    a: &[[f64; 2]],
+    a_factor: f64,
+    mv: &mut [[f64; 3]],
+    scatter: &mut Scatter<5>,
 ) -> Result<(), Fault> {
     let n = mass.len();
-    let len = Scatter::<3>::range_len(n);
-    let fault = scatter.run_ranges(
-        mv,
+    let len = Scatter::<5>::range_len(n);
+    let (fault, used) = scatter.accumulate(
+        mv.len(),
         n,
         (0..n.div_ceil(len)).into_par_iter(),
         |first, _, acc| {
-            let mut slots = Slots::default();
+            let mut slots = W::Scratch::default();
             let mut fault = None;
             for p in first..(first + len).min(n) {
-                match weights.particle_values(p, x[p], &mut slots) {
-                    Ok((nodes, w)) => {
-                        let vel = particle_velocity(v, a, a_factor, p);
-                        add_particle(nodes, w, mass[p], vel, acc);
-                    }
+                match weights.get::<false>(p, x[p], &mut slots) {
+                    Ok((nodes, w)) => add_particle(nodes, w, mass[p], v[p], accel(a, p), acc),
                     Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
             }
@@ -44,29 +60,43 @@ pub fn p2g(
         Fault::first,
         || None,
     );
+    if n > 0 {
+        scatter.reduce_map(mv, used, |s| combine(s, a_factor));
+    }
     fault.map_or(Ok(()), Err)
 }
 
-/// Adds one particle's N m and N m v to its nodes in `acc`. Shared with the
-/// fused `shape_eval::shape_eval_p2g`.
-#[inline]
-pub fn add_particle(nodes: &[u32], w: &[[f64; 3]], m: f64, vel: [f64; 2], acc: &mut [[f64; 3]]) {
+/// Adds one particle's N m, N m v and N m a to its nodes in `acc`.
+/// Shared with the fused `shape_eval::shape_eval_p2g` and `g2p_p2g`.
+#[inline(always)]
+pub fn add_particle(
+    nodes: &[u32],
+    w: &[[f64; 3]],
+    m: f64,
+    vel: [f64; 2],
+    a: [f64; 2],
+    acc: &mut [[f64; 5]],
+) {
     for (&node, wk) in nodes.iter().zip(w) {
         let nm = wk[0] * m;
         let acc = &mut acc[node as usize];
         acc[0] += nm;
         acc[1] += nm * vel[0];
         acc[2] += nm * vel[1];
+        acc[3] += nm * a[0];
+        acc[4] += nm * a[1];
     }
 }
 
-/// The velocity particle p scatters (NPC: the predictor's).
-#[inline]
-pub fn particle_velocity(v: &[[f64; 2]], a: &[[f64; 2]], a_factor: f64, p: usize) -> [f64; 2] {
-    let mut vel = v[p];
-    if !a.is_empty() {
-        vel[0] += a_factor * a[p][0];
-        vel[1] += a_factor * a[p][1];
-    }
-    vel
+/// Particle p's acceleration (zero for FE and MUSL, which keep none).
+#[inline(always)]
+pub fn accel(a: &[[f64; 2]], p: usize) -> [f64; 2] {
+    a.get(p).copied().unwrap_or([0.0; 2])
+}
+
+/// A node's [m, q] from its sums [Σ N m, Σ N m v, Σ N m a]: q = Σ N m v +
+/// `a_factor` Σ N m a, `a_factor` = (1 − γ) Δt for NPC, 0 otherwise.
+#[inline(always)]
+pub fn combine(s: [f64; 5], a_factor: f64) -> [f64; 3] {
+    [s[0], s[1] + a_factor * s[3], s[2] + a_factor * s[4]]
 }

@@ -93,7 +93,24 @@ impl<const K: usize> Scatter<K> {
         if n_particles == 0 {
             return none();
         }
-        let n_nodes = out.len();
+        let (r, used) = self.accumulate(out.len(), n_particles, ranges, kernel, fold, none);
+        self.reduce_into(out, used);
+        r
+    }
+
+    /// The first half of `run_ranges`: each worker range adds into its
+    /// own copy of `n_nodes` nodes, left in the scatter; returns the
+    /// kernels' folded result and how many copies hold sums, for
+    /// `reduce_map` once the caller knows how to finish them.
+    pub fn accumulate<C: Send, R: Send>(
+        &mut self,
+        n_nodes: usize,
+        n_particles: usize,
+        ranges: impl IndexedParallelIterator<Item = C>,
+        kernel: impl Fn(usize, C, &mut [[f64; K]]) -> R + Sync,
+        fold: impl Fn(R, R) -> R + Sync + Send,
+        none: impl Fn() -> R + Sync + Send,
+    ) -> (R, usize) {
         let threads = rayon::current_num_threads().clamp(1, n_particles.max(1));
         let per = Self::range_len(n_particles);
         let used = n_particles.div_ceil(per).max(1);
@@ -108,11 +125,38 @@ impl<const K: usize> Scatter<K> {
             .enumerate()
             .map(|(t, (acc, c))| {
                 acc.fill([0.0; K]);
-                kernel(t * per, c, acc)
+                crate::cpu::isa::vector(|| kernel(t * per, c, acc))
             })
             .reduce(&none, &fold);
-        self.reduce_into(out, used);
-        r
+        (r, used)
+    }
+
+    /// Writes `finish(Σ copies)` into each node of `out` (the sums of the
+    /// first `copies` node arrays `accumulate` left, node by node in
+    /// thread order: the sums `run_ranges` adds).
+    pub fn reduce_map<const M: usize>(
+        &self,
+        out: &mut [[f64; M]],
+        copies: usize,
+        finish: impl Fn([f64; K]) -> [f64; M] + Sync,
+    ) {
+        let n_nodes = out.len();
+        let scratch = &self.scratch;
+        out.par_chunks_mut(REDUCE_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let base = c * REDUCE_CHUNK;
+                for (k, o) in chunk.iter_mut().enumerate() {
+                    let mut sum = [0.0; K];
+                    for t in 0..copies {
+                        let v = &scratch[t * n_nodes + base + k];
+                        for d in 0..K {
+                            sum[d] += v[d];
+                        }
+                    }
+                    *o = finish(sum);
+                }
+            });
     }
 }
 

@@ -7,7 +7,7 @@
 //! GPU twin: `shaders/lme_newton.wgsl` (LME); other shapes are evaluated
 //! inline in each GPU pass.
 
-use super::p2g::{add_particle, particle_velocity};
+use super::p2g::{accel, add_particle, combine};
 use super::stage_inputs::{ShapeCache, Weights};
 use super::{p2g, scatter::Scatter};
 use crate::model::Grid;
@@ -87,7 +87,7 @@ pub fn shape_eval_p2g(
     a: &[[f64; 2]],
     a_factor: f64,
     mv: &mut [[f64; 3]],
-    scatter: &mut Scatter<3>,
+    scatter: &mut Scatter<5>,
 ) -> Result<(), Fault> {
     let n = x.len();
     if !cache.is_stored(n) {
@@ -95,18 +95,17 @@ pub fn shape_eval_p2g(
         return p2g::p2g(weights, x, mass, v, a, a_factor, mv, scatter);
     }
     let s = cache.stride;
-    let len = Scatter::<3>::range_len(n);
+    let len = Scatter::<5>::range_len(n);
     let particle = |p: usize,
                     lam: &mut [f64; 2],
                     cnt: &mut u16,
                     nodes: &mut [u32],
                     w: &mut [[f64; 3]],
-                    acc: &mut [[f64; 3]]| {
+                    acc: &mut [[f64; 5]]| {
         match shape.eval(grid, x[p], lam, nodes, w) {
             Ok(k) => {
                 *cnt = k as u16;
-                let vel = particle_velocity(v, a, a_factor, p);
-                add_particle(&nodes[..k], &w[..k], mass[p], vel, acc);
+                add_particle(&nodes[..k], &w[..k], mass[p], v[p], accel(a, p), acc);
                 None
             }
             Err(e) => {
@@ -120,9 +119,9 @@ pub fn shape_eval_p2g(
         .par_chunks_mut(len)
         .zip(cache.nodes.par_chunks_mut(len * s))
         .zip(cache.w.par_chunks_mut(len * s));
-    let fault = if lambda.is_empty() {
-        scatter.run_ranges(
-            mv,
+    let (fault, used) = if lambda.is_empty() {
+        scatter.accumulate(
+            mv.len(),
             n,
             ranges,
             |first, ((c, nodes), w), acc| {
@@ -142,8 +141,8 @@ pub fn shape_eval_p2g(
             || None,
         )
     } else {
-        scatter.run_ranges(
-            mv,
+        scatter.accumulate(
+            mv.len(),
             n,
             ranges.zip(lambda.par_chunks_mut(len)),
             |first, (((c, nodes), w), lam), acc| {
@@ -164,5 +163,8 @@ pub fn shape_eval_p2g(
             || None,
         )
     };
+    if n > 0 {
+        scatter.reduce_map(mv, used, |s| combine(s, a_factor));
+    }
     fault.map_or(Ok(()), Err)
 }

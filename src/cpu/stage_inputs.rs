@@ -7,6 +7,8 @@
 use crate::model::shape::separable::Separable;
 use crate::model::shape::{Shape, ShapeFault};
 use crate::model::{Grid, Integrator, Model};
+use rayon::iter::Either;
+use rayon::prelude::*;
 
 /// N and ∇N of every particle for the current step: `stride` slots per
 /// particle, `count[p]` of them used.
@@ -185,6 +187,148 @@ impl<'a> Weights<'a> {
         }
     }
 }
+/// Where a loop over the particles takes each particle's nodes and
+/// [N, ∂N/∂x, ∂N/∂y]: `Weights` (the stored cache, or `Shape::eval` at the
+/// particle), or a separable shape as a type of its own (`Fixed`), whose
+/// slots are a constant the compiler unrolls the loops over the nodes by.
+/// The loops are generic over it and `with_weights!` picks the type once
+/// per loop. All give the same numbers (`Separable::eval_fixed` is
+/// `Shape::eval`, tested in `model::shape::separable`).
+pub trait ParticleWeights: Sync {
+    /// A loop's scratch for one particle's slots.
+    type Scratch: Default;
+    /// Particle `p`'s nodes and weights at `x` (its position at the step's
+    /// shape evaluation); gradients written only when `GRAD`.
+    fn get<'s, const GRAD: bool>(
+        &'s self,
+        p: usize,
+        x: [f64; 2],
+        scratch: &'s mut Self::Scratch,
+    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault>;
+}
+
+impl ParticleWeights for Weights<'_> {
+    type Scratch = Slots;
+    #[inline(always)]
+    fn get<'s, const GRAD: bool>(
+        &'s self,
+        p: usize,
+        x: [f64; 2],
+        scratch: &'s mut Slots,
+    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
+        self.particle_with::<GRAD>(p, x, scratch)
+    }
+}
+
+/// A separable shape with exactly K slots (linear 4, quadratic B-splines
+/// 9, cubic 16), evaluated on the spot.
+#[derive(Clone, Copy)]
+pub struct Fixed<const K: usize>(pub Separable);
+
+/// `Fixed`'s scratch: K slots.
+pub struct FixedSlots<const K: usize> {
+    nodes: [u32; K],
+    w: [[f64; 3]; K],
+}
+
+impl<const K: usize> Default for FixedSlots<K> {
+    fn default() -> Self {
+        FixedSlots {
+            nodes: [0; K],
+            w: [[0.0; 3]; K],
+        }
+    }
+}
+
+impl<const K: usize> ParticleWeights for Fixed<K> {
+    type Scratch = FixedSlots<K>;
+    #[inline(always)]
+    fn get<'s, const GRAD: bool>(
+        &'s self,
+        _p: usize,
+        x: [f64; 2],
+        s: &'s mut FixedSlots<K>,
+    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
+        self.0.eval_fixed::<GRAD, K>(x, &mut s.nodes, &mut s.w)?;
+        Ok((&s.nodes, &s.w))
+    }
+}
+
+/// Runs `$body` with `$w` bound to a `ParticleWeights` for `$weights` (a
+/// `Weights`): a `Fixed` of the separable shape's slots, else the
+/// `Weights` itself. `$body` is compiled once per type.
+macro_rules! with_weights {
+    ($weights:expr, |$w:ident| $body:expr) => {{
+        let weights: $crate::cpu::stage_inputs::Weights<'_> = $weights;
+        use $crate::cpu::stage_inputs::Fixed;
+        use $crate::model::shape::separable::SeparableClass as C;
+        match weights {
+            $crate::cpu::stage_inputs::Weights::Separable(s) => match s.class() {
+                C::Linear => {
+                    let $w = &Fixed::<4>(s);
+                    $body
+                }
+                C::Bspline2 => {
+                    let $w = &Fixed::<9>(s);
+                    $body
+                }
+                C::Bspline3 => {
+                    let $w = &Fixed::<16>(s);
+                    $body
+                }
+            },
+            _ => {
+                let $w = &weights;
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use with_weights;
+
+/// The body force per unit mass of every particle at one time
+/// (`body_force`): gravity, plus the manufactured solution's and the
+/// loads' shares where the scene has them.
+pub struct BodyForce<'a> {
+    g: [f64; 2],
+    t: f64,
+    mms: &'a Option<crate::model::AlignedVibration>,
+    ext: &'a Option<crate::model::ExternalForces>,
+    x0: &'a [[f64; 2]],
+    mass: &'a [f64],
+}
+
+impl BodyForce<'static> {
+    /// The same `g` (m/s²) on every particle.
+    pub fn uniform(g: [f64; 2]) -> Self {
+        BodyForce {
+            g,
+            t: 0.0,
+            mms: &None,
+            ext: &None,
+            x0: &[],
+            mass: &[],
+        }
+    }
+}
+
+impl BodyForce<'_> {
+    /// Particle `i`'s (m/s²).
+    #[inline(always)]
+    pub fn at(&self, i: usize) -> [f64; 2] {
+        let mut b = self.g;
+        if let Some(s) = self.mms {
+            let s = s.body_force(self.x0[i], self.t);
+            b = [b[0] + s[0], b[1] + s[1]];
+        }
+        if let Some(e) = self.ext {
+            let f = e.at(i, self.t);
+            b = [b[0] + f[0] / self.mass[i], b[1] + f[1] / self.mass[i]];
+        }
+        b
+    }
+}
+
 /// Body force per unit mass on particle `i` at time `t` (m/s²): gravity
 /// with its ramp, plus a manufactured solution's load at the particle's
 /// reference position, plus the particle's share of the tractions and
@@ -196,18 +340,38 @@ pub(crate) fn body_force<'a>(
     x0: &'a [[f64; 2]],
     mass: &'a [f64],
     t: f64,
-) -> impl Fn(usize) -> [f64; 2] + Sync + 'a {
-    let g = gravity.map_or([0.0; 2], |g| g.at(t));
-    move |i: usize| {
-        let mut b = g;
-        if let Some(s) = mms {
-            let s = s.body_force(x0[i], t);
-            b = [b[0] + s[0], b[1] + s[1]];
-        }
-        if let Some(e) = ext {
-            let f = e.at(i, t);
-            b = [b[0] + f[0] / mass[i], b[1] + f[1] / mass[i]];
-        }
-        b
+) -> BodyForce<'a> {
+    BodyForce {
+        g: gravity.map_or([0.0; 2], |g| g.at(t)),
+        t,
+        mms,
+        ext,
+        x0,
+        mass,
+    }
+}
+
+/// Per-particle `Option<&mut T>` over `v`, or `None` n times when `v` is empty.
+pub fn optional<T: Send>(
+    v: &mut [T],
+    n: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut T>> {
+    if v.is_empty() {
+        Either::Left((0..n).into_par_iter().map(|_| None))
+    } else {
+        Either::Right(v.par_iter_mut().map(Some))
+    }
+}
+
+/// `optional` by chunks of `len`.
+pub fn optional_chunks<T: Send>(
+    v: &mut [T],
+    n: usize,
+    len: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
+    if v.is_empty() {
+        Either::Left((0..n.div_ceil(len)).into_par_iter().map(|_| None))
+    } else {
+        Either::Right(v.par_chunks_mut(len).map(Some))
     }
 }

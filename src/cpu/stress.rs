@@ -9,37 +9,16 @@
 
 use super::forces::add_particle_forces;
 use super::scatter::Scatter;
-use super::stage_inputs::{Slots, Weights};
+use super::stage_inputs::{
+    BodyForce, ParticleWeights, Weights, optional, optional_chunks, with_weights,
+};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::{Material, PlasticState};
-use rayon::iter::Either;
 use rayon::prelude::*;
 
 /// The state a particle may carry beyond its stress: F, the plastic state.
 /// Empty vectors (fields the scene does not use) give `None` per particle.
 type Extra<'a> = (Option<&'a mut [f64; 4]>, Option<&'a mut PlasticState>);
-
-/// Per-particle `Option<&mut T>` over `v`, or `None` n times when `v` is empty.
-fn optional<T: Send>(v: &mut [T], n: usize) -> impl IndexedParallelIterator<Item = Option<&mut T>> {
-    if v.is_empty() {
-        Either::Left((0..n).into_par_iter().map(|_| None))
-    } else {
-        Either::Right(v.par_iter_mut().map(Some))
-    }
-}
-
-/// `optional` by chunks of `len`.
-fn optional_chunks<T: Send>(
-    v: &mut [T],
-    n: usize,
-    len: usize,
-) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
-    if v.is_empty() {
-        Either::Left((0..n.div_ceil(len)).into_par_iter().map(|_| None))
-    } else {
-        Either::Right(v.par_chunks_mut(len).map(Some))
-    }
-}
 
 #[allow(clippy::too_many_arguments)]
 pub fn stress(
@@ -57,7 +36,7 @@ pub fn stress(
     dl: &[[f64; 4]],
 ) -> Result<(), Fault> {
     let n = stress.len();
-    let fault = (
+    let fault = with_weights!(weights, |weights| (
         stress.par_iter_mut(),
         rho.par_iter_mut(),
         optional(f, n),
@@ -66,31 +45,33 @@ pub fn stress(
         .into_par_iter()
         .enumerate()
         .with_min_len(256)
-        .map_init(Slots::default, |slots, (p, (s, r, f, q))| {
-            let (nodes, w) = match weights.particle(p, x[p], slots) {
-                Ok(nw) => nw,
-                Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
-            };
-            update_particle(
-                nodes,
-                w,
-                mv,
-                dt,
-                &materials[body_material[body[p] as usize] as usize],
-                p,
-                s,
-                r,
-                (f, q),
-                dl.get(p),
-            )
+        .map_init(Default::default, |slots, (p, (s, r, f, q))| {
+            crate::cpu::isa::vector(|| {
+                let (nodes, w) = match weights.get::<true>(p, x[p], slots) {
+                    Ok(nw) => nw,
+                    Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
+                };
+                update_particle(
+                    nodes,
+                    w,
+                    mv,
+                    dt,
+                    &materials[body_material[body[p] as usize] as usize],
+                    p,
+                    s,
+                    r,
+                    (f, q),
+                    dl.get(p),
+                )
+            })
         })
-        .reduce(|| None, Fault::first);
+        .reduce(|| None, Fault::first));
     fault.map_or(Ok(()), Err)
 }
 
 /// Particle p's velocity gradient and material update (the whole stage for
 /// one particle), from its nodes and weights.
-#[inline]
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn update_particle(
     nodes: &[u32],
@@ -151,7 +132,7 @@ pub fn stress_forces(
     materials: &[Material],
     body_material: &[u32],
     mass: &[f64],
-    body_force: &(dyn Fn(usize) -> [f64; 2] + Sync),
+    body_force: &BodyForce<'_>,
     stress: &mut [[f64; 3]],
     rho: &mut [f64],
     f: &mut [[f64; 4]],
@@ -159,24 +140,64 @@ pub fn stress_forces(
     force: &mut [[f64; 2]],
     scatter: &mut Scatter<2>,
 ) -> Result<(), Fault> {
-    let n = mass.len();
+    let inputs = StressInputs {
+        x,
+        mv,
+        dt,
+        body,
+        materials,
+        body_material,
+        mass,
+        body_force,
+    };
+    with_weights!(weights, |w| stress_forces_with(
+        w, &inputs, stress, rho, f, plastic, force, scatter
+    ))
+}
+
+/// What `stress_forces` reads besides the weights.
+struct StressInputs<'a> {
+    x: &'a [[f64; 2]],
+    mv: &'a [[f64; 3]],
+    dt: f64,
+    body: &'a [u32],
+    materials: &'a [Material],
+    body_material: &'a [u32],
+    mass: &'a [f64],
+    body_force: &'a BodyForce<'a>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn stress_forces_with<W: ParticleWeights>(
+    weights: &W,
+    inp: &StressInputs<'_>,
+    stress: &mut [[f64; 3]],
+    rho: &mut [f64],
+    f: &mut [[f64; 4]],
+    plastic: &mut [PlasticState],
+    force: &mut [[f64; 2]],
+    scatter: &mut Scatter<2>,
+) -> Result<(), Fault> {
+    let n = inp.mass.len();
     let len = Scatter::<2>::range_len(n);
     let particle = |p: usize,
                     s: &mut [f64; 3],
                     r: &mut f64,
                     extra: Extra<'_>,
-                    slots: &mut Slots,
+                    slots: &mut W::Scratch,
                     acc: &mut [[f64; 2]]| {
-        let material = &materials[body_material[body[p] as usize] as usize];
-        let (nodes, w) = match weights.particle(p, x[p], slots) {
+        let material = &inp.materials[inp.body_material[inp.body[p] as usize] as usize];
+        let (nodes, w) = match weights.get::<true>(p, inp.x[p], slots) {
             Ok(nw) => nw,
             Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
         };
-        if let Some(fault) = update_particle(nodes, w, mv, dt, material, p, s, r, extra, None) {
+        if let Some(fault) =
+            update_particle(nodes, w, inp.mv, inp.dt, material, p, s, r, extra, None)
+        {
             return Some(fault);
         }
-        let g = body_force(p);
-        let m = mass[p];
+        let g = inp.body_force.at(p);
+        let m = inp.mass[p];
         add_particle_forces(nodes, w, m / *r, *s, [m * g[0], m * g[1]], acc);
         None
     };
@@ -193,7 +214,7 @@ pub fn stress_forces(
         ranges,
         |first, (s, r, mut f, mut q), acc| {
             let mut fault = None;
-            let mut slots = Slots::default();
+            let mut slots = W::Scratch::default();
             for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
                 let extra = (
                     f.as_deref_mut().map(|f| &mut f[k]),

@@ -395,7 +395,7 @@ impl ImplicitBackend {
         let p = &m.particles;
         let body =
             crate::cpu::body_force(m.gravity, &m.manufactured, &m.external, &p.x0, &p.mass, 0.0);
-        let body: Vec<[f64; 2]> = (0..p.len()).map(body).collect();
+        let body: Vec<[f64; 2]> = (0..p.len()).map(|i| body.at(i)).collect();
         let zero = vec![[0.0; 2]; self.du.len()];
         let inp = StepInputs {
             cache: &self.cache,
@@ -570,7 +570,7 @@ impl ImplicitBackend {
         let body =
             crate::cpu::body_force(m.gravity, &m.manufactured, &m.external, &p.x0, &p.mass, t);
         for (i, b) in self.body.iter_mut().enumerate() {
-            let v = body(i);
+            let v = body.at(i);
             *b = [factor * v[0], factor * v[1]];
         }
     }

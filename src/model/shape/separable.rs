@@ -13,10 +13,9 @@ use crate::model::Grid;
 #[derive(Debug, Clone, Copy)]
 pub struct Separable {
     kind: Kind,
-    /// The grid's lattice origin (m), spacing h (m), h², 1/h.
+    /// The grid's lattice origin (m), spacing h (m), 1/h.
     min: [f64; 2],
     h: f64,
-    hh: f64,
     inv_h: f64,
     /// The lattice's last node position (m): `Grid::max`.
     hi: [f64; 2],
@@ -57,7 +56,6 @@ impl Shape {
             kind,
             min: grid.min,
             h: grid.h,
-            hh: grid.h * grid.h - 0.0 * 0.0,
             inv_h: 1.0 / grid.h,
             hi: grid.max(),
             margin,
@@ -79,6 +77,52 @@ impl Separable {
         nodes: &mut [u32; 16],
         w: &mut [[f64; 3]; 16],
     ) -> Result<usize, ShapeFault> {
+        let q = self.lattice(x)?;
+        match self.kind {
+            Kind::Linear => Ok(self.linear::<GRAD, 16>(q, nodes, w)),
+            Kind::Bspline { p: 2, e } => Ok(self.bspline::<GRAD, 2, 16>(q, e, nodes, w)),
+            Kind::Bspline { e, .. } => Ok(self.bspline::<GRAD, 3, 16>(q, e, nodes, w)),
+        }
+    }
+
+    /// The stencil this shape has, for the loops that take it as a type
+    /// (`cpu::stage_inputs::with_weights`): its slots are a constant.
+    pub fn class(&self) -> SeparableClass {
+        match self.kind {
+            Kind::Linear => SeparableClass::Linear,
+            Kind::Bspline { p: 2, .. } => SeparableClass::Bspline2,
+            Kind::Bspline { .. } => SeparableClass::Bspline3,
+        }
+    }
+
+    /// `eval` for a shape of `class` with exactly K = its slots: the same
+    /// numbers in the same order, into arrays of that length.
+    #[inline(always)]
+    pub fn eval_fixed<const GRAD: bool, const K: usize>(
+        &self,
+        x: [f64; 2],
+        nodes: &mut [u32; K],
+        w: &mut [[f64; 3]; K],
+    ) -> Result<(), ShapeFault> {
+        let q = self.lattice(x)?;
+        match (self.kind, K) {
+            (Kind::Linear, 4) => {
+                self.linear::<GRAD, K>(q, nodes, w);
+            }
+            (Kind::Bspline { p: 2, e }, 9) => {
+                self.bspline::<GRAD, 2, K>(q, e, nodes, w);
+            }
+            (Kind::Bspline { p: 3, e }, 16) => {
+                self.bspline::<GRAD, 3, K>(q, e, nodes, w);
+            }
+            (kind, k) => unreachable!("{kind:?} has no stencil of {k} slots"),
+        }
+        Ok(())
+    }
+
+    /// `x` in lattice units, or outside the grid (with the shape's margin).
+    #[inline(always)]
+    fn lattice(&self, x: [f64; 2]) -> Result<[f64; 2], ShapeFault> {
         let m = self.margin;
         if !(x[0] >= self.min[0] + m
             && x[0] <= self.hi[0] - m
@@ -87,23 +131,17 @@ impl Separable {
         {
             return Err(ShapeFault::OutsideGrid);
         }
-        let q = [(x[0] - self.min[0]) / self.h, (x[1] - self.min[1]) / self.h];
-        match self.kind {
-            Kind::Linear => Ok(self.linear::<GRAD>(q, nodes, w)),
-            Kind::Bspline { p: 2, e } => Ok(self.bspline::<GRAD, 2>(q, e, nodes, w)),
-            Kind::Bspline { e, .. } => Ok(self.bspline::<GRAD, 3>(q, e, nodes, w)),
-        }
+        Ok([(x[0] - self.min[0]) / self.h, (x[1] - self.min[1]) / self.h])
     }
 
     /// `linear::eval` on a regular grid: the cell's corners counter-clockwise
-    /// from (i, j), gradients through the Jacobian diag(h, h) as
-    /// `linear::to_physical` takes them.
+    /// from (i, j), gradients ∇_(s,t) / h as `linear::eval` takes them.
     #[inline(always)]
-    fn linear<const GRAD: bool>(
+    fn linear<const GRAD: bool, const K: usize>(
         &self,
         q: [f64; 2],
-        nodes: &mut [u32; 16],
-        w: &mut [[f64; 3]; 16],
+        nodes: &mut [u32; K],
+        w: &mut [[f64; 3]; K],
     ) -> usize {
         let cell = |v: f64, n: usize| (floor_nonneg(v).max(0) as usize).min(n - 2);
         let (i, j) = (cell(q[0], self.nx), cell(q[1], self.ny));
@@ -116,8 +154,8 @@ impl Separable {
             nodes[a] = idx[a] as u32;
             w[a][0] = n[a];
             if GRAD {
-                w[a][1] = (self.h * dn[a][0]) / self.hh;
-                w[a][2] = (self.h * dn[a][1]) / self.hh;
+                w[a][1] = dn[a][0] * self.inv_h;
+                w[a][2] = dn[a][1] * self.inv_h;
             }
         }
         4
@@ -126,12 +164,12 @@ impl Separable {
     /// `Bspline::eval`: the p + 1 bases per axis (`bspline::basis_of`), then
     /// their products, x fastest.
     #[inline(always)]
-    fn bspline<const GRAD: bool, const P: usize>(
+    fn bspline<const GRAD: bool, const P: usize, const K: usize>(
         &self,
         q: [f64; 2],
         e: f64,
-        nodes: &mut [u32; 16],
-        w: &mut [[f64; 3]; 16],
+        nodes: &mut [u32; K],
+        w: &mut [[f64; 3]; K],
     ) -> usize {
         let (fx, nx, dnx) = bspline::basis_of::<P>(q[0], self.nx, e);
         let (fy, ny, dny) = bspline::basis_of::<P>(q[1], self.ny, e);
@@ -152,10 +190,27 @@ impl Separable {
     }
 }
 
+/// The separable shapes by stencil (`Separable::class`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeparableClass {
+    /// 2 × 2 nodes.
+    Linear,
+    /// 3 × 3.
+    Bspline2,
+    /// 4 × 4.
+    Bspline3,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::shape::bspline::Bspline;
+
+    fn fixed_eval<const K: usize>(sep: &Separable, x: [f64; 2]) -> (Vec<u32>, Vec<[f64; 3]>) {
+        let (mut n, mut w) = ([0u32; K], [[0.0; 3]; K]);
+        sep.eval_fixed::<true, K>(x, &mut n, &mut w).unwrap();
+        (n.to_vec(), w.to_vec())
+    }
 
     /// Every slot of the separable evaluation equals `Shape::eval`'s, bit
     /// for bit (zeros up to sign), over points across the whole grid,
@@ -201,6 +256,14 @@ mod tests {
                             for k in 0..k0 {
                                 assert_eq!((n2[k], w2[k][0]), (n0[k], w0[k][0]));
                             }
+                            // The fixed-size stencil of the shape's class.
+                            let fixed = |k: usize| match k {
+                                4 => fixed_eval::<4>(&sep, x),
+                                9 => fixed_eval::<9>(&sep, x),
+                                _ => fixed_eval::<16>(&sep, x),
+                            };
+                            let (n3, w3) = fixed(k0);
+                            assert_eq!((&n3[..], &w3[..]), (&n0[..k0], &w0[..k0]), "{shape:?}");
                             checked += 1;
                         }
                         (Err(a), Err(b)) => assert_eq!(a, b),

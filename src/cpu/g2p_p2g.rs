@@ -1,0 +1,131 @@
+//! Pass `g2p_p2g` (CPU only): this step's particle update (`g2p`) and, in
+//! the same loop over the particles, the next step's `cfl` reduction and
+//! `p2g` scatter at the positions just reached, so a particle's fields are
+//! read once for the three (what `StepPlan::cpu_primed` then starts from).
+//! Each particle is updated exactly as `g2p::g2p` does, its signal speed
+//! is `time_step::max_speed`'s, and its mass, momentum and m a go to the
+//! nodes in the same ranges and order as `p2g::p2g`'s, so a step from a
+//! primed grid equals the step from the particles alone bit for bit
+//! (`tests/fused_step.rs`). The scatter is summed into the nodes once the
+//! next Δt is known (`p2g::combine`, NPC's (1 − γ) Δt a_p).
+//! No GPU twin: the GPU runs `g2p`, then the next step's passes.
+
+use super::g2p::{self, G2pParams};
+use super::p2g::add_particle;
+use super::scatter::Scatter;
+use super::stage_inputs::{ParticleWeights, Weights, optional_chunks, with_weights};
+use crate::model::Grid;
+use crate::model::fault::{Fault, FaultKind};
+use crate::model::material::{Material, PlasticState};
+
+/// What the next step's Δt needs from the particles' state after this
+/// step: their materials and state (`Material::wave_speed`).
+pub struct SpeedInputs<'a> {
+    pub materials: &'a [Material],
+    pub body_material: &'a [u32],
+    pub body: &'a [u32],
+    pub rho: &'a [f64],
+    pub stress: &'a [[f64; 3]],
+    pub plastic: &'a [PlasticState],
+    pub mass: &'a [f64],
+    /// A fixed Δt: no speeds needed.
+    pub fixed_dt: bool,
+}
+
+/// Runs the pass: returns the largest signal speed (m/s) after the update
+/// and the worker ranges `scatter` holds (`Scatter::reduce_map` sums them).
+#[allow(clippy::too_many_arguments)]
+pub fn g2p_p2g(
+    weights: Weights<'_>,
+    nodal: &[[f64; 4]],
+    grid: &Grid,
+    prm: G2pParams,
+    speed: &SpeedInputs<'_>,
+    x: &mut [[f64; 2]],
+    v: &mut [[f64; 2]],
+    a: &mut [[f64; 2]],
+    n_nodes: usize,
+    scatter: &mut Scatter<5>,
+) -> Result<(f64, usize), Fault> {
+    with_weights!(weights, |w| run(
+        w, nodal, grid, prm, speed, x, v, a, n_nodes, scatter
+    ))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run<W: ParticleWeights>(
+    weights: &W,
+    nodal: &[[f64; 4]],
+    grid: &Grid,
+    prm: G2pParams,
+    sp: &SpeedInputs<'_>,
+    x: &mut [[f64; 2]],
+    v: &mut [[f64; 2]],
+    a: &mut [[f64; 2]],
+    n_nodes: usize,
+    scatter: &mut Scatter<5>,
+) -> Result<(f64, usize), Fault> {
+    use rayon::prelude::*;
+    let n = x.len();
+    let len = Scatter::<5>::range_len(n);
+    let update = g2p::Update {
+        nodal,
+        grid,
+        prm,
+        touched: None,
+        mass: &[],
+    };
+    let ranges = (
+        x.par_chunks_mut(len),
+        v.par_chunks_mut(len),
+        optional_chunks(a, n, len),
+    )
+        .into_par_iter();
+    let ((fault, c), used) = scatter.accumulate(
+        n_nodes,
+        n,
+        ranges,
+        |first, (x, v, mut a), acc| {
+            let mut fault = None;
+            let mut c = 0.0f64;
+            let (mut before, mut after) = (W::Scratch::default(), W::Scratch::default());
+            for (k, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
+                // The weights at the step's start, for g2p, then at the
+                // position reached, for the next p2g.
+                let p = first + k;
+                let mut a = a.as_deref_mut().map(|a| &mut a[k]);
+                let f = match weights.get::<false>(p, *x, &mut before) {
+                    Ok((nodes, w)) => update.particle(p, nodes, w, x, v, a.as_deref_mut(), None),
+                    Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
+                };
+                if f.is_some() {
+                    fault = Fault::first(fault, f);
+                    continue;
+                }
+                if !sp.fixed_dt {
+                    let wave = sp.materials[sp.body_material[sp.body[p] as usize] as usize]
+                        .wave_speed(
+                            sp.rho[p],
+                            &sp.stress[p],
+                            sp.plastic.get(p).unwrap_or(&[0.0; 4]),
+                        );
+                    c = c.max((v[0] * v[0] + v[1] * v[1]).sqrt().max(wave));
+                }
+                match weights.get::<false>(p, *x, &mut after) {
+                    Ok((nodes, w)) => {
+                        let acc_p = a.map_or([0.0; 2], |a| *a);
+                        add_particle(nodes, w, sp.mass[p], *v, acc_p, acc);
+                    }
+                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                }
+            }
+            (fault, c)
+        },
+        |(fa, ca), (fb, cb)| (Fault::first(fa, fb), ca.max(cb)),
+        || (None, 0.0),
+    );
+    match fault {
+        Some(f) => Err(f),
+        None => Ok((c, used)),
+    }
+}
