@@ -188,7 +188,7 @@ impl NewtonStats {
 }
 
 pub trait Backend {
-    /// Human-readable description, e.g. "cpu (f64, 2 threads)".
+    /// Human-readable description, e.g. "cpu (f64, 2 threads, x86-64-v3)".
     fn name(&self) -> String;
     /// Simulated time reached (s).
     fn time(&self) -> f64;

@@ -1044,7 +1044,11 @@ impl CpuBackend {
 
 impl Backend for CpuBackend {
     fn name(&self) -> String {
-        format!("cpu (f64, {} threads)", rayon::current_num_threads())
+        format!(
+            "cpu (f64, {} threads, {})",
+            rayon::current_num_threads(),
+            isa::name()
+        )
     }
 
     fn time(&self) -> f64 {

@@ -56,7 +56,7 @@ pub struct Record {
     pub particle_steps_per_second: Option<f64>,
     pub particles: Option<u64>,
     pub bytes_per_particle: Option<f64>,
-    /// e.g. `cpu (f64, 2 threads)`.
+    /// e.g. `cpu (f64, 2 threads, x86-64-v3)`.
     pub backend: String,
     /// Grid spacing (m).
     pub h: Option<f64>,
