@@ -4,6 +4,7 @@
 //! against depth at t_end with the exact line.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{Method, backend_slug, image, sig, table};
 use crate::cases::ELASTIC_BLOCK;
 use crate::chart::{LineChart, Series};
@@ -23,6 +24,32 @@ pub const METHODS: [Method; 4] = [
     ("lme-g0.8", "lme", 0.8),
     ("lme-g3", "lme", 3.0),
 ];
+
+/// `lme-mpm study block`.
+pub struct BlockStudy;
+
+impl Study for BlockStudy {
+    fn slug(&self) -> &'static str {
+        "block"
+    }
+
+    fn help(&self) -> &'static str {
+        "Elastic block: linear, uGIMP, LME γ = 0.8 and 3 (NPC)"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
+}
 
 pub fn jobs(_quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     // The block is cheap (100 particles): the quick sweep is the full one.

@@ -23,6 +23,7 @@
 //! figures do not depend on the run's own score.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{backend_slug, image, sig, table};
 use crate::cases::{CONTACT_BLOCK, CONTACT_DISKS, CONTACT_ROLLING, FOOTING};
 use crate::chart::{LineChart, Series};
@@ -108,6 +109,35 @@ const ROLL_R: f64 = 0.5;
 fn every(dt: f64, t_end: f64) -> Vec<f64> {
     let n = (t_end / dt).round() as usize;
     (1..=n).map(|k| k as f64 * dt).collect()
+}
+
+/// `lme-mpm study contact`.
+pub struct ContactStudy;
+
+impl Study for ContactStudy {
+    fn slug(&self) -> &'static str {
+        "contact"
+    }
+
+    fn help(&self) -> &'static str {
+        "Contact between bodies: block on a slab (μ = 0–0.7), two disks colliding head-on and \
+         off-centre, a disk rolling on an elastic slab (R/h = 10–40), each beside the single \
+         shared field; a strip footing on a Tresca soil against Prandtl's 5.14 c, smooth and \
+         rough, three grids (full run only) (CPU; about 15 minutes, --quick about 1)"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {

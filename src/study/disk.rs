@@ -6,6 +6,7 @@
 //! front) and the displacement history at the smallest step.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{Method, backend_slug, image, sig, table};
 use crate::cases::ROLLING_DISK;
 use crate::chart::{LineChart, Series};
@@ -72,6 +73,33 @@ pub fn job(b: BackendChoice, method: Method, k: usize, dt: f64, t_end: f64) -> J
     .tag("dt", dt);
     j.snapshot_times = sample_times(t_end);
     j
+}
+
+/// `lme-mpm study disk`.
+pub struct DiskStudy;
+
+impl Study for DiskStudy {
+    fn slug(&self) -> &'static str {
+        "disk"
+    }
+
+    fn help(&self) -> &'static str {
+        "Rolling disk: linear, uGIMP, LME γ = 2.8, bspline2 × 3 time steps; error against wall \
+         time beside the paper's Table 1"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {

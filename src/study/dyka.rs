@@ -5,6 +5,7 @@
 //! NPC (Fig. 8), the γ sweep (Fig. 9) and uGIMP vs LME (Fig. 10).
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{Method, backend_slug, backends_of, image, sig, table};
 use crate::cases::{DYKA_BAR, DYKA_L};
 use crate::chart::{LineChart, Series};
@@ -81,6 +82,32 @@ pub fn bar_at(j: Job, h: f64) -> Job {
             DYKA_L / 2.0,
             h / 2.0
         ))
+}
+
+/// `lme-mpm study dyka`.
+pub struct DykaStudy;
+
+impl Study for DykaStudy {
+    fn slug(&self) -> &'static str {
+        "dyka"
+    }
+
+    fn help(&self) -> &'static str {
+        "Dyka's bar: 7 cell sizes × linear, uGIMP, LME γ = 2, 3, 4 × FE, NPC"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {

@@ -18,8 +18,12 @@
 //!   reason and the time it reached.
 //!
 //! Every run is on the CPU: the implicit step has no GPU twin.
+//!
+//! `study gmm` (`gmm.rs`) runs the GMM rows alone on this file's jobs and
+//! report parts (`pub(super)`), so nothing here names it.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{image, sig, table};
 use crate::cases::{CANTILEVER, ROLLING_DISK};
 use crate::error::Result;
@@ -130,7 +134,7 @@ const PAPER_TABLE1: [(&str, [f64; 3]); 5] = [
 
 const SCHEMES: [&str; 2] = ["implicit", "explicit"];
 
-fn cantilever_h(quick: bool) -> &'static [f64] {
+pub(super) fn cantilever_h(quick: bool) -> &'static [f64] {
     if quick {
         &CANTILEVER_H_QUICK
     } else {
@@ -203,7 +207,7 @@ fn hold_times() -> Vec<f64> {
 
 /// A cantilever run: implicit static in one load step, or NPC under the
 /// ramped gravity held to the end of the window.
-fn cantilever_job(scheme: &str, (label, shape): (&str, &str), h: f64) -> Job {
+pub(super) fn cantilever_job(scheme: &str, (label, shape): (&str, &str), h: f64) -> Job {
     let mut j = Job::new(
         format!("cantilever-{scheme}-{label}-h{h}"),
         CANTILEVER,
@@ -253,6 +257,34 @@ fn gmm_cantilever_job((label, keys): (&str, &[&str]), h: f64) -> Job {
         j = j.set(*k);
     }
     j
+}
+
+/// `lme-mpm study implicit`.
+pub struct ImplicitStudy;
+
+impl Study for ImplicitStudy {
+    fn slug(&self) -> &'static str {
+        "implicit"
+    }
+
+    fn help(&self) -> &'static str {
+        "Implicit against explicit: the static cantilever (mesh study), Dyka's bar and the \
+         rolling disk, error against wall time per case, and the Newton iteration's cost split \
+         (CPU only)"
+    }
+
+    fn jobs(&self, quick: bool, _backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool) -> Vec<Job> {
@@ -449,7 +481,7 @@ fn gmm_disk_findings(md: &mut String, done: &DiskRuns, n: usize, quick: bool) {
 pub const GMM_DISK_FINEST: f64 = 1.0;
 
 /// The run whose tags include every (key, value) of `tags`.
-fn find<'a>(results: &'a [JobResult], tags: &[(&str, &str)]) -> Option<&'a JobResult> {
+pub(super) fn find<'a>(results: &'a [JobResult], tags: &[(&str, &str)]) -> Option<&'a JobResult> {
     results
         .iter()
         .find(|r| tags.iter().all(|(k, v)| r.job.tag_value(k) == Some(*v)))
@@ -493,7 +525,7 @@ fn hold_statistics(r: &JobResult) -> Option<(f64, f64)> {
 }
 
 /// Relative error against the paper's 0.67433 m.
-fn cantilever_error(r: &JobResult) -> Option<f64> {
+pub(super) fn cantilever_error(r: &JobResult) -> Option<f64> {
     deflection(r).map(|v| (v - PAPER_NONLINEAR).abs() / PAPER_NONLINEAR)
 }
 
@@ -505,7 +537,7 @@ fn dyka_error(r: &JobResult) -> Option<(f64, f64)> {
     }
 }
 
-fn wall(r: &JobResult) -> String {
+pub(super) fn wall(r: &JobResult) -> String {
     r.data().map_or("-".into(), |d| sig(d.wall_seconds))
 }
 
@@ -524,15 +556,19 @@ fn list(v: &[f64]) -> String {
         .join(", ")
 }
 
-/// What every part of the report reads.
-struct Report<'a> {
-    results: &'a [JobResult],
-    quick: bool,
-    dir: &'a Path,
+/// What every part of the report reads (this study's and `study gmm`'s).
+pub(super) struct Report<'a> {
+    pub(super) results: &'a [JobResult],
+    pub(super) quick: bool,
+    pub(super) dir: &'a Path,
 }
 
 /// The rolling disk with one of `SHAPES` at the three Δt of `scheme`.
-fn disk_jobs(scheme: &str, (label, shape): (&'static str, &'static str), quick: bool) -> Vec<Job> {
+pub(super) fn disk_jobs(
+    scheme: &str,
+    (label, shape): (&'static str, &'static str),
+    quick: bool,
+) -> Vec<Job> {
     let b = BackendChoice::Cpu;
     let mut out = Vec::new();
     for (k, dt) in disk_steps(scheme, quick).into_iter().enumerate() {
@@ -553,7 +589,7 @@ fn disk_jobs(scheme: &str, (label, shape): (&'static str, &'static str), quick: 
 }
 
 /// GMM's rolling disk runs (`DISK_GMM`), implicit at the three Δt.
-fn gmm_disk_jobs(quick: bool) -> Vec<Job> {
+pub(super) fn gmm_disk_jobs(quick: bool) -> Vec<Job> {
     let mut out = Vec::new();
     for (label, keys) in DISK_GMM {
         for mut j in disk_jobs("implicit", (label, "lme"), quick) {
@@ -567,7 +603,7 @@ fn gmm_disk_jobs(quick: bool) -> Vec<Job> {
 }
 
 /// GMM's cantilever runs (the implicit study's GMM rows).
-fn gmm_only_jobs(quick: bool) -> Vec<Job> {
+pub(super) fn gmm_only_jobs(quick: bool) -> Vec<Job> {
     let mut out = Vec::new();
     for &h in gmm_h(quick).iter().rev() {
         for m in GMM_METHODS {
@@ -575,38 +611,6 @@ fn gmm_only_jobs(quick: bool) -> Vec<Job> {
         }
     }
     out
-}
-
-/// `lme-mpm study gmm`: GMM's cantilever runs, and implicit MPM with Q4
-/// on the same scenes for the cost per step (seconds in all); and the
-/// rolling disk, GMM's four bases and implicit MPM with Q4 at the three
-/// Δt (the implicit study's disk rows without its explicit and B-spline
-/// runs; 16 minutes on 2 cores on 2026-11-28; `--quick`: Δt1 to 0.03 s).
-pub fn gmm_jobs(quick: bool) -> Vec<Job> {
-    // The longest first, so they do not trail.
-    let mut out: Vec<Job> = gmm_disk_jobs(quick).into_iter().rev().collect();
-    out.extend(disk_jobs("implicit", SHAPES[0], quick));
-    out.extend(gmm_only_jobs(quick));
-    for &h in cantilever_h(quick).iter().rev() {
-        out.push(cantilever_job("implicit", SHAPES[0], h));
-    }
-    out
-}
-
-/// `lme-mpm study gmm`'s section.
-pub fn gmm_report(
-    results: &[JobResult],
-    dir: &Path,
-    quick: bool,
-) -> Result<(String, Vec<PathBuf>)> {
-    let r = Report {
-        results,
-        quick,
-        dir,
-    };
-    let mut md = String::new();
-    let charts = r.gmm_section(&mut md)?;
-    Ok((md, charts))
 }
 
 pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String, Vec<PathBuf>)> {
@@ -637,7 +641,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
 }
 
 impl Report<'_> {
-    fn cant(&self, scheme: &str, method: &str, h: f64) -> Option<&JobResult> {
+    pub(super) fn cant(&self, scheme: &str, method: &str, h: f64) -> Option<&JobResult> {
         let h = h.to_string();
         find(
             self.results,
@@ -651,7 +655,7 @@ impl Report<'_> {
     }
 
     /// The runs of a scheme and method, (h, run), coarsest first.
-    fn runs(&self, scheme: &str, method: &str) -> Vec<(f64, &JobResult)> {
+    pub(super) fn runs(&self, scheme: &str, method: &str) -> Vec<(f64, &JobResult)> {
         let hs = if is_gmm(method) {
             gmm_h(self.quick)
         } else if scheme == "implicit" {
@@ -665,7 +669,7 @@ impl Report<'_> {
     }
 
     /// (h, value) over the cell sizes where `value` is known, coarsest first.
-    fn over_h(
+    pub(super) fn over_h(
         &self,
         scheme: &str,
         method: &str,
@@ -881,7 +885,7 @@ impl Report<'_> {
     /// Self-convergence of `method`'s implicit cantilever from its three
     /// finest runs: (order of the finest pair of differences, Richardson
     /// limit (m), finest h (m), its deflection (m)).
-    fn richardson(&self, method: &str) -> Option<(f64, f64, f64, f64)> {
+    pub(super) fn richardson(&self, method: &str) -> Option<(f64, f64, f64, f64)> {
         let defl = self.over_h("implicit", method, deflection);
         let n = defl.len();
         if n < 3 {
@@ -892,148 +896,11 @@ impl Report<'_> {
         Some((p, c + (c - b) / (2f64.powf(p) - 1.0), defl[n - 1].0, c))
     }
 
-    /// `lme-mpm study gmm`: GMM's cantilever runs alone, their table, mesh
-    /// chart and acceptance.
-    fn gmm_section(&self, md: &mut String) -> Result<Vec<PathBuf>> {
-        let _ = writeln!(
-            md,
-            "### GMM on the static cantilever\n\nThe static cantilever (`cases/cantilever.toml`, one load step) on \
-             GMM's node cloud instead of the grid, the paper's §5.1 settings; the same runs are rows of \
-             `lme-mpm study implicit`'s cantilever beside implicit MPM.\n"
-        );
-        let header: Vec<String> = [
-            "method",
-            "h (m)",
-            "particles",
-            "Newton iterations",
-            "deflection (m)",
-            "error vs 0.67433 (%)",
-            "wall (s)",
-        ]
-        .map(String::from)
-        .to_vec();
-        let mut rows = Vec::new();
-        for (m, _) in GMM_METHODS {
-            for (h, r) in self.runs("implicit", m) {
-                let d = r.data();
-                rows.push(vec![
-                    m.to_string(),
-                    sig(h),
-                    d.map_or("-".into(), |d| d.particles.to_string()),
-                    d.and_then(|d| d.newton.as_ref())
-                        .map_or("-".into(), |n| n.iterations.to_string()),
-                    deflection(r).map_or_else(|| super::failure_text(r), |v| format!("{v:.5}")),
-                    cantilever_error(r).map_or("-".into(), |e| sig(100.0 * e)),
-                    wall(r),
-                ]);
-            }
-        }
-        md.push_str(&table(&header, &rows));
-        md.push('\n');
-        let pct = |r: &JobResult| cantilever_error(r).map(|e| 100.0 * e);
-        let mut curves = Vec::new();
-        for (k, (m, _)) in GMM_METHODS.iter().enumerate() {
-            let defl = self.over_h("implicit", m, deflection);
-            curves.push(Curve {
-                label: format!("{m} vs 0.67433"),
-                points: self.over_h("implicit", m, pct),
-                color: k,
-                dashed: false,
-            });
-            curves.push(Curve {
-                label: format!("{m} |δ(h) − δ(h/2)|"),
-                points: defl
-                    .windows(2)
-                    .map(|w| (w[0].0, 100.0 * (w[0].1 - w[1].1).abs() / PAPER_NONLINEAR))
-                    .collect(),
-                color: k,
-                dashed: true,
-            });
-        }
-        let (charts, orders) = report::convergence_chart(
-            "Cantilever on GMM's node cloud: free-end deflection error against cell size",
-            "cell size h (m)",
-            "error relative to 0.67433 m (%)",
-            &curves,
-            &self.dir.join("study-gmm-cantilever-mesh"),
-        )?;
-        md.push_str(&image(
-            "GMM cantilever error against cell size",
-            "study-gmm-cantilever-mesh.png",
-        ));
-        let fitted: Vec<String> = curves
-            .iter()
-            .zip(&orders)
-            .filter_map(|(c, p)| Some(format!("{}: {:.2}", c.label, (*p)?)))
-            .collect();
-        let _ = writeln!(
-            md,
-            "\n**Orders.** Least-squares slopes over all cell sizes: {}.\n",
-            fitted.join("; ")
-        );
-        let gmm: Vec<_> = GMM_METHODS
-            .iter()
-            .filter_map(|(m, _)| self.richardson(m).map(|(p, l, h, d)| (*m, p, l, h, d)))
-            .collect();
-        self.gmm_acceptance(md, &gmm);
-        self.gmm_cost(md);
-        let mut charts = charts;
-        if find(self.results, &[("case", "disk")]).is_some() {
-            charts.extend(self.disk(md, "study-gmm-disk-time")?);
-            self.cost(md);
-        }
-        Ok(charts)
-    }
-
-    /// GMM's cost against implicit MPM's (Q4) on the same scene: one
-    /// static step each, so the run's stepping time is the step's.
-    fn gmm_cost(&self, md: &mut String) {
-        let (q4, _) = SHAPES[0];
-        let mut rows = Vec::new();
-        for (h, r) in self.runs("implicit", q4) {
-            let Some(base) = r.data().map(|d| d.wall_seconds) else {
-                continue;
-            };
-            let mut row = vec![
-                sig(h),
-                sig(base),
-                cantilever_error(r).map_or("-".into(), |e| sig(100.0 * e)),
-            ];
-            for (m, _) in GMM_METHODS {
-                row.push(
-                    self.cant("implicit", m, h)
-                        .and_then(|g| g.data())
-                        .map_or("-".into(), |d| {
-                            format!("{} ({}×)", sig(d.wall_seconds), sig(d.wall_seconds / base))
-                        }),
-                );
-            }
-            rows.push(row);
-        }
-        let header: Vec<String> = [
-            "h (m)",
-            "MPM Q4 step (s)",
-            "MPM Q4 error (%)",
-            "GMM-LME step (s)",
-            "GMM-MLS step (s)",
-        ]
-        .map(String::from)
-        .to_vec();
-        let _ = writeln!(
-            md,
-            "\n**Cost.** One static step each (the run's stepping time), GMM against implicit MPM with Q4 on the \
-             same scene; runs share the machine with each other (`--jobs`) and any other work, so compare within a row. The paper measured GMM \
-             +10 % (MLS) and +8.5 to 16 % (LME) over MPM on the rolling disk. GMM pays for its neighbour search \
-             and basis over clouds of about 6 nodes (Q4: 4), and a Jacobian with more couplings.\n\n{}",
-            table(&header, &rows)
-        );
-    }
-
     /// GMM's mesh study against the issue's acceptance, and the paper's
     /// observation (GMM-MLS below GMM-LME); `gmm` holds per method (label,
     /// order of the finest self-convergence pair, Richardson limit, finest
     /// h, its deflection).
-    fn gmm_acceptance(&self, md: &mut String, gmm: &[(&str, f64, f64, f64, f64)]) {
+    pub(super) fn gmm_acceptance(&self, md: &mut String, gmm: &[(&str, f64, f64, f64, f64)]) {
         let _ = writeln!(
             md,
             "**GMM** (issue 27; implicit-MPM paper §4.2, Algorithm 2): the node cloud is the lattice of `grid.h` \
@@ -1317,7 +1184,7 @@ impl Report<'_> {
     /// (chart `<chart>.png`), failed runs included; a method none of whose
     /// runs is in the results (`study gmm` runs no explicit disk) has no
     /// row.
-    fn disk(&self, md: &mut String, chart: &str) -> Result<Vec<PathBuf>> {
+    pub(super) fn disk(&self, md: &mut String, chart: &str) -> Result<Vec<PathBuf>> {
         let scene = Scene::from_str(ROLLING_DISK, "rolling_disk", "rolling_disk", &[])?;
         let exact = RollingDisk::from_scene(&scene);
         let m = scene.materials().next().expect("the disk has a material").1;
@@ -1481,7 +1348,7 @@ impl Report<'_> {
 
     /// Where the implicit runs' time went: per Newton iteration, assembly
     /// (residual and Jacobian) against the sparse LU.
-    fn cost(&self, md: &mut String) {
+    pub(super) fn cost(&self, md: &mut String) {
         let header: Vec<String> = [
             "run",
             "steps",

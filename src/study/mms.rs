@@ -22,6 +22,7 @@
 //! by label) and `LME_MPM_MMS_E=1e7` (readings).
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{backend_slug, backends_of, image, sig, table};
 use crate::cases::ALIGNED_VIBRATION;
 use crate::error::{Error, Result};
@@ -230,6 +231,34 @@ pub fn job(
     }
     j.backend = backend;
     j
+}
+
+/// `lme-mpm study mms`.
+pub struct MmsStudy;
+
+impl Study for MmsStudy {
+    fn slug(&self) -> &'static str {
+        "mms"
+    }
+
+    fn help(&self) -> &'static str {
+        "Manufactured aligned vibration, the B-spline paper's study: 8–64 cells × linear, \
+         bspline2/3 with and without MLS, the paper's update, E = 1e7 and 1e8 Pa (hours on 2 \
+         cores; `LME_MPM_MMS_CELLS` restricts it)"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        jobs(quick, backends)
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {

@@ -8,13 +8,17 @@ pub mod column;
 pub mod contact;
 pub mod disk;
 pub mod dyka;
+pub mod gmm;
 pub mod granular;
 pub mod implicit;
 pub mod mms;
 pub mod plate;
 pub mod results;
 pub mod runner;
+pub mod spec;
 pub mod stability;
+
+pub use spec::Study;
 
 pub use results::{
     Method, backend_slug, backends_of, failure_text, find_tagged, image, main_backend, on_backend,
@@ -26,68 +30,79 @@ use crate::simulation::BackendChoice;
 use crate::sweep::record::Record;
 use std::path::{Path, PathBuf};
 
-/// Which study.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum StudyName {
-    /// Dyka's bar: 7 cell sizes × linear, uGIMP, LME γ = 2, 3, 4 × FE, NPC.
-    Dyka,
-    /// Elastic block: linear, uGIMP, LME γ = 0.8 and 3 (NPC).
-    Block,
-    /// 2D plate impact: FE vs NPC fields; regular vs perturbed grids.
-    PlateImpact,
-    /// Stability map: shape × integrator × case × resolution.
-    Stability,
-    /// Manufactured aligned vibration, the B-spline paper's study: 8–64
-    /// cells × linear, bspline2/3 with and without MLS, the paper's update,
-    /// E = 1e7 and 1e8 Pa (hours on 2 cores; `LME_MPM_MMS_CELLS` restricts it).
-    Mms,
-    /// Rolling disk: linear, uGIMP, LME γ = 2.8, bspline2 × 3 time steps;
-    /// error against wall time beside the paper's Table 1.
-    Disk,
-    /// Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both,
-    /// profiles, run-out (1 h 40 min on 2 cores on 2026-11-29, GMM on
-    /// mesh 2 the longest run, on one thread the whole time).
-    Column,
-    /// Cohesionless column collapse from geostatic rest behind a gate:
-    /// run-out against the experimental scaling 1.2 H/W for H/W = 0.5, 1
-    /// and 2, 4 shapes, pure FLIP and 1 % PIC (about 5 minutes on one core).
-    Granular,
-    /// Implicit against explicit: the static cantilever (mesh study), Dyka's
-    /// bar and the rolling disk, error against wall time per case, and the
-    /// Newton iteration's cost split (CPU only).
-    Implicit,
-    /// Contact between bodies: block on a slab (μ = 0–0.7), two disks
-    /// colliding head-on and off-centre, a disk rolling on an elastic slab
-    /// (R/h = 10–40), each beside the single shared field; a strip footing
-    /// on a Tresca soil against Prandtl's 5.14 c, smooth and rough, three
-    /// grids (full run only) (CPU; about 15 minutes, --quick about 1).
-    Contact,
-    /// The Galerkin meshfree method: the static cantilever (GMM-LME and
-    /// GMM-MLS, h = 0.5 … 0.03125, self-convergence and Richardson) and
-    /// the rolling disk (GMM-LME γ = 0.8, 1.8, 2.8, GMM-MLS and implicit
-    /// MPM Q4 × 3 time steps), the implicit study's GMM rows alone (about
-    /// 20 minutes on 2 cores; --quick: seconds).
-    Gmm,
-    /// All of them, in that order.
-    All,
+/// The studies, one line each: `StudyName`'s variant and the study (its
+/// file's `impl Study`), in the order of `lme-mpm study --help` and of
+/// `all`. The CLI's names and help, `all` and the dispatch of jobs and
+/// reports follow from this list; a new study is its file, its `pub mod`
+/// above and one line here.
+macro_rules! studies {
+    ($($name:ident => $study:expr),* $(,)?) => {
+        /// Which study.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub enum StudyName {
+            $($name,)*
+            /// All of them, in that order.
+            All,
+        }
+
+        /// Every study, in `StudyName`'s order (`all` aside).
+        pub const STUDIES: &[&dyn Study] = &[$(&$study),*];
+
+        impl StudyName {
+            /// Every name the CLI takes, in its order, `all` last.
+            pub const NAMES: &[StudyName] = &[$(StudyName::$name,)* StudyName::All];
+        }
+    };
 }
 
+studies! {
+    Dyka => dyka::DykaStudy,
+    Block => block::BlockStudy,
+    PlateImpact => plate::PlateImpactStudy,
+    Stability => stability::StabilityStudy,
+    Mms => mms::MmsStudy,
+    Disk => disk::DiskStudy,
+    Column => column::ColumnStudy,
+    Granular => granular::GranularStudy,
+    Implicit => implicit::ImplicitStudy,
+    Contact => contact::ContactStudy,
+    Gmm => gmm::GmmStudy,
+}
+
+/// `all`'s line in `lme-mpm study --help`.
+const ALL_HELP: &str = "All of them, in that order";
+
 impl StudyName {
+    /// The study; None for `all`.
+    pub fn study(self) -> Option<&'static dyn Study> {
+        STUDIES.get(self as usize).copied()
+    }
+
     pub fn slug(self) -> &'static str {
+        self.study().map_or("all", |s| s.slug())
+    }
+
+    /// Its line in `lme-mpm study --help`.
+    pub fn help(self) -> &'static str {
+        self.study().map_or(ALL_HELP, |s| s.help())
+    }
+
+    /// The studies it runs: itself, or every one for `all`.
+    pub fn each(self) -> Vec<StudyName> {
         match self {
-            StudyName::Dyka => "dyka",
-            StudyName::Block => "block",
-            StudyName::PlateImpact => "plate-impact",
-            StudyName::Stability => "stability",
-            StudyName::Mms => "mms",
-            StudyName::Disk => "disk",
-            StudyName::Column => "column",
-            StudyName::Granular => "granular",
-            StudyName::Implicit => "implicit",
-            StudyName::Contact => "contact",
-            StudyName::Gmm => "gmm",
-            StudyName::All => "all",
+            StudyName::All => StudyName::NAMES[..STUDIES.len()].to_vec(),
+            n => vec![n],
         }
+    }
+}
+
+impl clap::ValueEnum for StudyName {
+    fn value_variants<'a>() -> &'a [Self] {
+        StudyName::NAMES
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.slug()).help(self.help()))
     }
 }
 
@@ -154,41 +169,14 @@ pub fn backends(b: StudyBackend) -> Vec<BackendChoice> {
 
 /// Runs one study (or all) and writes its outputs.
 pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
-    let names = match name {
-        StudyName::All => vec![
-            StudyName::Dyka,
-            StudyName::Block,
-            StudyName::PlateImpact,
-            StudyName::Stability,
-            StudyName::Mms,
-            StudyName::Disk,
-            StudyName::Column,
-            StudyName::Granular,
-            StudyName::Implicit,
-            StudyName::Contact,
-            StudyName::Gmm,
-        ],
-        n => vec![n],
-    };
+    let names = name.each();
     let backends = backends(opts.backend);
     let mut reports = Vec::new();
     for n in names {
         let dir = opts.out.join(n.slug());
         std::fs::create_dir_all(&dir).map_err(|e| Error::io("cannot create", &dir, e))?;
-        let jobs = match n {
-            StudyName::Dyka => dyka::jobs(opts.quick, &backends),
-            StudyName::Block => block::jobs(opts.quick, &backends),
-            StudyName::PlateImpact => plate::jobs(opts.quick, &backends),
-            StudyName::Stability => stability::jobs(opts.quick, &backends),
-            StudyName::Mms => mms::jobs(opts.quick, &backends)?,
-            StudyName::Disk => disk::jobs(opts.quick, &backends),
-            StudyName::Column => column::jobs(opts.quick, &backends),
-            StudyName::Granular => granular::jobs(opts.quick, &backends),
-            StudyName::Implicit => implicit::jobs(opts.quick),
-            StudyName::Contact => contact::jobs(opts.quick, &backends),
-            StudyName::Gmm => implicit::gmm_jobs(opts.quick),
-            StudyName::All => unreachable!(),
-        };
+        let study = n.study().expect("each names the studies, not all");
+        let jobs = study.jobs(opts.quick, &backends)?;
         if opts.progress || opts.progress_lines {
             crate::say!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
@@ -204,20 +192,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             &dir.join("results.csv"),
             crate::sweep::report::csv(&records).as_bytes(),
         )?;
-        let (markdown, charts) = match n {
-            StudyName::Dyka => dyka::report(&results, &dir, opts.quick)?,
-            StudyName::Block => block::report(&results, &dir, opts.quick)?,
-            StudyName::PlateImpact => plate::report(&results, &dir, opts.quick)?,
-            StudyName::Stability => stability::report(&results, &dir, opts.quick)?,
-            StudyName::Mms => mms::report(&results, &dir, opts.quick)?,
-            StudyName::Disk => disk::report(&results, &dir, opts.quick)?,
-            StudyName::Column => column::report(&results, &dir, opts.quick)?,
-            StudyName::Granular => granular::report(&results, &dir, opts.quick)?,
-            StudyName::Implicit => implicit::report(&results, &dir, opts.quick)?,
-            StudyName::Contact => contact::report(&results, &dir, opts.quick)?,
-            StudyName::Gmm => implicit::gmm_report(&results, &dir, opts.quick)?,
-            StudyName::All => unreachable!(),
-        };
+        let (markdown, charts) = study.report(&results, &dir, opts.quick)?;
         // The charts sit beside report.md; the markdown links them in
         // `charts/` as the docs keep them.
         let local = markdown.replace("](charts/", "](");
@@ -268,4 +243,36 @@ fn publish(
         crate::bench::machine()
     );
     crate::docgen::replace_section(doc, name, &(stamp + &markdown))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::ValueEnum;
+
+    /// One list: every study once under a slug of its own, `StudyName` in
+    /// its order, and the CLI's names its slugs then `all`.
+    #[test]
+    fn the_study_list_names_the_cli() {
+        let slugs: Vec<&str> = STUDIES.iter().map(|s| s.slug()).collect();
+        let unique: std::collections::BTreeSet<&str> = slugs.iter().copied().collect();
+        assert_eq!(unique.len(), slugs.len(), "{slugs:?}");
+        assert!(!unique.contains("all"), "{slugs:?}");
+        for (k, n) in StudyName::NAMES.iter().enumerate() {
+            assert_eq!(n.study().map(|s| s.slug()), slugs.get(k).copied(), "{n:?}");
+            assert_eq!(StudyName::from_str(n.slug(), false), Ok(*n));
+            let help = n.help();
+            assert!(!help.is_empty() && !help.ends_with('.'), "{n:?}: {help}");
+        }
+        let cli: Vec<String> = StudyName::value_variants()
+            .iter()
+            .map(|n| n.to_possible_value().unwrap().get_name().to_string())
+            .collect();
+        let mut want: Vec<String> = slugs.iter().map(|s| s.to_string()).collect();
+        want.push("all".into());
+        assert_eq!(cli, want);
+        let each: Vec<&str> = StudyName::All.each().iter().map(|n| n.slug()).collect();
+        assert_eq!(each, slugs);
+        assert_eq!(StudyName::Gmm.each(), vec![StudyName::Gmm]);
+    }
 }

@@ -6,6 +6,7 @@
 //! departs from its regular twin.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{backend_slug, image, sig, table};
 use crate::cases::PLATE_IMPACT;
 use crate::chart::{Panel, ParticleImage};
@@ -47,6 +48,32 @@ fn job(b: BackendChoice, quick: bool, shape: &str, integrator: &str, perturbed: 
     }
     j.keep_final = true;
     j
+}
+
+/// `lme-mpm study plate-impact`.
+pub struct PlateImpactStudy;
+
+impl Study for PlateImpactStudy {
+    fn slug(&self) -> &'static str {
+        "plate-impact"
+    }
+
+    fn help(&self) -> &'static str {
+        "2D plate impact: FE vs NPC fields; regular vs perturbed grids"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
+    }
 }
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {

@@ -4,6 +4,7 @@
 //! grid image.
 
 use super::runner::{Job, JobResult};
+use super::spec::Study;
 use super::{backend_slug, image, sig, table};
 use crate::cases::{
     CLAY_BIAXIAL, COLUMN_COLLAPSE, DYKA_BAR, ELASTIC_BLOCK, PLATE_IMPACT, ROLLING_DISK,
@@ -100,6 +101,32 @@ pub fn columns(quick: bool) -> Vec<Column> {
             c("column_collapse", 0.05, 0.0),
             c("clay_biaxial", 0.125, 0.0),
         ]
+    }
+}
+
+/// `lme-mpm study stability`.
+pub struct StabilityStudy;
+
+impl Study for StabilityStudy {
+    fn slug(&self) -> &'static str {
+        "stability"
+    }
+
+    fn help(&self) -> &'static str {
+        "Stability map: shape × integrator × case × resolution"
+    }
+
+    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
+        Ok(jobs(quick, backends))
+    }
+
+    fn report(
+        &self,
+        results: &[JobResult],
+        dir: &Path,
+        quick: bool,
+    ) -> Result<(String, Vec<PathBuf>)> {
+        report(results, dir, quick)
     }
 }
 
