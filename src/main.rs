@@ -158,9 +158,10 @@ struct RenderArgs {
     /// The run's output folder (holding particles.pvd and vtk/).
     dir: PathBuf,
     /// What colours the particles: speed (m/s), stress (von Mises, Pa),
-    /// pressure (Pa, positive in compression), eps_p (equivalent plastic
-    /// strain; Mohr-Coulomb, Drucker-Prager), p_c (preconsolidation
-    /// pressure, Pa; modified Cam-clay), displacement (m, from the start).
+    /// pressure (Pa, positive in compression), a material's state column
+    /// (as its particles.csv column: eps_p, eps_pv for Mohr-Coulomb and
+    /// Drucker-Prager; p_c, v for modified Cam-clay), displacement (m, from
+    /// the start).
     #[arg(long, value_enum, default_value_t = lme_mpm::output::render::Field::Speed)]
     field: lme_mpm::output::render::Field,
     /// Frames per second of the animation, 0.1 to 50 (a GIF's delays are

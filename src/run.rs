@@ -9,6 +9,7 @@ use crate::model::Model;
 use crate::model::shape::Shape;
 use crate::output::checkpoint::{self, Checkpoint};
 use crate::output::folder::Folder;
+use crate::output::state::StateLayout;
 use crate::output::{self, csv, summary::Summary, vtk};
 use crate::scene::{Override, Scene};
 pub use crate::simulation::BackendChoice;
@@ -280,7 +281,7 @@ fn finish(
     if scene.file.output.particles_csv {
         writer.write(
             "particles.csv",
-            csv::particles(&model.body_names, particles).as_bytes(),
+            csv::particles(&model.body_names, &StateLayout::of(model), particles).as_bytes(),
         )?;
     }
     let out = &scene.file.output;
@@ -416,8 +417,8 @@ struct Writer {
     /// When driving started, with the time and steps then.
     started: Option<(Instant, f64, u64)>,
     resumed_from: Option<f64>,
-    /// σzz of the VTK stress tensor, per body.
-    out_of_plane: vtk::OutOfPlane,
+    /// σzz of the VTK stress tensor and the materials' state columns, per body.
+    state: StateLayout,
 }
 
 /// Rewrite the CSV files at most this often while running.
@@ -460,7 +461,7 @@ impl Writer {
             lines: opts.progress_lines.then(|| (0, Instant::now())),
             started: None,
             resumed_from: None,
-            out_of_plane: vtk::OutOfPlane::of(model),
+            state: StateLayout::of(model),
         };
         let o = &scene.file.output;
         if o.vtk_final || o.vtk_interval.is_some() {
@@ -532,7 +533,7 @@ impl Writer {
         let vdir = self.folder.path("vtk");
         std::fs::create_dir_all(&vdir).map_err(|e| Error::io("cannot create", &vdir, e))?;
         let name = format!("vtk/particles_{:05}.vtu", self.snapshots.len());
-        self.write(&name, &vtk::particles_vtu(particles, &self.out_of_plane, t))?;
+        self.write(&name, &vtk::particles_vtu(particles, &self.state, t))?;
         self.snapshots.push((t, name));
         self.write_pvd()?;
         self.io_seconds += t0.elapsed().as_secs_f64();

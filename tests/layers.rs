@@ -248,3 +248,68 @@ fn import_parser_sees_groups_and_paths() {
     let got: Vec<String> = imports(text).into_iter().collect();
     assert_eq!(got, ["cpu", "error", "gpu", "model"]);
 }
+
+/// The `Material` variants `register!` declares in
+/// `src/model/material/mod.rs`: the `Variant(module::Type)` lines of its
+/// invocation.
+fn registered_variants(src: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(src.join("model/material/mod.rs")).unwrap();
+    let start = text
+        .find("\nregister! {")
+        .expect("the register! invocation");
+    let body = &text[start..];
+    let body = &body[..body.find("\n}").expect("its end")];
+    body.lines()
+        .skip(2)
+        .filter_map(|l| {
+            let l = l.trim();
+            let (variant, rest) = l.split_once('(')?;
+            rest.contains("::").then(|| variant.to_string())
+        })
+        .collect()
+}
+
+/// A material is its own files and one line of `register!`
+/// (docs/architecture.md, "Adding a material"): no file outside
+/// `src/model/material/` matches on a `Material` variant (σzz, state
+/// columns, name lists all come through `Constitutive` and the registry).
+#[test]
+fn materials_are_matched_only_in_their_own_files() {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src");
+    let variants = registered_variants(&src);
+    for v in [
+        "LinearElastic",
+        "NeoHookean",
+        "MohrCoulomb",
+        "DruckerPrager",
+        "ModifiedCamClay",
+    ] {
+        assert!(variants.iter().any(|r| r == v), "{v} in {variants:?}");
+    }
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let own = src.join("model").join("material");
+    let mut found = Vec::new();
+    for f in files.iter().filter(|f| !f.starts_with(&own)) {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for v in &variants {
+                let pat = format!("Material::{v}");
+                let hit = code.match_indices(&pat).any(|(k, _)| {
+                    let after = code[k + pat.len()..].chars().next();
+                    !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
+                });
+                if hit {
+                    found.push(format!("{}:{}: {}", f.display(), n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "material variants named outside src/model/material/ (give the model a \
+         `Constitutive` item instead):\n{}",
+        found.join("\n")
+    );
+}

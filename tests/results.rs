@@ -176,6 +176,10 @@ fn cam_clay_is_labelled_by_its_preconsolidation_pressure() {
     assert!(pc.iter().all(|&x| x >= 0.99e5), "{:?}", &pc[..4]);
     assert!(v.get("specific_volume").is_some());
     assert!(v.get("plastic_strain_eq").is_none(), "no ε̄p for Cam-clay");
+    // So does particles.csv: p_c and v, not the strain columns' names.
+    let csv = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.ends_with(",szz,p_c,v,plastic"), "{header}");
     // `render` colours by p_c and refuses eps_p, naming p_c.
     let r = bin()
         .arg("render")

@@ -919,10 +919,14 @@ fn geostatic_start(
         if b.initial_stress == InitialStress::Geostatic {
             let own_start = m.initial_state() != ([0.0; 3], [0.0; 4]);
             if m.needs_deformation_gradient() || own_start {
+                let stress_only = material::names_where(|e| {
+                    e.state != material::StateKind::DefGrad && !e.own_start
+                });
                 return Err(SceneError::invalid(
                     format!("bodies.{name}.initial_stress"),
                     format!(
-                        "= \"geostatic\" needs a material whose state is its stress (linear_elastic, mohr_coulomb, drucker_prager); model = \"{}\" {}",
+                        "= \"geostatic\" needs a material whose state is its stress ({}); model = \"{}\" {}",
+                        stress_only.join(", "),
                         m.entry().name,
                         if own_start {
                             "starts at a stress of its own"

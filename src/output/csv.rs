@@ -4,6 +4,7 @@
 
 use crate::backend::Sample;
 use crate::model::Particles;
+use crate::output::state::StateLayout;
 use std::fmt::Write;
 
 /// `t,probe,x,y,vx,vy,sxx,syy,sxy` (s, m, m/s, Pa), and for the implicit
@@ -78,19 +79,24 @@ pub fn reactions(names: &[String], samples: &[Sample]) -> String {
 }
 
 /// `id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume` (m, m/s, Pa, kg/m, m²),
-/// then with a plastic material `,szz,eps_p,eps_pv,plastic`: σzz (Pa),
-/// equivalent and volumetric plastic strain, and the surfaces active in the
-/// last step's return (bit mask, 0 = elastic; docs/outputs.md).
-/// `body_names` in scene order.
-pub fn particles(body_names: &[String], p: &Particles) -> String {
+/// then with a plastic material `,szz,<state columns>,plastic`: σzz (Pa),
+/// the columns the materials name (`StateLayout::columns`: `eps_p,eps_pv`
+/// for Mohr–Coulomb and Drucker–Prager, `p_c,v` for modified Cam-clay),
+/// and the surfaces active in the last step's return (bit mask, 0 =
+/// elastic; docs/outputs.md). `body_names` in scene order.
+pub fn particles(body_names: &[String], state: &StateLayout, p: &Particles) -> String {
     let plastic = !p.plastic.is_empty();
     let mut s = String::with_capacity(p.len() * if plastic { 240 } else { 160 } + 64);
     s.push_str("id,body,x0,y0,x,y,vx,vy,sxx,syy,sxy,mass,volume");
-    s.push_str(if plastic {
-        ",szz,eps_p,eps_pv,plastic\n"
-    } else {
-        "\n"
-    });
+    if plastic {
+        s.push_str(",szz");
+        for c in state.columns() {
+            s.push(',');
+            s.push_str(c.column);
+        }
+        s.push_str(",plastic");
+    }
+    s.push('\n');
     for i in 0..p.len() {
         let _ = write!(
             s,
@@ -111,7 +117,11 @@ pub fn particles(body_names: &[String], p: &Particles) -> String {
         );
         if plastic {
             let q = &p.plastic[i];
-            let _ = write!(s, ",{},{},{},{}", q[0], q[1], q[2], q[3] as u32);
+            let _ = write!(s, ",{}", q[0]);
+            for c in 0..state.columns().count() {
+                let _ = write!(s, ",{}", state.value(c, p, i));
+            }
+            let _ = write!(s, ",{}", q[3] as u32);
         }
         s.push('\n');
     }

@@ -8,6 +8,7 @@ pub mod csv;
 pub mod folder;
 pub mod render;
 pub mod result;
+pub mod state;
 pub mod summary;
 pub mod vtk;
 

@@ -14,6 +14,7 @@
 
 use crate::chart::register_font;
 use crate::error::{Error, Result};
+use crate::model::material::{self, StateColumn, state_columns};
 use crate::output::vtk::{Vtu, read_pvd, read_vtu};
 use crate::scene::Scene;
 use plotters::prelude::*;
@@ -21,8 +22,10 @@ use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
-/// What colours the particles.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+/// What colours the particles: a field of every run, or a state column
+/// of the registered materials (`Constitutive::STATE_COLUMNS`, by its
+/// `column` name: ε̄p `eps_p`, p_c `p_c`, ...).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Field {
     /// |v| (m/s).
     Speed,
@@ -30,14 +33,28 @@ pub enum Field {
     Stress,
     /// Pressure −(σxx + σyy + σzz)/3 (Pa; positive in compression).
     Pressure,
-    /// Equivalent plastic strain ε̄p (Mohr–Coulomb, Drucker–Prager).
-    #[value(name = "eps_p")]
-    EpsP,
-    /// Preconsolidation pressure p_c (Pa; modified Cam-clay).
-    #[value(name = "p_c")]
-    Pc,
+    /// A material's state column, from its VTU array.
+    State(StateColumn),
     /// |x − X|, the distance from the initial position (m).
     Displacement,
+}
+
+impl clap::ValueEnum for Field {
+    /// The run's fields, with every registered state column before
+    /// `displacement`.
+    fn value_variants<'a>() -> &'a [Self] {
+        static ALL: std::sync::OnceLock<Vec<Field>> = std::sync::OnceLock::new();
+        ALL.get_or_init(|| {
+            let mut all = vec![Field::Speed, Field::Stress, Field::Pressure];
+            all.extend(state_columns().into_iter().map(Field::State));
+            all.push(Field::Displacement);
+            all
+        })
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.slug()).help(self.label()))
+    }
 }
 
 impl Field {
@@ -46,20 +63,27 @@ impl Field {
             Field::Speed => "speed",
             Field::Stress => "stress",
             Field::Pressure => "pressure",
-            Field::EpsP => "eps_p",
-            Field::Pc => "p_c",
+            Field::State(c) => c.column,
             Field::Displacement => "displacement",
         }
     }
 
-    fn label(self) -> &'static str {
+    fn label(self) -> String {
         match self {
-            Field::Speed => "speed (m/s)",
-            Field::Stress => "von Mises stress (Pa)",
-            Field::Pressure => "pressure (Pa)",
-            Field::EpsP => "equivalent plastic strain",
-            Field::Pc => "preconsolidation pressure p_c (Pa)",
-            Field::Displacement => "displacement (m)",
+            Field::Speed => "speed (m/s)".into(),
+            Field::Stress => "von Mises stress (Pa)".into(),
+            Field::Pressure => "pressure (Pa)".into(),
+            Field::State(c) => c.label(),
+            Field::Displacement => "displacement (m)".into(),
+        }
+    }
+
+    /// Its colour scale starts at its least value, not at 0.
+    fn scale_at_least(self) -> bool {
+        match self {
+            Field::Pressure => true,
+            Field::State(c) => !c.from_zero,
+            _ => false,
         }
     }
 }
@@ -201,6 +225,37 @@ fn folder_error(msg: String) -> Error {
     Error::Folder(msg)
 }
 
+/// A state column the snapshot lacks: which models have it, and the state
+/// columns the snapshot holds instead.
+fn no_column(v: &Vtu, c: &StateColumn, path: &Path) -> Error {
+    let models = material::names_where(|e| e.state_columns.contains(c));
+    let held: Vec<StateColumn> = state_columns()
+        .into_iter()
+        .filter(|d| v.get(d.array).is_some())
+        .collect();
+    let instead = if held.is_empty() {
+        String::new()
+    } else {
+        let what: Vec<&str> = held.iter().map(|d| d.meaning).collect();
+        let fields: Vec<String> = held
+            .iter()
+            .map(|d| format!("--field {}", d.column))
+            .collect();
+        format!(
+            " (its materials carry {} instead: {})",
+            material::name_list(&what, "and"),
+            material::name_list(&fields.iter().map(String::as_str).collect::<Vec<_>>(), "or")
+        )
+    };
+    folder_error(format!(
+        "{}: no {}: --field {} needs a {} material{instead}",
+        path.display(),
+        c.meaning,
+        c.column,
+        material::name_list(&models, "or")
+    ))
+}
+
 /// The field's value per particle, from the arrays `particles_vtu` writes.
 fn values(v: &Vtu, field: Field, path: &Path) -> Result<Vec<f32>> {
     let n = v.n;
@@ -218,32 +273,9 @@ fn values(v: &Vtu, field: Field, path: &Path) -> Result<Vec<f32>> {
                 .ok_or_else(|| missing("displacement"))?;
             (0..n).map(|i| d[3 * i].hypot(d[3 * i + 1])).collect()
         }
-        Field::EpsP => v
-            .get("plastic_strain_eq")
-            .ok_or_else(|| {
-                let cam = if v.get("preconsolidation_pressure").is_some() {
-                    " (modified Cam-clay carries its preconsolidation pressure instead: \
-                     --field p_c)"
-                } else {
-                    ""
-                };
-                folder_error(format!(
-                    "{}: no plastic strain: --field eps_p needs a mohr_coulomb or \
-                     drucker_prager material{cam}",
-                    path.display()
-                ))
-            })?
-            .0
-            .to_vec(),
-        Field::Pc => v
-            .get("preconsolidation_pressure")
-            .ok_or_else(|| {
-                folder_error(format!(
-                    "{}: no preconsolidation pressure: --field p_c needs a \
-                     modified_cam_clay material",
-                    path.display()
-                ))
-            })?
+        Field::State(c) => v
+            .get(c.array)
+            .ok_or_else(|| no_column(v, &c, path))?
             .0
             .to_vec(),
         Field::Stress | Field::Pressure => {
@@ -712,7 +744,7 @@ pub fn render(dir: &Path, opts: &RenderOptions) -> Result<Rendered> {
     }
     // Magnitudes start at zero; p_c (about p′0 and up) and the pressure
     // keep their least value, so the scale spans what changes.
-    if lo >= 0.0 && !matches!(opts.field, Field::Pressure | Field::Pc) {
+    if lo >= 0.0 && !opts.field.scale_at_least() {
         lo = 0.0;
     }
     // A few outliers (a shear band's tip, a particle flung off) would

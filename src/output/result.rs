@@ -9,6 +9,7 @@ use crate::chart::{LineChart, Panel, ParticleImage, Series};
 use crate::error::{Error, Result};
 use crate::exact::Errors;
 use crate::model::Model;
+use crate::model::material::StateColumn;
 use crate::output::summary::Summary;
 use crate::scene::{ExactKind, Scene};
 use plotters::prelude::*;
@@ -650,35 +651,30 @@ fn cantilever(scene: &Scene, model: &Model) -> History {
     }
 }
 
-/// What colours the final particles: a plastic material's state where
-/// every plastic body has the same one (ε̄p for Mohr–Coulomb and
-/// Drucker–Prager, the preconsolidation pressure p_c for modified
-/// Cam-clay), else the displacement magnitude.
+/// What colours the final particles: the plastic materials' first state
+/// column where every plastic body has the same one (`STATE_COLUMNS`: ε̄p
+/// for Mohr–Coulomb and Drucker–Prager, the preconsolidation pressure p_c
+/// for modified Cam-clay), else the displacement magnitude.
 #[derive(Clone, Copy, PartialEq)]
 enum Colour {
-    PlasticStrain,
-    Preconsolidation,
+    State(StateColumn),
     Displacement,
 }
 
 fn colour_of(model: &Model) -> Colour {
-    use crate::model::material::Material;
     if model.particles.plastic.is_empty() {
         return Colour::Displacement;
     }
-    let plastic: Vec<bool> = model
+    let first: Vec<Option<StateColumn>> = model
         .body_material
         .iter()
         .map(|&m| &model.materials[m as usize])
         .filter(|m| m.needs_plastic_state())
-        .map(|m| matches!(m, Material::ModifiedCamClay(_)))
+        .map(|m| m.entry().state_columns.first().copied())
         .collect();
-    if plastic.iter().all(|&c| c) {
-        Colour::Preconsolidation
-    } else if plastic.iter().all(|&c| !c) {
-        Colour::PlasticStrain
-    } else {
-        Colour::Displacement
+    match first.first() {
+        Some(&Some(c)) if first.iter().all(|f| *f == Some(c)) => Colour::State(c),
+        _ => Colour::Displacement,
     }
 }
 
@@ -687,7 +683,7 @@ fn particles_panel(model: &Model, t: f64) -> ParticleImage {
     let p = &model.particles;
     let colour = colour_of(model);
     let value = |i: usize| match colour {
-        Colour::PlasticStrain | Colour::Preconsolidation => p.plastic[i][1],
+        Colour::State(_) => p.plastic[i][1],
         Colour::Displacement => (p.x[i][0] - p.x0[i][0]).hypot(p.x[i][1] - p.x0[i][1]),
     };
     let points: Vec<(f64, f64, f64)> = (0..p.len())
@@ -699,9 +695,10 @@ fn particles_panel(model: &Model, t: f64) -> ParticleImage {
             (a.min(q.2), b.max(q.2))
         });
     // Magnitudes start the scale at zero; p_c starts at its least.
+    let from_least = matches!(colour, Colour::State(c) if !c.from_zero);
     let range = match colour {
-        Colour::Preconsolidation if lo.is_finite() && hi > lo => (lo, hi),
-        Colour::Preconsolidation if lo.is_finite() => (lo, lo + lo.abs().max(1.0)),
+        _ if from_least && lo.is_finite() && hi > lo => (lo, hi),
+        _ if from_least && lo.is_finite() => (lo, lo + lo.abs().max(1.0)),
         _ if lo.is_finite() && hi > 0.0 => (0.0, hi),
         _ => (0.0, 1.0),
     };
@@ -715,8 +712,7 @@ fn particles_panel(model: &Model, t: f64) -> ParticleImage {
     ParticleImage {
         title: String::new(),
         value_label: match colour {
-            Colour::PlasticStrain => "ε̄p".into(),
-            Colour::Preconsolidation => "p_c (Pa)".into(),
+            Colour::State(c) => c.short_label(),
             Colour::Displacement => "|u| (m)".into(),
         },
         panels: vec![Panel {
@@ -724,8 +720,7 @@ fn particles_panel(model: &Model, t: f64) -> ParticleImage {
                 "particles at t = {} s, coloured by {}",
                 num(t),
                 match colour {
-                    Colour::PlasticStrain => "equivalent plastic strain",
-                    Colour::Preconsolidation => "preconsolidation pressure p_c",
+                    Colour::State(c) => c.meaning,
                     Colour::Displacement => "displacement magnitude",
                 }
             ),

@@ -4,94 +4,14 @@
 //! The format is small enough that a dependency would add more than it saves.
 //! `read_vtu` reads such a file back (`lme-mpm render`).
 
-use crate::model::material::Material;
-use crate::model::{Model, Particles};
+use crate::model::Particles;
+use crate::output::state::StateLayout;
 use std::fmt::Write;
 
-/// σzz of plane strain (εzz = 0), per body: what each material's law
-/// makes of it from the state a particle carries.
-#[derive(Debug, Clone, Default)]
-pub struct OutOfPlane {
-    rule: Vec<Szz>,
-    /// Per body: modified Cam-clay, whose plastic state holds p_c and v
-    /// where the other plastic laws hold ε̄p and εp_v.
-    cam_clay: Vec<bool>,
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Szz {
-    /// Linear elastic from a stress-free start: ν (σxx + σyy).
-    Linear { nu: f64 },
-    /// Neo-Hookean: λ ln J / J (b_zz = 1).
-    Neo { lame: f64, density: f64 },
-    /// The plastic laws carry it (`Particles::plastic[i][0]`).
-    Carried,
-    /// A law this does not know: 0.
-    Unknown,
-}
-
-impl OutOfPlane {
-    pub fn of(model: &Model) -> OutOfPlane {
-        let rule = model
-            .body_material
-            .iter()
-            .map(|&m| match &model.materials[m as usize] {
-                Material::LinearElastic(e) => Szz::Linear { nu: e.nu },
-                Material::NeoHookean(e) => Szz::Neo {
-                    lame: e.lame,
-                    density: e.density,
-                },
-                // The plastic laws (Mohr–Coulomb, Drucker–Prager,
-                // modified Cam-clay) carry σzz in their plastic state.
-                m if m.needs_plastic_state() => Szz::Carried,
-                _ => Szz::Unknown,
-            })
-            .collect();
-        let cam_clay = model
-            .body_material
-            .iter()
-            .map(|&m| matches!(model.materials[m as usize], Material::ModifiedCamClay(_)))
-            .collect();
-        OutOfPlane { rule, cam_clay }
-    }
-
-    /// Particle `i` is of a modified Cam-clay body.
-    pub fn cam_clay(&self, p: &Particles, i: usize) -> bool {
-        self.cam_clay.get(p.body[i] as usize) == Some(&true)
-    }
-
-    /// Some body is modified Cam-clay; some body is of another plastic law.
-    fn plastic_kinds(&self) -> (bool, bool) {
-        let mcc = self.cam_clay.iter().any(|&c| c);
-        let other = self
-            .rule
-            .iter()
-            .zip(&self.cam_clay)
-            .any(|(r, &c)| matches!(r, Szz::Carried) && !c);
-        (mcc, other)
-    }
-
-    /// σzz of particle `i` (Pa); 0 for a body this does not know.
-    pub fn szz(&self, p: &Particles, i: usize) -> f64 {
-        let s = p.stress[i];
-        match self.rule.get(p.body[i] as usize) {
-            Some(Szz::Linear { nu }) => nu * (s[0] + s[1]),
-            Some(Szz::Neo { lame, density }) => {
-                let j = match p.f.get(i) {
-                    Some(f) => f[0] * f[3] - f[1] * f[2],
-                    None => density / p.rho[i],
-                };
-                lame * j.ln() / j
-            }
-            Some(Szz::Carried) => p.plastic.get(i).map_or(0.0, |q| q[0]),
-            Some(Szz::Unknown) | None => 0.0,
-        }
-    }
-}
-
-/// The .vtu file for the particle state at time `t`; `zz` gives the
-/// out-of-plane stress of the symmetric `stress` tensor.
-pub fn particles_vtu(p: &Particles, zz: &OutOfPlane, t: f64) -> Vec<u8> {
+/// The .vtu file for the particle state at time `t`; `state` gives the
+/// out-of-plane stress of the symmetric `stress` tensor and the arrays of
+/// the materials' state columns.
+pub fn particles_vtu(p: &Particles, state: &StateLayout, t: f64) -> Vec<u8> {
     let n = p.len();
     let mut arrays: Vec<(&str, &str, usize, Vec<u8>)> = Vec::new();
     let f32s = |it: &mut dyn Iterator<Item = f64>| {
@@ -107,7 +27,7 @@ pub fn particles_vtu(p: &Particles, zz: &OutOfPlane, t: f64) -> Vec<u8> {
     // The Cauchy stress as ParaView's symmetric tensor: xx, yy, zz, xy, yz, xz.
     let mut tensor = (0..n).flat_map(|i| {
         let s = p.stress[i];
-        [s[0], s[1], zz.szz(p, i), s[2], 0.0, 0.0]
+        [s[0], s[1], state.szz(p, i), s[2], 0.0, 0.0]
     });
     arrays.push(("stress", "Float32", 6, f32s(&mut tensor)));
     let mut sig = (0..n).flat_map(|i| p.stress[i]);
@@ -116,36 +36,11 @@ pub fn particles_vtu(p: &Particles, zz: &OutOfPlane, t: f64) -> Vec<u8> {
         // σzz, the state's two fields and the last return's active surfaces (0 = elastic).
         let mut szz = p.plastic.iter().map(|q| q[0]);
         arrays.push(("stress_zz", "Float32", 1, f32s(&mut szz)));
-        // Each array holds what it names: ε̄p and εp_v for Mohr–Coulomb and
-        // Drucker–Prager, p_c and v for modified Cam-clay (whose state holds
-        // those in the same slots); a particle of another law has 0 there.
-        let (mcc, other) = zz.plastic_kinds();
-        let slot = |k: usize, cam: bool| {
-            (0..n).map(move |i| {
-                if zz.cam_clay(p, i) == cam {
-                    p.plastic[i][k]
-                } else {
-                    0.0
-                }
-            })
-        };
-        if other || !mcc {
-            arrays.push(("plastic_strain_eq", "Float32", 1, f32s(&mut slot(1, false))));
-            arrays.push((
-                "plastic_strain_vol",
-                "Float32",
-                1,
-                f32s(&mut slot(2, false)),
-            ));
-        }
-        if mcc {
-            arrays.push((
-                "preconsolidation_pressure",
-                "Float32",
-                1,
-                f32s(&mut slot(1, true)),
-            ));
-            arrays.push(("specific_volume", "Float32", 1, f32s(&mut slot(2, true))));
+        // Each array holds what it names (its material's `STATE_COLUMNS`);
+        // a particle of a law without that column has 0 there.
+        for (c, col) in state.columns().enumerate() {
+            let mut v = (0..n).map(|i| state.value(c, p, i));
+            arrays.push((col.array, "Float32", 1, f32s(&mut v)));
         }
         let ret: Vec<u8> = p
             .plastic

@@ -128,6 +128,16 @@ impl Constitutive for LinearElastic {
     fn gpu_params(&self) -> Vec<f32> {
         Vec::new()
     }
+    /// From a stress-free start: ν (σxx + σyy).
+    fn stress_zz(
+        &self,
+        stress: &[f64; 3],
+        _f: Option<&DefGrad>,
+        _rho: f64,
+        _q: Option<&PlasticState>,
+    ) -> f64 {
+        self.nu * (stress[0] + stress[1])
+    }
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ pub mod plastic;
 pub mod registry;
 pub mod state;
 
-pub use registry::{Constitutive, Entry, Key, Keys, MaterialFault, StateKind};
+pub use registry::{Constitutive, Entry, Key, Keys, MaterialFault, StateColumn, StateKind};
 pub use state::{DefGrad, PlasticState};
 
 use crate::error::SceneError;
@@ -41,6 +41,8 @@ macro_rules! register {
                 gpu_params: <$ty as Constitutive>::GPU_PARAMS,
                 keys: <$ty as Constitutive>::KEYS,
                 faults: <$ty as Constitutive>::FAULTS,
+                state_columns: <$ty as Constitutive>::STATE_COLUMNS,
+                own_start: <$ty as Constitutive>::OWN_START,
             }),*]
             .into_iter()
             .enumerate()
@@ -127,6 +129,18 @@ macro_rules! register {
                 match self { $(Material::$variant(m) => <$ty as Constitutive>::initial_state(m),)* }
             }
 
+            /// σzz (Pa) of a particle's state (`Constitutive::stress_zz`).
+            #[inline]
+            pub fn stress_zz(
+                &self,
+                stress: &[f64; 3],
+                f: Option<&DefGrad>,
+                rho: f64,
+                q: Option<&PlasticState>,
+            ) -> f64 {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::stress_zz(m, stress, f, rho, q),)* }
+            }
+
             /// The GPU parameters (`GpuMaterial::p`), in the entry's order.
             pub fn gpu_params(&self) -> Vec<f32> {
                 match self { $(Material::$variant(m) => <$ty as Constitutive>::gpu_params(m),)* }
@@ -141,6 +155,36 @@ register! {
     MohrCoulomb(mohr_coulomb::MohrCoulomb),
     DruckerPrager(drucker_prager::DruckerPrager),
     ModifiedCamClay(modified_cam_clay::ModifiedCamClay),
+}
+
+/// The registered models' scene names, in registry order, for messages
+/// that list them (`"a", "b" or "c"` with `quoted_list`).
+pub fn names_where(keep: impl Fn(&Entry) -> bool) -> Vec<&'static str> {
+    registry()
+        .into_iter()
+        .filter(|e| keep(e))
+        .map(|e| e.name)
+        .collect()
+}
+
+/// `names` as a message lists them: `a, b or c` (`word` = "or"/"and").
+pub fn name_list(names: &[&str], word: &str) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} {word} {last}", rest.join(", ")),
+    }
+}
+
+/// Every distinct state column of the registered models, in registry order.
+pub fn state_columns() -> Vec<StateColumn> {
+    let mut out: Vec<StateColumn> = Vec::new();
+    for c in registry().iter().flat_map(|e| e.state_columns) {
+        if !out.contains(c) {
+            out.push(*c);
+        }
+    }
+    out
 }
 
 impl Material {
@@ -266,6 +310,71 @@ mod tests {
         let got = biaxial_peak(&m, sigma_c, 4000, 1e-5);
         println!("DP ψ = 0: peak {got:.2} vs MC {want:.2}");
         assert!(got < want, "{got} vs {want}");
+    }
+
+    /// Every model names what its state holds (`STATE_COLUMNS`): a plastic
+    /// model the two middle slots of its `PlasticState`, the others none;
+    /// distinct columns have distinct names, none the outputs' fixed ones.
+    #[test]
+    fn every_model_names_its_state_columns() {
+        for e in registry() {
+            let want = if e.state == StateKind::Plastic { 2 } else { 0 };
+            assert_eq!(e.state_columns.len(), want, "{}", e.name);
+        }
+        let all = state_columns();
+        for (i, a) in all.iter().enumerate() {
+            for b in &all[i + 1..] {
+                assert!(a.column != b.column && a.array != b.array, "{a:?} {b:?}");
+            }
+            assert!(!["szz", "plastic", "stress_zz", "body"].contains(&a.column));
+        }
+        let names: Vec<&str> = all.iter().map(|c| c.column).collect();
+        assert_eq!(names, ["eps_p", "eps_pv", "p_c", "v"]);
+    }
+
+    /// σzz as each model makes it: ν (σxx + σyy) for linear elasticity,
+    /// λ ln J / J for Neo-Hookean (J from F, else ρ0 / ρ), carried in the
+    /// plastic state otherwise (0 without one).
+    #[test]
+    fn every_model_gives_its_own_szz() {
+        let s = [-3.0e4, -1.0e4, 2.0e3];
+        let f = [1.01, 0.02, -0.01, 0.98];
+        let q = [-7.5e3, 0.0, 0.0, 0.0];
+        for e in registry() {
+            let spec = MaterialSpec::new(e.name, 1800.0)
+                .with("E", 2.0e7)
+                .with("nu", 0.3);
+            let spec = if e.state != StateKind::Plastic {
+                spec
+            } else if e.name != "modified_cam_clay" {
+                spec.with("cohesion", 1.0e4).with("friction_angle", 30.0)
+            } else {
+                MaterialSpec::new(e.name, 1800.0)
+                    .with("kappa", 0.04)
+                    .with("lambda", 0.2)
+                    .with("M", 1.2)
+                    .with("N", 2.5)
+                    .with("p0", 1.0e5)
+                    .with("nu", 0.3)
+            };
+            let m = Material::from_spec("m", &spec).unwrap();
+            let got = m.stress_zz(&s, Some(&f), 1700.0, Some(&q));
+            let want = match &m {
+                Material::LinearElastic(l) => l.nu * (s[0] + s[1]),
+                Material::NeoHookean(n) => {
+                    let j = f[0] * f[3] - f[1] * f[2];
+                    let without = m.stress_zz(&s, None, 1700.0, None);
+                    let j0: f64 = 1800.0 / 1700.0;
+                    assert_eq!(without, n.lame * j0.ln() / j0);
+                    n.lame * j.ln() / j
+                }
+                _ => {
+                    assert_eq!(m.stress_zz(&s, Some(&f), 1700.0, None), 0.0);
+                    q[0]
+                }
+            };
+            assert_eq!(got, want, "{}", e.name);
+        }
     }
 
     /// A model's faults are its own: declared once (`FAULTS`), numbered

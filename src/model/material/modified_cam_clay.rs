@@ -563,6 +563,25 @@ impl super::Constitutive for ModifiedCamClay {
         "kappa", "lambda", "m_cs", "nu", "shear", "p_floor", "rho_v0", "n_pa",
     ];
     const FAULTS: &'static [MaterialFault] = &[NOT_CONVERGED];
+    const STATE_COLUMNS: &'static [super::StateColumn] = &[
+        super::StateColumn {
+            column: "p_c",
+            array: "preconsolidation_pressure",
+            unit: "Pa",
+            meaning: "preconsolidation pressure p_c",
+            symbol: "p_c",
+            from_zero: false,
+        },
+        super::StateColumn {
+            column: "v",
+            array: "specific_volume",
+            unit: "1",
+            meaning: "specific volume v = 1 + e",
+            symbol: "v",
+            from_zero: false,
+        },
+    ];
+    const OWN_START: bool = true;
 
     fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
         let keys = CamClayKeys {
@@ -622,6 +641,16 @@ impl super::Constitutive for ModifiedCamClay {
     }
     fn initial_state(&self) -> ([f64; 3], PlasticState) {
         ModifiedCamClay::initial_state(self)
+    }
+    /// Carried in the plastic state.
+    fn stress_zz(
+        &self,
+        _stress: &[f64; 3],
+        _f: Option<&super::DefGrad>,
+        _rho: f64,
+        q: Option<&PlasticState>,
+    ) -> f64 {
+        q.map_or(0.0, |q| q[plastic::SZZ])
     }
 }
 

@@ -127,6 +127,20 @@ impl Constitutive for NeoHookean {
     fn strain_energy_density(&self, _s: &[f64; 3], f: &DefGrad, _q: &PlasticState) -> f64 {
         self.energy_density(f)
     }
+    /// λ ln J / J (b_zz = 1), J = det F, or ρ0 / ρ without F.
+    fn stress_zz(
+        &self,
+        _stress: &[f64; 3],
+        f: Option<&DefGrad>,
+        rho: f64,
+        _q: Option<&PlasticState>,
+    ) -> f64 {
+        let j = match f {
+            Some(f) => f[0] * f[3] - f[1] * f[2],
+            None => self.density / rho,
+        };
+        self.lame * j.ln() / j
+    }
     fn gpu_params(&self) -> Vec<f32> {
         Vec::new()
     }

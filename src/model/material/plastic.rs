@@ -144,6 +144,7 @@ macro_rules! elastoplastic_constitutive {
             const KEYS: &'static [super::Key] = plastic::YIELD_KEYS;
             const STATE: super::StateKind = super::StateKind::Plastic;
             const GPU_PARAMS: &'static [&'static str] = &[$($param),*];
+            const STATE_COLUMNS: &'static [super::StateColumn] = plastic::STRAIN_COLUMNS;
 
             fn from_keys(k: &super::Keys) -> Result<Self, crate::error::SceneError> {
                 let (e, nu) = k.youngs_nu()?;
@@ -187,10 +188,41 @@ macro_rules! elastoplastic_constitutive {
                 let $m = self;
                 $pack
             }
+            /// Carried in the plastic state.
+            fn stress_zz(
+                &self,
+                _stress: &[f64; 3],
+                _f: Option<&super::DefGrad>,
+                _rho: f64,
+                q: Option<&PlasticState>,
+            ) -> f64 {
+                q.map_or(0.0, |q| q[plastic::SZZ])
+            }
         }
     };
 }
 pub(crate) use elastoplastic_constitutive;
+
+/// What the elastic-perfectly plastic models (Mohr–Coulomb,
+/// Drucker–Prager) keep in `PlasticState[EPS_EQ]` and `[EPS_VOL]`.
+pub const STRAIN_COLUMNS: &[super::StateColumn] = &[
+    super::StateColumn {
+        column: "eps_p",
+        array: "plastic_strain_eq",
+        unit: "1",
+        meaning: "equivalent plastic strain",
+        symbol: "ε̄p",
+        from_zero: true,
+    },
+    super::StateColumn {
+        column: "eps_pv",
+        array: "plastic_strain_vol",
+        unit: "1",
+        meaning: "volumetric plastic strain",
+        symbol: "εp_v",
+        from_zero: true,
+    },
+];
 
 /// The keys of the elastic-perfectly plastic models (Mohr–Coulomb,
 /// Drucker–Prager): E and ν, then the yield keys.

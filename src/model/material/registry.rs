@@ -52,6 +52,47 @@ pub struct Key {
     pub doc: &'static str,
 }
 
+/// One column of a model's state in the outputs: what a `PlasticState`
+/// slot (1 or 2) of the model holds, named the model's way in
+/// `particles.csv`, the VTU point data, `result.png` and `lme-mpm render`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StateColumn {
+    /// Its `particles.csv` column and `render --field` value.
+    pub column: &'static str,
+    /// Its VTU point-array name.
+    pub array: &'static str,
+    /// Its unit ("1": none).
+    pub unit: &'static str,
+    /// What it is, in words (titles and messages).
+    pub meaning: &'static str,
+    /// Its symbol in a colour bar's label.
+    pub symbol: &'static str,
+    /// A magnitude that grows from zero: colour scales start at 0 (else
+    /// at the least value, as p_c's about p′0).
+    pub from_zero: bool,
+}
+
+impl StateColumn {
+    /// ` (unit)`, or nothing for a pure number.
+    fn unit_suffix(&self) -> String {
+        if self.unit == "1" {
+            String::new()
+        } else {
+            format!(" ({})", self.unit)
+        }
+    }
+
+    /// Its meaning and unit, as a picture's title names it.
+    pub fn label(&self) -> String {
+        format!("{}{}", self.meaning, self.unit_suffix())
+    }
+
+    /// Its symbol and unit, as a colour bar names it.
+    pub fn short_label(&self) -> String {
+        format!("{}{}", self.symbol, self.unit_suffix())
+    }
+}
+
 /// A constitutive model. The methods mirror its WGSL twin's functions.
 pub trait Constitutive: Sized {
     /// Its scene name (`model = "..."`), also the prefix of its WGSL functions.
@@ -66,6 +107,14 @@ pub trait Constitutive: Sized {
     /// The faults its update can report beyond the solver's own (at most
     /// `FAULT_SLOTS`); none unless the model says.
     const FAULTS: &'static [MaterialFault] = &[];
+    /// What slots 1 and 2 of its `PlasticState` hold, in that order: two
+    /// columns for a `StateKind::Plastic` model, none for the others (a
+    /// test holds every model to it). Slot 0 is σzz and slot 3 the active
+    /// surfaces for every plastic model (`szz`, `plastic`).
+    const STATE_COLUMNS: &'static [StateColumn] = &[];
+    /// It starts at a state of its own (`initial_state` is not zero), so
+    /// a geostatic start cannot set its stress.
+    const OWN_START: bool = false;
 
     /// Builds the model from its keys, each checked (the error names it).
     fn from_keys(k: &Keys) -> Result<Self, SceneError>;
@@ -93,6 +142,18 @@ pub trait Constitutive: Sized {
     fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64;
     /// The GPU parameters, in `GPU_PARAMS` order.
     fn gpu_params(&self) -> Vec<f32>;
+    /// The out-of-plane stress σzz (Pa) of plane strain (εzz = 0) that the
+    /// model makes of a particle's state: its stress, its F (`None` where
+    /// the particles keep none), its density `rho` (kg/m³) and its plastic
+    /// state (`None` where the particles keep none). Every model says; none
+    /// is silently 0.
+    fn stress_zz(
+        &self,
+        stress: &[f64; 3],
+        f: Option<&DefGrad>,
+        rho: f64,
+        q: Option<&PlasticState>,
+    ) -> f64;
     /// The stress (Pa) and plastic state a particle starts with: zero,
     /// unless the model starts elsewhere.
     fn initial_state(&self) -> ([f64; 3], PlasticState) {
@@ -226,6 +287,8 @@ pub struct Entry {
     pub gpu_params: &'static [&'static str],
     pub keys: &'static [Key],
     pub faults: &'static [MaterialFault],
+    pub state_columns: &'static [StateColumn],
+    pub own_start: bool,
 }
 
 impl Entry {
