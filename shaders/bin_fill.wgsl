@@ -1,5 +1,6 @@
 // Binning (shared/bins.wgsl), pass 4 of 4: list each particle under its
-// grid cell (order within a cell is arbitrary). CPU twin: `Mls::bin`.
+// grid cell (order within a cell is arbitrary). CPU twin: `Mls::bin`
+// (src/cpu/mls.rs).
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_CELL_COUNT}}) var<storage, read_write> cell_count: array<atomic<u32>>;

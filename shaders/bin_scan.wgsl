@@ -1,7 +1,7 @@
 // Binning (shared/bins.wgsl), pass 3 of 4 (one workgroup): exclusive prefix sum of
 // the per-cell counts into cell starts, resetting the counts to serve as
 // fill cursors. Each of the 256 invocations sums a contiguous run of cells.
-// CPU twin: `Mls::bin`.
+// CPU twin: `Mls::bin` (src/cpu/mls.rs).
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_CELL_COUNT}}) var<storage, read_write> cell_count: array<u32>;

@@ -1,7 +1,8 @@
 // Stage `lme_newton` (LME only): per particle, damped Newton on λ minimising
 // log Z, warm-started from the last step's λ, then (λ, log Z, J⁻¹) stored
 // for the other passes. Converged when |r| ≤ lme_tol (f32: ~30 ulp of the
-// sums). CPU twin: src/shape/lme.rs (Lme::eval), via src/cpu/shape_eval.rs.
+// sums). CPU twin: src/model/shape/lme.rs (Lme::eval), via
+// src/cpu/shape_eval.rs.
 #include "shared/common.wgsl"
 #include "shared/shape_bindings.wgsl" LME_ACCESS=read_write
 #include "shared/shape.wgsl"

@@ -1,6 +1,7 @@
 // Gather the probe particles' state into a small buffer for read-back at
 // sample times: per probe [x, y, vx, vy, sxx, syy, sxy, 0]. Positions are
-// relative to the grid's lower-left node. CPU twin: CpuBackend::sample.
+// relative to the grid's lower-left node. CPU twin: `probe_states` in
+// src/backend.rs (which `CpuBackend::sample` calls).
 #include "shared/common.wgsl"
 
 @group(0) @binding({{B_X0}}) var<storage, read> x0: array<vec2<f32>>;

@@ -1,6 +1,7 @@
 //! WGSL checks that need no GPU: every file is embedded in the binary, every
 //! pass expands and validates with naga in every variant a scene can ask
-//! for, and every struct shared with Rust has the same layout on both sides.
+//! for, every struct shared with Rust has the same layout on both sides, and
+//! every Rust file a file's header names (its CPU twin) exists.
 
 use lme_mpm::gpu::constraint_points::PointCounts;
 use lme_mpm::gpu::context::AtomicMode;
@@ -38,6 +39,78 @@ fn every_wgsl_file_is_embedded() {
     let mut embedded: Vec<String> = SOURCES.iter().map(|(p, _)| p.to_string()).collect();
     embedded.sort();
     assert_eq!(on_disk, embedded, "shaders/ and preprocess::SOURCES differ");
+}
+
+/// The comment block a WGSL file opens with: its leading `//` lines, blank
+/// lines before the first one skipped.
+fn header(text: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines().map(str::trim) {
+        if let Some(rest) = line.strip_prefix("//") {
+            out.push_str(rest);
+            out.push('\n');
+        } else if !(line.is_empty() && out.is_empty()) {
+            break;
+        }
+    }
+    out
+}
+
+/// Every `src/...rs` path in `text`, one brace group (`src/a/{b,c}.rs`)
+/// expanded.
+fn rust_paths(text: &str) -> Vec<String> {
+    let is_path = |c: char| c.is_ascii_alphanumeric() || "_/.{},-".contains(c);
+    let mut out = Vec::new();
+    for (at, _) in text.match_indices("src/") {
+        if at > 0 && is_path(text[..at].chars().next_back().unwrap()) {
+            continue; // inside a longer path, e.g. `tests/src/`.
+        }
+        let token: String = text[at..].chars().take_while(|&c| is_path(c)).collect();
+        let Some(end) = token.find(".rs") else {
+            continue;
+        };
+        let token = &token[..end + 3];
+        match (token.find('{'), token.find('}')) {
+            (Some(open), Some(close)) if open < close => {
+                for alt in token[open + 1..close].split(',') {
+                    out.push(format!("{}{alt}{}", &token[..open], &token[close + 1..]));
+                }
+            }
+            _ => out.push(token.to_string()),
+        }
+    }
+    out
+}
+
+#[test]
+fn every_wgsl_header_names_rust_files_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = root.join("shaders");
+    let mut files = Vec::new();
+    wgsl_files(&base, &base, &mut files);
+    files.sort();
+    let mut named = 0;
+    let mut missing = Vec::new();
+    for file in &files {
+        let text = std::fs::read_to_string(base.join(file)).unwrap();
+        let header = header(&text);
+        let paths = rust_paths(&header);
+        if header.contains("CPU twin") && paths.is_empty() {
+            missing.push(format!("shaders/{file}: a CPU twin without a src/ path"));
+        }
+        for path in paths {
+            named += 1;
+            if !root.join(&path).is_file() {
+                missing.push(format!("shaders/{file}: {path}"));
+            }
+        }
+    }
+    assert!(named > 40, "only {named} src/ paths found in WGSL headers");
+    assert!(
+        missing.is_empty(),
+        "WGSL headers name files that do not exist:\n{}",
+        missing.join("\n")
+    );
 }
 
 fn variants() -> Vec<Variant> {

@@ -1,6 +1,6 @@
 // Compressible Neo-Hookean, plane strain, on F = (xx, xy, yx, yy):
 // F ← (I + Δt L) F, σ = λ ln J / J I + μ / J (F Fᵀ − I).
-// CPU twin: src/material/neo_hookean.rs.
+// CPU twin: src/model/material/neo_hookean.rs.
 
 fn neo_hookean_update(m: Material, l: vec4<f32>, dt: f32, s: vec3<f32>, f: vec4<f32>, q: vec4<f32>) -> MatUpdate {
     let g = vec4<f32>(1.0 + dt * l.x, dt * l.y, dt * l.z, 1.0 + dt * l.w);

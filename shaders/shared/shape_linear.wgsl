@@ -1,4 +1,5 @@
-// Bilinear Q4 (isoparametric on perturbed grids). CPU twin: src/shape/linear.rs.
+// Bilinear Q4 (isoparametric on perturbed grids).
+// CPU twin: src/model/shape/linear.rs.
 
 const STENCIL: u32 = 4u;
 const SHAPE_WIDTH: u32 = 2u;

@@ -4,7 +4,7 @@
 // pass over the search box per use (24 bytes per particle). LME_STORED:
 // `lme_newton` stores N and ∇N per search-box slot (16 bytes per slot) and
 // the passes read them. docs/performance.md compares the two.
-// CPU twin: src/shape/lme.rs.
+// CPU twin: src/model/shape/lme.rs.
 
 const SHAPE_WIDTH: u32 = {{LME_SIDE}}u;
 const STENCIL: u32 = SHAPE_WIDTH * SHAPE_WIDTH;

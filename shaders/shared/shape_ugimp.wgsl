@@ -1,7 +1,8 @@
 // Uniform GIMP: the tent averaged over a particle square of half-width
 // lp = h/(2 ppc); tensor product of the 1D weight, 3 x 3 nodes. On a
 // perturbed grid, in the lattice coordinates of the Q4 map (see
-// src/shape/ugimp.rs, the CPU twin, for why that loses linear reproduction).
+// src/model/shape/ugimp.rs, the CPU twin, for why that loses linear
+// reproduction).
 
 const STENCIL: u32 = 9u;
 const SHAPE_WIDTH: u32 = 3u;
