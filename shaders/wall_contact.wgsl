@@ -8,7 +8,8 @@
 // force that stops the particle's own slip, v_p' = v_p + sΔt Σ N f_I/m_I
 // (sΔt = (2 − γ)Δt, the time it feels a nodal force in), −v'_t / w',
 // w' = sΔt Σ N T_I / m_I (T_I: the friction's weights of the contacts,
-// `wall_touch[2n + 1]`), at most μ F_n (stick: μ = STICK_MU; slip: 0).
+// `wall_touch[2n + 1]`), at most μ F_n (`shared/wall_coulomb.wgsl`;
+// stick: μ = STICK_MU; slip: 0).
 // With WALL_PRELOAD both velocities count the preloads (`wall_touch`'s
 // `wall_pre_force`). F goes onto the nodes with the particle's weights
 // (`wall_force`, which `correct` adds to f_I), the preload's share of F_n
@@ -35,6 +36,7 @@
 #include "shared/atomics.wgsl" ARR=wall_force FN=wall_force_add
 #include "shared/atomics.wgsl" ARR=reactions FN=reaction_add
 #include "shared/wall_spring.wgsl"
+#include "shared/wall_coulomb.wgsl"
 #if WALL_PRELOAD
 @group(0) @binding({{B_WALL_PRE_FORCE}}) var<storage, read> wall_pre_force: array<f32>;
 #endif
@@ -44,7 +46,6 @@
 
 // Keep in sync with src/model/walls.rs.
 const WALL_DAMPING: f32 = 0.05;
-const STICK_MU: f32 = 20.0;
 
 @compute @workgroup_size(256)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -117,13 +118,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let vn = dot(v, wl.normal);
         let fnorm = max(sp.x - WALL_DAMPING * vn / w, 0.0);
         let vt = vp - dot(vp, wl.normal) * wl.normal;
-        var mu = 0.0;
-        if wl.contact == CONTACT_STICK {
-            mu = STICK_MU;
-        } else if wl.contact == CONTACT_FRICTION {
-            mu = wl.mu;
-        }
-        // Coulomb: the force that stops the slip, at most μ F_n.
+        // Coulomb (`coulomb_slip`): the force that stops the slip, at
+        // most μ F_n.
         // Sized over sdt, the step the particle feels it in (over γΔt the
         // stick loop's gain was (2 − γ)/γ and a slip grew), and with the
         // friction's own weights T_I (with S_I while it acts on the line,
@@ -135,9 +131,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
         var ft = -vt / ws;
         let mag = length(ft);
-        let cap = mu * fnorm;
-        if mag > cap {
-            ft *= cap / mag;
+        let slip = coulomb_slip(mag, fnorm, coulomb_mu(wl));
+        if slip.slips {
+            ft *= slip.cap / mag;
         }
         let fw = fnorm * wl.normal + ft;
         reaction_add(2u * (params.n_groups + k), fw.x);

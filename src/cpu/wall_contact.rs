@@ -12,9 +12,7 @@
 use super::stage_inputs::ShapeCache;
 use super::wall_touch::{ContactParticles, LineWeights, contact_spring, line_weights_positive};
 use crate::model::Walls;
-use crate::model::walls::{
-    CONTACT_FRICTION, CONTACT_STICK, STICK_MU, WALL_DAMPING, face_weight, half_width, wall_depth,
-};
+use crate::model::walls::{WALL_DAMPING, coulomb_slip, face_weight, half_width, wall_depth};
 
 /// The walls' forces at their contact points: every particle in contact
 /// with a wall gets a normal force F_n = k pen 2 l_p (penalty) plus its
@@ -69,6 +67,15 @@ pub fn wall_contact(
     }
     let fit_on = walls.fit_at(t);
     let mut lw = LineWeights::new(pt.line);
+    let nodal = NodeInputs {
+        mv,
+        force,
+        pre_force,
+        touch,
+        gamma_dt,
+        slip_dt,
+        mass_eps,
+    };
     for p in 0..pt.x.len() {
         let lp = half_width(pt.mass[p], pt.rho[p]);
         for (k, wl) in walls.list.iter().enumerate() {
@@ -80,28 +87,8 @@ pub fn wall_contact(
                 continue;
             }
             let (nodes, wt) = cache.particle(p);
-            // v: the body's corrected velocity at the particle (for the
-            // damping); vp: the particle's own next velocity (for the
-            // friction); both without the walls' contact forces, with
-            // their preloads.
-            let (mut v, mut w, mut wf, mut w_own) = ([0.0; 2], 0.0, 0.0, 0.0);
-            let mut vp = pt.v[p];
-            for (&n, wk) in nodes.iter().zip(wt) {
-                let node = &mv[n as usize];
-                if node[0] > mass_eps {
-                    let mut f = force[n as usize];
-                    if let Some(pf) = pre_force.get(n as usize) {
-                        f = [f[0] + pf[0], f[1] + pf[1]];
-                    }
-                    v[0] += wk[0] * (node[1] + gamma_dt * f[0] / node[0]);
-                    v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
-                    vp[0] += wk[0] * slip_dt * f[0] / node[0];
-                    vp[1] += wk[0] * slip_dt * f[1] / node[0];
-                    w += wk[0] * touch[n as usize][0] / node[0];
-                    wf += wk[0] * touch[n as usize][1] / node[0];
-                    w_own += wk[0] * wk[0] / node[0];
-                }
-            }
+            let s = nodal.sums(nodes, wt, pt.v[p]);
+            let mut w = s.w;
             if w <= 0.0 {
                 continue;
             }
@@ -113,38 +100,13 @@ pub fn wall_contact(
             // and the damping's ζ v_n / w kicked it off the wall at 130 m/s
             // (LME granular collapse, docs/methods.md "Granular collapse:
             // runs that stop").
-            w = w.max(w_own);
+            w = w.max(s.w_own);
             w *= gamma_dt;
             let nrm = wl.normal;
-            let vn = v[0] * nrm[0] + v[1] * nrm[1];
+            let vn = s.v[0] * nrm[0] + s.v[1] * nrm[1];
             let fnorm = (spring - WALL_DAMPING * vn / w).max(0.0);
-            let vpn = vp[0] * nrm[0] + vp[1] * nrm[1];
-            let vt = [vp[0] - vpn * nrm[0], vp[1] - vpn * nrm[1]];
-            let mu = match wl.contact {
-                CONTACT_STICK => STICK_MU,
-                CONTACT_FRICTION => wl.mu,
-                _ => 0.0,
-            };
-            // Coulomb: the force that stops the particle's slip, at most
-            // μ F_n. The particle feels it over `slip_dt` (NPC: Δt in v_p
-            // and (1 − γ)Δt more in the next predictor), so that is the
-            // step it is sized for. Sized on the corrected nodal velocity
-            // over γΔt instead, the stick loop's gain was (2 − γ)/γ = 3 and
-            // a slip grew (the geostatic column's bottom row: from 1e-16
-            // to 1 m/s in 100 steps). And with the weights it acts with
-            // (T_I): sized with the particle's (S_I) while it acts on the
-            // line, a stick loop's gain was about 1.28, which left the
-            // held particles a steady slip against their load and a
-            // stick-held slab crept under a block (docs/methods.md,
-            // "Walls"). A point whose nodes carry no friction weight (T
-            // is never negative beyond round-off) falls back on S.
-            let ws = slip_dt * if wf > 0.0 { wf } else { w / gamma_dt };
-            let mut ft = [-vt[0] / ws, -vt[1] / ws];
-            let mag = ft[0].hypot(ft[1]);
-            let cap = mu * fnorm;
-            if mag > cap {
-                ft = [ft[0] * cap / mag, ft[1] * cap / mag];
-            }
+            let ws = slip_dt * if s.wf > 0.0 { s.wf } else { w / gamma_dt };
+            let ft = friction(s.vp, nrm, ws, fnorm, wl.coulomb_mu());
             let fw = [fnorm * nrm[0] + ft[0], fnorm * nrm[1] + ft[1]];
             wall_r[k][0] += fw[0];
             wall_r[k][1] += fw[1];
@@ -202,12 +164,97 @@ pub fn wall_contact(
     }
 }
 
+/// What a contact reads from its particle's nodes (`wall_contact`'s
+/// arguments of the same names).
+struct NodeInputs<'a> {
+    mv: &'a [[f64; 3]],
+    force: &'a [[f64; 2]],
+    pre_force: &'a [[f64; 2]],
+    touch: &'a [[f64; 2]],
+    gamma_dt: f64,
+    slip_dt: f64,
+    mass_eps: f64,
+}
+
+/// A contact's sums over its particle's nodes: `v` the body's corrected
+/// velocity at the particle (for the damping), `vp` the particle's own
+/// next velocity (for the friction), both without the walls' contact
+/// forces, with their preloads; Σ N S_I / m_I (`w`), Σ N T_I / m_I (`wf`)
+/// and Σ N² / m_I (`w_own`).
+struct NodeSums {
+    v: [f64; 2],
+    vp: [f64; 2],
+    w: f64,
+    wf: f64,
+    w_own: f64,
+}
+
+impl NodeInputs<'_> {
+    /// The sums of the particle on `nodes` with weights `wt` and velocity
+    /// `v_p`, over its nodes with mass.
+    #[inline]
+    fn sums(&self, nodes: &[u32], wt: &[[f64; 3]], v_p: [f64; 2]) -> NodeSums {
+        let (mut v, mut w, mut wf, mut w_own) = ([0.0; 2], 0.0, 0.0, 0.0);
+        let mut vp = v_p;
+        let (gamma_dt, slip_dt) = (self.gamma_dt, self.slip_dt);
+        for (&n, wk) in nodes.iter().zip(wt) {
+            let node = &self.mv[n as usize];
+            if node[0] > self.mass_eps {
+                let mut f = self.force[n as usize];
+                if let Some(pf) = self.pre_force.get(n as usize) {
+                    f = [f[0] + pf[0], f[1] + pf[1]];
+                }
+                v[0] += wk[0] * (node[1] + gamma_dt * f[0] / node[0]);
+                v[1] += wk[0] * (node[2] + gamma_dt * f[1] / node[0]);
+                vp[0] += wk[0] * slip_dt * f[0] / node[0];
+                vp[1] += wk[0] * slip_dt * f[1] / node[0];
+                w += wk[0] * self.touch[n as usize][0] / node[0];
+                wf += wk[0] * self.touch[n as usize][1] / node[0];
+                w_own += wk[0] * wk[0] / node[0];
+            }
+        }
+        NodeSums {
+            v,
+            vp,
+            w,
+            wf,
+            w_own,
+        }
+    }
+}
+
+/// The contact's friction (N per unit thickness): the force that stops
+/// the slip of the particle's next velocity `vp` along the wall (normal
+/// `nrm`), −v_t / `ws`, at most μ `fnorm` (`coulomb_slip`, `mu` from
+/// `Wall::coulomb_mu`). `ws` = `slip_dt` Σ N T_I / m_I: the particle
+/// feels the force over `slip_dt` (NPC: Δt in v_p and (1 − γ)Δt more in
+/// the next predictor), so that is the step it is sized for. Sized on the
+/// corrected nodal velocity over γΔt instead, the stick loop's gain was
+/// (2 − γ)/γ = 3 and a slip grew (the geostatic column's bottom row: from
+/// 1e-16 to 1 m/s in 100 steps). And with the weights it acts with (T_I):
+/// sized with the particle's (S_I) while it acts on the line, a stick
+/// loop's gain was about 1.28, which left the held particles a steady slip
+/// against their load and a stick-held slab crept under a block
+/// (docs/methods.md, "Walls"). A point whose nodes carry no friction
+/// weight (T is never negative beyond round-off) falls back on S.
+#[inline]
+fn friction(vp: [f64; 2], nrm: [f64; 2], ws: f64, fnorm: f64, mu: f64) -> [f64; 2] {
+    let vpn = vp[0] * nrm[0] + vp[1] * nrm[1];
+    let vt = [vp[0] - vpn * nrm[0], vp[1] - vpn * nrm[1]];
+    let mut ft = [-vt[0] / ws, -vt[1] / ws];
+    let mag = ft[0].hypot(ft[1]);
+    if let Some(cap) = coulomb_slip(mag, fnorm, mu) {
+        ft = [ft[0] * cap / mag, ft[1] * cap / mag];
+    }
+    ft
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cpu::wall_touch::wall_touch;
     use crate::model::Wall;
-    use crate::model::walls::CONTACT_SLIP;
+    use crate::model::walls::{CONTACT_FRICTION, CONTACT_SLIP, CONTACT_STICK};
 
     /// One particle at `x` on one node (weight 1) of mass 2 kg moving at
     /// `v` (m/s), against a level wall at y = 0 with k = 1e6 Pa/m; the

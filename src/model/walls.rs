@@ -4,7 +4,10 @@
 //! the same wall nodes as the regular one. Both backends apply the
 //! contact (`cpu::wall_touch` / `cpu::wall_contact` and their WGSL
 //! twins) from this list, with each wall's penalty stiffness and offset
-//! and the particles' preloads (`Walls::set_contact`).
+//! and the particles' preloads (`Walls::set_contact`). Coulomb's law of a
+//! wall's contact (`Wall::coulomb_mu`, `coulomb_slip`) is here for both
+//! steps: the explicit one's `cpu::wall_contact` (and its WGSL twin) and
+//! the implicit one's `cpu::implicit::contact`.
 
 use crate::error::SceneError;
 use crate::model::{Grid, Particles};
@@ -78,6 +81,35 @@ impl Wall {
     pub fn active_at(&self, t: f64) -> bool {
         self.appear_at <= t && t < self.remove_at
     }
+
+    /// Coulomb's μ of the wall's contact law: `STICK_MU` on a `stick`
+    /// wall (it holds a contact as friction bounded so), the wall's own
+    /// `mu` on a `friction` wall, 0 on a `slip` wall. WGSL twin
+    /// `coulomb_mu` in shaders/shared/wall_coulomb.wgsl.
+    #[inline]
+    pub fn coulomb_mu(&self) -> f64 {
+        match self.contact {
+            CONTACT_STICK => STICK_MU,
+            CONTACT_FRICTION => self.mu,
+            _ => 0.0,
+        }
+    }
+}
+
+/// Coulomb's law at a wall's contact, |f_t| ≤ μ f_n: whether the
+/// tangential `trial` (the magnitude of what would hold the contact
+/// still: stick) exceeds μ times `normal` (the normal one, compression
+/// positive, in the same units), and if so the bound μ `normal` that it
+/// is capped at (slip); None while the contact holds. The explicit step
+/// (`cpu::wall_contact`) asks it of forces (N), trial the force that
+/// stops the slip; the implicit one (`cpu::implicit::contact::
+/// natural_state`) of the gap's components (m; the penalty k of both
+/// forces cancels), trial the tangential increment. WGSL twin
+/// `coulomb_slip` in shaders/shared/wall_coulomb.wgsl.
+#[inline]
+pub fn coulomb_slip(trial: f64, normal: f64, mu: f64) -> Option<f64> {
+    let cap = mu * normal;
+    (trial > cap).then_some(cap)
 }
 
 /// The scene's walls, and per node the bit set of the walls it is behind

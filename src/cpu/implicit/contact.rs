@@ -12,11 +12,13 @@
 //! then −k g n. Coulomb's
 //! law on the tangential increment s = Δu·t (t = n rotated a quarter turn)
 //! is a return map: the trial (stick) force −k s t if |k s| ≤ μ k |g|,
-//! else μ k |g| against the slip. Within one state the force is linear in
-//! Δu, so its derivative is exact there; the law as a whole is only
-//! piecewise smooth, which is why Newton holds the states (`mod.rs`).
+//! else μ k |g| against the slip (the test: `model::walls::coulomb_slip`
+//! with the μ of `Wall::coulomb_mu`, as in the explicit step). Within one
+//! state the force is linear in Δu, so its derivative is exact there; the
+//! law as a whole is only piecewise smooth, which is why Newton holds the
+//! states (`mod.rs`).
 
-use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK, Wall};
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK, Wall, coulomb_slip};
 
 /// A wall node's contact state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,7 +84,10 @@ fn components(wall: &Wall, gap: f64, du: [f64; 2]) -> (f64, f64) {
 /// Newton does not begin by letting it fall through. A `stick` wall's
 /// contacts (GMM's cloud nodes only: the grid holds a stick wall's nodes
 /// as fixed components instead) stick while closed, as friction with no
-/// bound on μ, and let go when the node lifts off.
+/// bound on μ (not `STICK_MU`: the explicit step's bound), and let go
+/// when the node lifts off. A `slip` wall's slip without a test. On a
+/// `friction` wall, Coulomb's test (`coulomb_slip`) of |s| against μ |g|
+/// (both forces' k cancels).
 pub fn natural_state(wall: &Wall, gap: f64, du: [f64; 2]) -> ContactState {
     let (g, s) = components(wall, gap, du);
     if g > 0.0 {
@@ -91,7 +96,7 @@ pub fn natural_state(wall: &Wall, gap: f64, du: [f64; 2]) -> ContactState {
         ContactState::Stick
     } else if wall.contact != CONTACT_FRICTION {
         ContactState::Slip(1.0)
-    } else if s.abs() <= wall.mu * -g {
+    } else if coulomb_slip(s.abs(), -g, wall.coulomb_mu()).is_none() {
         ContactState::Stick
     } else {
         ContactState::Slip(s.signum())
@@ -128,11 +133,9 @@ pub fn force(
             (f, [k, 0.0, 0.0, k])
         }
         ContactState::Slip(sigma) => {
-            let mu = if wall.contact == CONTACT_FRICTION {
-                wall.mu
-            } else {
-                0.0
-            };
+            // μ of the wall's law: `natural_state` gives a slip state
+            // only on `slip` (0) and `friction` (μ) walls.
+            let mu = wall.coulomb_mu();
             // f = −k g n + μ k g σ t (g ≤ 0: friction −μ k |g| σ t).
             let f = [
                 -k * g * n[0] + mu * k * g * sigma * t[0],
