@@ -3,7 +3,7 @@
 //! GPU twin: `shaders/forces.wgsl`.
 
 use super::scatter::Scatter;
-use super::stage_inputs::{BodyForce, ParticleWeights, Weights, with_weights};
+use super::stage_inputs::{BodyForce, ParticleWeights, Stencil, Weights, with_weights};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::node_force;
 use rayon::prelude::*;
@@ -44,6 +44,7 @@ fn forces_with<W: ParticleWeights>(
         force,
         n,
         (0..n.div_ceil(len)).into_par_iter(),
+        #[inline(always)]
         |first, _, acc| {
             let mut slots = W::Scratch::default();
             let mut fault = None;
@@ -53,7 +54,7 @@ fn forces_with<W: ParticleWeights>(
                 let g = body.at(p);
                 let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
                 match weights.get::<true>(p, x[p], &mut slots) {
-                    Ok((nodes, w)) => add_particle_forces(nodes, w, vol, s, [bx, by], acc),
+                    Ok(st) => add_particle_forces(&st, vol, s, [bx, by], acc),
                     Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
             }
@@ -69,17 +70,16 @@ fn forces_with<W: ParticleWeights>(
 /// m_p b). Shared with the fused `stress::stress_forces`.
 #[inline(always)]
 pub fn add_particle_forces(
-    nodes: &[u32],
-    w: &[[f64; 3]],
+    st: &impl Stencil,
     vol: f64,
     s: [f64; 3],
     mb: [f64; 2],
     acc: &mut [[f64; 2]],
 ) {
-    for (&node, wk) in nodes.iter().zip(w) {
+    st.each(|node, wk| {
         let acc = &mut acc[node as usize];
-        let f = node_force(vol, s, wk, mb);
+        let f = node_force(vol, s, &wk, mb);
         acc[0] += f[0];
         acc[1] += f[1];
-    }
+    });
 }

@@ -13,7 +13,7 @@
 //! contact takes at least `CONTACT_PIC_FRACTION` of PIC.
 //! GPU twin: `shaders/g2p.wgsl`.
 
-use super::stage_inputs::{ParticleWeights, Weights, with_weights};
+use super::stage_inputs::{ParticleWeights, Stencil, Weights, with_weights};
 use crate::model::contact::CONTACT_PIC_FRACTION;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
@@ -60,8 +60,7 @@ impl Update<'_> {
     pub fn particle(
         &self,
         p: usize,
-        nodes: &[u32],
-        w: &[[f64; 3]],
+        st: &impl Stencil,
         x: &mut [f64; 2],
         v: &mut [f64; 2],
         a: Option<&mut [f64; 2]>,
@@ -72,22 +71,15 @@ impl Update<'_> {
         let dt = prm.dt;
         // Σ N f/m and Σ N v_I (nodes without mass hold zeros).
         let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
-        for (&node, wk) in nodes.iter().zip(w) {
+        st.each(|node, wk| {
             let n = &nodal[node as usize];
             vel[0] += wk[0] * n[0];
             vel[1] += wk[0] * n[1];
             acc[0] += wk[0] * n[2];
             acc[1] += wk[0] * n[3];
-        }
+        });
         let alpha = match touched {
-            Some(t)
-                if nodes
-                    .iter()
-                    .zip(w)
-                    .any(|(&node, wk)| wk[0] > 0.0 && t[node as usize]) =>
-            {
-                prm.pic_fraction.max(CONTACT_PIC_FRACTION)
-            }
+            Some(t) if touches(st, t) => prm.pic_fraction.max(CONTACT_PIC_FRACTION),
             _ => prm.pic_fraction,
         };
         if let Some(dp) = dp {
@@ -157,6 +149,35 @@ impl Update<'_> {
     }
 }
 
+impl Update<'_> {
+    /// `particle` with its weights evaluated into `slots`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn with_weights<W: ParticleWeights>(
+        &self,
+        weights: &W,
+        slots: &mut W::Scratch,
+        p: usize,
+        x: &mut [f64; 2],
+        v: &mut [f64; 2],
+        a: Option<&mut [f64; 2]>,
+        dp: Option<&mut [f64; 2]>,
+    ) -> Option<Fault> {
+        match weights.get::<false>(p, *x, slots) {
+            Ok(st) => self.particle(p, &st, x, v, a, dp),
+            Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
+        }
+    }
+}
+
+/// Whether a node of the stencil with a weight is one where a contact
+/// pair is in contact (`t`).
+fn touches(st: &impl Stencil, t: &[bool]) -> bool {
+    let mut hit = false;
+    st.each(|node, wk| hit |= wk[0] > 0.0 && t[node as usize]);
+    hit
+}
+
 /// Per node the velocity and acceleration g2p interpolates,
 /// [v_x, v_y, f_x/m, f_y/m], zero on nodes without mass: one division per
 /// node rather than one per particle and node.
@@ -211,25 +232,16 @@ fn g2p_with<W: ParticleWeights>(
         touched,
         mass,
     };
-    let kernel = |slots: &mut W::Scratch,
-                  p: usize,
-                  x: &mut [f64; 2],
-                  v: &mut [f64; 2],
-                  a: Option<&mut [f64; 2]>,
-                  dp: Option<&mut [f64; 2]>|
-     -> Option<Fault> {
-        match weights.get::<false>(p, *x, slots) {
-            Ok((nodes, w)) => update.particle(p, nodes, w, x, v, a, dp),
-            Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
-        }
-    };
     let fault = match (a.is_empty(), pic_dp.is_empty()) {
         (true, true) => (x.par_iter_mut(), v.par_iter_mut())
             .into_par_iter()
             .enumerate()
             .with_min_len(256)
             .map_init(W::Scratch::default, |sl, (p, (x, v))| {
-                crate::cpu::isa::vector(|| kernel(sl, p, x, v, None, None))
+                crate::cpu::isa::vector(
+                    #[inline(always)]
+                    || update.with_weights(weights, sl, p, x, v, None, None),
+                )
             })
             .reduce(|| None, Fault::first),
         (false, true) => (x.par_iter_mut(), v.par_iter_mut(), a.par_iter_mut())
@@ -237,7 +249,10 @@ fn g2p_with<W: ParticleWeights>(
             .enumerate()
             .with_min_len(256)
             .map_init(W::Scratch::default, |sl, (p, (x, v, a))| {
-                crate::cpu::isa::vector(|| kernel(sl, p, x, v, Some(a), None))
+                crate::cpu::isa::vector(
+                    #[inline(always)]
+                    || update.with_weights(weights, sl, p, x, v, Some(a), None),
+                )
             })
             .reduce(|| None, Fault::first),
         (true, false) => (x.par_iter_mut(), v.par_iter_mut(), pic_dp.par_iter_mut())
@@ -245,7 +260,10 @@ fn g2p_with<W: ParticleWeights>(
             .enumerate()
             .with_min_len(256)
             .map_init(W::Scratch::default, |sl, (p, (x, v, d))| {
-                crate::cpu::isa::vector(|| kernel(sl, p, x, v, None, Some(d)))
+                crate::cpu::isa::vector(
+                    #[inline(always)]
+                    || update.with_weights(weights, sl, p, x, v, None, Some(d)),
+                )
             })
             .reduce(|| None, Fault::first),
         (false, false) => (
@@ -258,7 +276,10 @@ fn g2p_with<W: ParticleWeights>(
             .enumerate()
             .with_min_len(256)
             .map_init(W::Scratch::default, |sl, (p, (x, v, a, d))| {
-                crate::cpu::isa::vector(|| kernel(sl, p, x, v, Some(a), Some(d)))
+                crate::cpu::isa::vector(
+                    #[inline(always)]
+                    || update.with_weights(weights, sl, p, x, v, Some(a), Some(d)),
+                )
             })
             .reduce(|| None, Fault::first),
     };

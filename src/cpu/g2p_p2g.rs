@@ -13,13 +13,13 @@
 use super::g2p::{self, G2pParams};
 use super::p2g::add_particle;
 use super::scatter::Scatter;
-use super::stage_inputs::{ParticleWeights, Weights, optional_chunks, with_weights};
+use super::stage_inputs::{BATCH, ParticleWeights, Weights, optional_chunks, with_weights};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::{Material, PlasticState};
 
 /// What the next step's Δt needs from the particles' state after this
-/// step: their materials and state (`Material::wave_speed`).
+/// step: their materials and state (`Material::wave_speed_squared`).
 pub struct SpeedInputs<'a> {
     pub materials: &'a [Material],
     pub body_material: &'a [u32],
@@ -85,47 +85,60 @@ fn run<W: ParticleWeights>(
         n_nodes,
         n,
         ranges,
+        #[inline(always)]
         |first, (x, v, mut a), acc| {
             let mut fault = None;
-            let mut c = 0.0f64;
-            let (mut before, mut after) = (W::Scratch::default(), W::Scratch::default());
-            for (k, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
-                // The weights at the step's start, for g2p, then at the
-                // position reached, for the next p2g.
-                let p = first + k;
-                let mut a = a.as_deref_mut().map(|a| &mut a[k]);
-                let f = match weights.get::<false>(p, *x, &mut before) {
-                    Ok((nodes, w)) => update.particle(p, nodes, w, x, v, a.as_deref_mut(), None),
-                    Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
-                };
-                if f.is_some() {
+            let mut c2 = 0.0f64;
+            let mut batch = W::Batch::default();
+            let mut moved = [false; BATCH];
+            let mut next = [[0.0; 2]; BATCH];
+            for (b, (x, v)) in x.chunks_mut(BATCH).zip(v.chunks_mut(BATCH)).enumerate() {
+                let (k0, len) = (b * BATCH, x.len());
+                // The weights at the step's start, for g2p.
+                weights.prepare::<false>(first + k0, x, &mut batch);
+                for (j, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
+                    let p = first + k0 + j;
+                    let a = a.as_deref_mut().map(|a| &mut a[k0 + j]);
+                    let f = match weights.view(p, &batch, j) {
+                        Ok(st) => update.particle(p, &st, x, v, a, None),
+                        Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
+                    };
+                    moved[j] = f.is_none();
                     fault = Fault::first(fault, f);
-                    continue;
+                    next[j] = *x;
                 }
-                if !sp.fixed_dt {
-                    let wave = sp.materials[sp.body_material[sp.body[p] as usize] as usize]
-                        .wave_speed(
-                            sp.rho[p],
-                            &sp.stress[p],
-                            sp.plastic.get(p).unwrap_or(&[0.0; 4]),
-                        );
-                    c = c.max((v[0] * v[0] + v[1] * v[1]).sqrt().max(wave));
-                }
-                match weights.get::<false>(p, *x, &mut after) {
-                    Ok((nodes, w)) => {
-                        let acc_p = a.map_or([0.0; 2], |a| *a);
-                        add_particle(nodes, w, sp.mass[p], *v, acc_p, acc);
+                // Then at the positions reached, for the next p2g.
+                weights.prepare::<false>(first + k0, &next[..len], &mut batch);
+                for j in (0..len).filter(|&j| moved[j]) {
+                    let (p, v) = (first + k0 + j, v[j]);
+                    if !sp.fixed_dt {
+                        // Squared, as `time_step::max_speed` takes them.
+                        let wave = sp.materials[sp.body_material[sp.body[p] as usize] as usize]
+                            .wave_speed_squared(
+                                sp.rho[p],
+                                &sp.stress[p],
+                                sp.plastic.get(p).unwrap_or(&[0.0; 4]),
+                            );
+                        c2 = c2.max((v[0] * v[0] + v[1] * v[1]).max(wave));
                     }
-                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                    match weights.view(p, &batch, j) {
+                        Ok(st) => {
+                            let acc_p = a.as_deref().map_or([0.0; 2], |a| a[k0 + j]);
+                            add_particle(&st, sp.mass[p], v, acc_p, acc);
+                        }
+                        Err(e) => {
+                            fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e))))
+                        }
+                    }
                 }
             }
-            (fault, c)
+            (fault, c2)
         },
         |(fa, ca), (fb, cb)| (Fault::first(fa, fb), ca.max(cb)),
         || (None, 0.0),
     );
     match fault {
         Some(f) => Err(f),
-        None => Ok((c, used)),
+        None => Ok((c.sqrt(), used)),
     }
 }

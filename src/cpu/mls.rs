@@ -580,7 +580,13 @@ impl Mls {
             let g = body(p);
             let mb = [mass[p] * g[0], mass[p] * g[1]];
             let (nodes, w) = cache.particle(p);
-            super::forces::add_particle_forces(nodes, w, vol, s, mb, acc);
+            super::forces::add_particle_forces(
+                &super::stage_inputs::Slices(nodes, w),
+                vol,
+                s,
+                mb,
+                acc,
+            );
         });
         let (shape, gw, gf) = (&self.gp_shape, &self.gp_w, &self.gp_f);
         self.f_scatter.run(force, gf.len(), |g, acc| {

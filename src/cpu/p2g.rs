@@ -7,7 +7,7 @@
 //! GPU twin: `shaders/p2g.wgsl`.
 
 use super::scatter::Scatter;
-use super::stage_inputs::{ParticleWeights, Weights, with_weights};
+use super::stage_inputs::{ParticleWeights, Stencil, Weights, with_weights};
 use crate::model::fault::{Fault, FaultKind};
 use rayon::prelude::*;
 
@@ -46,12 +46,13 @@ fn p2g_with<W: ParticleWeights>(
         mv.len(),
         n,
         (0..n.div_ceil(len)).into_par_iter(),
+        #[inline(always)]
         |first, _, acc| {
             let mut slots = W::Scratch::default();
             let mut fault = None;
             for p in first..(first + len).min(n) {
                 match weights.get::<false>(p, x[p], &mut slots) {
-                    Ok((nodes, w)) => add_particle(nodes, w, mass[p], v[p], accel(a, p), acc),
+                    Ok(st) => add_particle(&st, mass[p], v[p], accel(a, p), acc),
                     Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
             }
@@ -69,15 +70,8 @@ fn p2g_with<W: ParticleWeights>(
 /// Adds one particle's N m, N m v and N m a to its nodes in `acc`.
 /// Shared with the fused `shape_eval::shape_eval_p2g` and `g2p_p2g`.
 #[inline(always)]
-pub fn add_particle(
-    nodes: &[u32],
-    w: &[[f64; 3]],
-    m: f64,
-    vel: [f64; 2],
-    a: [f64; 2],
-    acc: &mut [[f64; 5]],
-) {
-    for (&node, wk) in nodes.iter().zip(w) {
+pub fn add_particle(st: &impl Stencil, m: f64, vel: [f64; 2], a: [f64; 2], acc: &mut [[f64; 5]]) {
+    st.each(|node, wk| {
         let nm = wk[0] * m;
         let acc = &mut acc[node as usize];
         acc[0] += nm;
@@ -85,7 +79,7 @@ pub fn add_particle(
         acc[2] += nm * vel[1];
         acc[3] += nm * a[0];
         acc[4] += nm * a[1];
-    }
+    });
 }
 
 /// Particle p's acceleration (zero for FE and MUSL, which keep none).

@@ -125,7 +125,10 @@ impl<const K: usize> Scatter<K> {
             .enumerate()
             .map(|(t, (acc, c))| {
                 acc.fill([0.0; K]);
-                crate::cpu::isa::vector(|| kernel(t * per, c, acc))
+                crate::cpu::isa::vector(
+                    #[inline(always)]
+                    || kernel(t * per, c, acc),
+                )
             })
             .reduce(&none, &fold);
         (r, used)

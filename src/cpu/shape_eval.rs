@@ -8,7 +8,7 @@
 //! inline in each GPU pass.
 
 use super::p2g::{accel, add_particle, combine};
-use super::stage_inputs::{ShapeCache, Weights};
+use super::stage_inputs::{ShapeCache, Slices, Weights};
 use super::{p2g, scatter::Scatter};
 use crate::model::Grid;
 use crate::model::fault::{Fault, FaultKind};
@@ -105,7 +105,13 @@ pub fn shape_eval_p2g(
         match shape.eval(grid, x[p], lam, nodes, w) {
             Ok(k) => {
                 *cnt = k as u16;
-                add_particle(&nodes[..k], &w[..k], mass[p], v[p], accel(a, p), acc);
+                add_particle(
+                    &Slices(&nodes[..k], &w[..k]),
+                    mass[p],
+                    v[p],
+                    accel(a, p),
+                    acc,
+                );
                 None
             }
             Err(e) => {

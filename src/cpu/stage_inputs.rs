@@ -4,7 +4,7 @@
 //! (`body_force`). A leaf, so the stage files name it and not the backend
 //! (`cpu/mod.rs`) that calls them.
 
-use crate::model::shape::separable::Separable;
+use crate::model::shape::separable::{Lanes, Separable, Stencil1};
 use crate::model::shape::{Shape, ShapeFault};
 use crate::model::{Grid, Integrator, Model};
 use rayon::iter::Either;
@@ -142,51 +142,32 @@ impl<'a> Weights<'a> {
             None => Weights::Eval { shape, grid },
         }
     }
+}
 
-    /// Particle `p`'s nodes and [N, ∂N/∂x, ∂N/∂y], at `x` (its position at
-    /// the step's shape evaluation) when evaluated, into `slots`.
-    #[inline(always)]
-    pub fn particle<'s>(
-        &'s self,
-        p: usize,
-        x: [f64; 2],
-        slots: &'s mut Slots,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
-        self.particle_with::<true>(p, x, slots)
-    }
+/// One particle's nodes and [N, ∂N/∂x, ∂N/∂y], slot by slot, as a loop
+/// over its nodes reads them: stored slots (`Slots`), or a separable
+/// shape's 1-D bases whose products are taken where they are used
+/// (`FixedView`), so no loop stores and reloads them.
+pub trait Stencil {
+    /// `f(node, [N, ∂N/∂x, ∂N/∂y])` for each slot in order; a loop that
+    /// reads N only leaves the gradients' products unused (and the
+    /// compiler drops them).
+    fn each(&self, f: impl FnMut(u32, [f64; 3]));
+}
 
-    /// As `particle`, where the loop reads N only: the separable shapes
-    /// leave the gradients unwritten.
-    #[inline(always)]
-    pub fn particle_values<'s>(
-        &'s self,
-        p: usize,
-        x: [f64; 2],
-        slots: &'s mut Slots,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
-        self.particle_with::<false>(p, x, slots)
-    }
+/// Stored slots: nodes and weights side by side.
+#[derive(Clone, Copy)]
+pub struct Slices<'a>(pub &'a [u32], pub &'a [[f64; 3]]);
 
+impl Stencil for Slices<'_> {
     #[inline(always)]
-    fn particle_with<'s, const GRAD: bool>(
-        &'s self,
-        p: usize,
-        x: [f64; 2],
-        slots: &'s mut Slots,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
-        match self {
-            Weights::Cache(c) => Ok(c.particle(p)),
-            Weights::Separable(s) => {
-                let k = s.eval::<GRAD>(x, &mut slots.nodes, &mut slots.w)?;
-                Ok((&slots.nodes[..k], &slots.w[..k]))
-            }
-            Weights::Eval { shape, grid } => {
-                let k = shape.eval(grid, x, &mut [0.0; 2], &mut slots.nodes, &mut slots.w)?;
-                Ok((&slots.nodes[..k], &slots.w[..k]))
-            }
+    fn each(&self, mut f: impl FnMut(u32, [f64; 3])) {
+        for (&node, w) in self.0.iter().zip(self.1) {
+            f(node, *w);
         }
     }
 }
+
 /// Where a loop over the particles takes each particle's nodes and
 /// [N, ∂N/∂x, ∂N/∂y]: `Weights` (the stored cache, or `Shape::eval` at the
 /// particle), or a separable shape as a type of its own (`Fixed`), whose
@@ -195,28 +176,111 @@ impl<'a> Weights<'a> {
 /// per loop. All give the same numbers (`Separable::eval_fixed` is
 /// `Shape::eval`, tested in `model::shape::separable`).
 pub trait ParticleWeights: Sync {
-    /// A loop's scratch for one particle's slots.
+    /// A loop's scratch for one particle's weights (`get`).
     type Scratch: Default;
+    /// A loop's scratch for the weights of `BATCH` particles (`prepare`).
+    type Batch: Default;
+    /// What a particle's weights read as.
+    type View<'s>: Stencil
+    where
+        Self: 's;
     /// Particle `p`'s nodes and weights at `x` (its position at the step's
-    /// shape evaluation); gradients written only when `GRAD`.
+    /// shape evaluation), gradients only when `GRAD`.
     fn get<'s, const GRAD: bool>(
         &'s self,
         p: usize,
         x: [f64; 2],
         scratch: &'s mut Self::Scratch,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault>;
+    ) -> Result<Self::View<'s>, ShapeFault>;
+    /// Evaluates the weights of particles `first + j` at `x[j]` for the
+    /// `x.len()` ≤ `BATCH` lanes j of `batch`, which `view` then reads:
+    /// the loops that take the particles by batches evaluate them in
+    /// lanes, as they depend on the positions alone.
+    fn prepare<const GRAD: bool>(&self, first: usize, x: &[[f64; 2]], batch: &mut Self::Batch);
+    /// Particle `p`'s weights from lane `j` of what `prepare` left.
+    fn view<'s>(
+        &'s self,
+        p: usize,
+        batch: &'s Self::Batch,
+        j: usize,
+    ) -> Result<Self::View<'s>, ShapeFault>;
+}
+
+/// Particles a loop evaluates the weights of at once
+/// (`ParticleWeights::prepare`).
+pub const BATCH: usize = 8;
+
+/// `Weights`' scratch: the slots and what the evaluation returned.
+pub struct Prepared {
+    slots: Slots,
+    k: Result<usize, ShapeFault>,
+}
+
+impl Default for Prepared {
+    fn default() -> Self {
+        Prepared {
+            slots: Slots::default(),
+            k: Ok(0),
+        }
+    }
+}
+
+impl Weights<'_> {
+    #[inline(always)]
+    fn prepare_one<const GRAD: bool>(&self, x: [f64; 2], s: &mut Prepared) {
+        let slots = &mut s.slots;
+        s.k = match self {
+            Weights::Cache(_) => Ok(0),
+            Weights::Separable(sep) => sep.eval::<GRAD>(x, &mut slots.nodes, &mut slots.w),
+            Weights::Eval { shape, grid } => {
+                shape.eval(grid, x, &mut [0.0; 2], &mut slots.nodes, &mut slots.w)
+            }
+        };
+    }
+
+    #[inline(always)]
+    fn view_one<'s>(&'s self, p: usize, s: &'s Prepared) -> Result<Slices<'s>, ShapeFault> {
+        match self {
+            Weights::Cache(c) => {
+                let (n, w) = c.particle(p);
+                Ok(Slices(n, w))
+            }
+            _ => s.k.map(|k| Slices(&s.slots.nodes[..k], &s.slots.w[..k])),
+        }
+    }
 }
 
 impl ParticleWeights for Weights<'_> {
-    type Scratch = Slots;
+    type Scratch = Prepared;
+    type Batch = [Prepared; BATCH];
+    type View<'s>
+        = Slices<'s>
+    where
+        Self: 's;
     #[inline(always)]
     fn get<'s, const GRAD: bool>(
         &'s self,
         p: usize,
         x: [f64; 2],
-        scratch: &'s mut Slots,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
-        self.particle_with::<GRAD>(p, x, scratch)
+        s: &'s mut Prepared,
+    ) -> Result<Slices<'s>, ShapeFault> {
+        self.prepare_one::<GRAD>(x, s);
+        self.view_one(p, s)
+    }
+    #[inline(always)]
+    fn prepare<const GRAD: bool>(&self, _first: usize, x: &[[f64; 2]], b: &mut [Prepared; BATCH]) {
+        for (x, s) in x.iter().zip(b) {
+            self.prepare_one::<GRAD>(*x, s);
+        }
+    }
+    #[inline(always)]
+    fn view<'s>(
+        &'s self,
+        p: usize,
+        b: &'s [Prepared; BATCH],
+        j: usize,
+    ) -> Result<Slices<'s>, ShapeFault> {
+        self.view_one(p, &b[j])
     }
 }
 
@@ -225,32 +289,63 @@ impl ParticleWeights for Weights<'_> {
 #[derive(Clone, Copy)]
 pub struct Fixed<const K: usize>(pub Separable);
 
-/// `Fixed`'s scratch: K slots.
-pub struct FixedSlots<const K: usize> {
-    nodes: [u32; K],
-    w: [[f64; 3]; K],
+/// `Fixed`'s view of one particle: its stencil's 1-D bases (one lane of
+/// `Lanes`), with the shape.
+pub struct FixedView<'a, const K: usize> {
+    sep: &'a Separable,
+    stencil: Stencil1<K>,
 }
 
-impl<const K: usize> Default for FixedSlots<K> {
-    fn default() -> Self {
-        FixedSlots {
-            nodes: [0; K],
-            w: [[0.0; 3]; K],
+impl<const K: usize> Stencil for FixedView<'_, K> {
+    #[inline(always)]
+    fn each(&self, f: impl FnMut(u32, [f64; 3])) {
+        self.sep.each(&self.stencil, f);
+    }
+}
+
+impl<const K: usize> Fixed<K> {
+    #[inline(always)]
+    fn view_lane<const L: usize>(
+        &self,
+        lanes: &Lanes<K, L>,
+        j: usize,
+    ) -> Result<FixedView<'_, K>, ShapeFault> {
+        match lanes.fault(j) {
+            Some(e) => Err(e),
+            None => Ok(FixedView {
+                sep: &self.0,
+                stencil: lanes.lane(j),
+            }),
         }
     }
 }
 
 impl<const K: usize> ParticleWeights for Fixed<K> {
-    type Scratch = FixedSlots<K>;
+    type Scratch = Lanes<K, 1>;
+    type Batch = Lanes<K, BATCH>;
+    type View<'s> = FixedView<'s, K>;
     #[inline(always)]
     fn get<'s, const GRAD: bool>(
         &'s self,
         _p: usize,
         x: [f64; 2],
-        s: &'s mut FixedSlots<K>,
-    ) -> Result<(&'s [u32], &'s [[f64; 3]]), ShapeFault> {
-        self.0.eval_fixed::<GRAD, K>(x, &mut s.nodes, &mut s.w)?;
-        Ok((&s.nodes, &s.w))
+        s: &'s mut Lanes<K, 1>,
+    ) -> Result<FixedView<'s, K>, ShapeFault> {
+        self.0.bases_lanes::<K, 1>(&[x], s);
+        self.view_lane(s, 0)
+    }
+    #[inline(always)]
+    fn prepare<const GRAD: bool>(&self, _first: usize, x: &[[f64; 2]], b: &mut Lanes<K, BATCH>) {
+        self.0.bases_lanes::<K, BATCH>(x, b);
+    }
+    #[inline(always)]
+    fn view<'s>(
+        &'s self,
+        _p: usize,
+        b: &'s Lanes<K, BATCH>,
+        j: usize,
+    ) -> Result<FixedView<'s, K>, ShapeFault> {
+        self.view_lane(b, j)
     }
 }
 

@@ -10,7 +10,7 @@
 use super::forces::add_particle_forces;
 use super::scatter::Scatter;
 use super::stage_inputs::{
-    BodyForce, ParticleWeights, Weights, optional, optional_chunks, with_weights,
+    BATCH, BodyForce, ParticleWeights, Stencil, Weights, optional, optional_chunks, with_weights,
 };
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::{Material, PlasticState};
@@ -46,24 +46,26 @@ pub fn stress(
         .enumerate()
         .with_min_len(256)
         .map_init(Default::default, |slots, (p, (s, r, f, q))| {
-            crate::cpu::isa::vector(|| {
-                let (nodes, w) = match weights.get::<true>(p, x[p], slots) {
-                    Ok(nw) => nw,
-                    Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
-                };
-                update_particle(
-                    nodes,
-                    w,
-                    mv,
-                    dt,
-                    &materials[body_material[body[p] as usize] as usize],
-                    p,
-                    s,
-                    r,
-                    (f, q),
-                    dl.get(p),
-                )
-            })
+            crate::cpu::isa::vector(
+                #[inline(always)]
+                || {
+                    let st = match weights.get::<true>(p, x[p], slots) {
+                        Ok(st) => st,
+                        Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
+                    };
+                    update_particle(
+                        &st,
+                        mv,
+                        dt,
+                        &materials[body_material[body[p] as usize] as usize],
+                        p,
+                        s,
+                        r,
+                        (f, q),
+                        dl.get(p),
+                    )
+                },
+            )
         })
         .reduce(|| None, Fault::first));
     fault.map_or(Ok(()), Err)
@@ -74,8 +76,7 @@ pub fn stress(
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn update_particle(
-    nodes: &[u32],
-    w: &[[f64; 3]],
+    st: &impl Stencil,
     mv: &[[f64; 3]],
     dt: f64,
     material: &Material,
@@ -87,13 +88,13 @@ fn update_particle(
 ) -> Option<Fault> {
     // Velocity gradient L_ij = Σ v_i ∂N/∂x_j.
     let mut l = [0.0; 4];
-    for (&node, wk) in nodes.iter().zip(w) {
+    st.each(|node, wk| {
         let v = &mv[node as usize];
         l[0] += v[1] * wk[1];
         l[1] += v[1] * wk[2];
         l[2] += v[2] * wk[1];
         l[3] += v[2] * wk[2];
-    }
+    });
     // `solver.mls_scope = "force"`: the transpose of the force's bracket
     // (`Mls::strain_correction`), so that the stress does the forces' work.
     if let Some(d) = dl {
@@ -167,6 +168,38 @@ struct StressInputs<'a> {
     body_force: &'a BodyForce<'a>,
 }
 
+impl StressInputs<'_> {
+    /// Particle p's update, then its forces from the stress just
+    /// computed, from the weights `prepare` left in `slots`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn particle<W: ParticleWeights>(
+        &self,
+        weights: &W,
+        p: usize,
+        s: &mut [f64; 3],
+        r: &mut f64,
+        extra: Extra<'_>,
+        batch: &W::Batch,
+        j: usize,
+        acc: &mut [[f64; 2]],
+    ) -> Option<Fault> {
+        let inp = self;
+        let material = &inp.materials[inp.body_material[inp.body[p] as usize] as usize];
+        let st = match weights.view(p, batch, j) {
+            Ok(st) => st,
+            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
+        };
+        if let Some(fault) = update_particle(&st, inp.mv, inp.dt, material, p, s, r, extra, None) {
+            return Some(fault);
+        }
+        let g = inp.body_force.at(p);
+        let m = inp.mass[p];
+        add_particle_forces(&st, m / *r, *s, [m * g[0], m * g[1]], acc);
+        None
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn stress_forces_with<W: ParticleWeights>(
     weights: &W,
@@ -180,27 +213,6 @@ fn stress_forces_with<W: ParticleWeights>(
 ) -> Result<(), Fault> {
     let n = inp.mass.len();
     let len = Scatter::<2>::range_len(n);
-    let particle = |p: usize,
-                    s: &mut [f64; 3],
-                    r: &mut f64,
-                    extra: Extra<'_>,
-                    slots: &mut W::Scratch,
-                    acc: &mut [[f64; 2]]| {
-        let material = &inp.materials[inp.body_material[inp.body[p] as usize] as usize];
-        let (nodes, w) = match weights.get::<true>(p, inp.x[p], slots) {
-            Ok(nw) => nw,
-            Err(e) => return Some(Fault::at(p, FaultKind::Shape(e))),
-        };
-        if let Some(fault) =
-            update_particle(nodes, w, inp.mv, inp.dt, material, p, s, r, extra, None)
-        {
-            return Some(fault);
-        }
-        let g = inp.body_force.at(p);
-        let m = inp.mass[p];
-        add_particle_forces(nodes, w, m / *r, *s, [m * g[0], m * g[1]], acc);
-        None
-    };
     let ranges = (
         stress.par_chunks_mut(len),
         rho.par_chunks_mut(len),
@@ -212,16 +224,23 @@ fn stress_forces_with<W: ParticleWeights>(
         force,
         n,
         ranges,
+        #[inline(always)]
         |first, (s, r, mut f, mut q), acc| {
             let mut fault = None;
-            let mut slots = W::Scratch::default();
-            for (k, (s, r)) in s.iter_mut().zip(r).enumerate() {
-                let extra = (
-                    f.as_deref_mut().map(|f| &mut f[k]),
-                    q.as_deref_mut().map(|q| &mut q[k]),
-                );
-                let f = particle(first + k, s, r, extra, &mut slots, acc);
-                fault = Fault::first(fault, f);
+            let mut batch = W::Batch::default();
+            for (b, (s, r)) in s.chunks_mut(BATCH).zip(r.chunks_mut(BATCH)).enumerate() {
+                let k0 = b * BATCH;
+                let at = first + k0;
+                weights.prepare::<true>(at, &inp.x[at..at + s.len()], &mut batch);
+                for (j, (s, r)) in s.iter_mut().zip(r).enumerate() {
+                    let k = k0 + j;
+                    let extra = (
+                        f.as_deref_mut().map(|f| &mut f[k]),
+                        q.as_deref_mut().map(|q| &mut q[k]),
+                    );
+                    let f = inp.particle(weights, first + k, s, r, extra, &batch, j, acc);
+                    fault = Fault::first(fault, f);
+                }
             }
             fault
         },

@@ -61,12 +61,13 @@ pub fn max_speed(model: &Model) -> f64 {
         .with_min_len(1024)
         .map(|i| {
             let v = p.v[i];
-            let c = model.material_of(i).wave_speed(
+            let c2 = model.material_of(i).wave_speed_squared(
                 p.rho[i],
                 &p.stress[i],
                 p.plastic.get(i).unwrap_or(&[0.0; 4]),
             );
-            (v[0] * v[0] + v[1] * v[1]).sqrt().max(c)
+            (v[0] * v[0] + v[1] * v[1]).max(c2)
         })
         .reduce(|| 0.0, f64::max)
+        .sqrt()
 }

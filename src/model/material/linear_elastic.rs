@@ -67,6 +67,12 @@ impl LinearElastic {
         (self.p_modulus / rho).sqrt()
     }
 
+    /// `wave_speed` squared: (λ + 2μ)/ρ.
+    #[inline(always)]
+    pub fn wave_speed_squared(&self, rho: f64) -> f64 {
+        self.p_modulus / rho
+    }
+
     /// ½ σ : ε with ε from the plane-strain compliance (σzz = ν(σxx + σyy) implied).
     #[inline]
     pub fn strain_energy_density(&self, s: &[f64; 3]) -> f64 {
@@ -97,7 +103,7 @@ impl Constitutive for LinearElastic {
     fn youngs_nu(&self) -> (f64, f64) {
         (self.youngs, self.nu)
     }
-    #[inline]
+    #[inline(always)]
     fn update(
         &self,
         l: [f64; 4],
@@ -120,6 +126,10 @@ impl Constitutive for LinearElastic {
     #[inline]
     fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
         LinearElastic::wave_speed(self, rho)
+    }
+    #[inline(always)]
+    fn wave_speed_squared(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+        LinearElastic::wave_speed_squared(self, rho)
     }
     #[inline]
     fn strain_energy_density(&self, stress: &[f64; 3], _f: &DefGrad, _q: &PlasticState) -> f64 {

@@ -99,7 +99,7 @@ macro_rules! register {
             /// `dt` (s): updates the stress (and F, or the plastic state
             /// `q`), and returns the volume ratio V_new / V_old. Models
             /// ignore the state they do not keep.
-            #[inline]
+            #[inline(always)]
             pub fn update(
                 &self,
                 l: [f64; 4],
@@ -113,9 +113,15 @@ macro_rules! register {
 
             /// Speed of the fastest wave at density `rho` (m/s) and the
             /// particle's state, for the CFL condition.
-            #[inline]
+            #[inline(always)]
             pub fn wave_speed(&self, rho: f64, stress: &[f64; 3], q: &PlasticState) -> f64 {
                 match self { $(Material::$variant(m) => <$ty as Constitutive>::wave_speed(m, rho, stress, q),)* }
+            }
+
+            /// `wave_speed` squared (m²/s²), for the largest over the particles.
+            #[inline(always)]
+            pub fn wave_speed_squared(&self, rho: f64, stress: &[f64; 3], q: &PlasticState) -> f64 {
+                match self { $(Material::$variant(m) => <$ty as Constitutive>::wave_speed_squared(m, rho, stress, q),)* }
             }
 
             /// Stored elastic energy per unit current volume (J/m³).

@@ -455,10 +455,15 @@ impl ModifiedCamClay {
     /// K ≤ v P_REF exp((N − v)/λ) / κ bounds the stiffness.
     #[inline]
     pub fn wave_speed(&self, rho: f64) -> f64 {
+        self.wave_speed_squared(rho).sqrt()
+    }
+
+    /// `wave_speed` squared.
+    pub fn wave_speed_squared(&self, rho: f64) -> f64 {
         let v = self.v0 * self.density / rho;
         let p_max = P_REF * ((self.n_ncl - v) / self.lambda).exp();
         let k = self.bulk(p_max, v);
-        ((k + 4.0 / 3.0 * self.shear_at(k)) / rho).sqrt()
+        (k + 4.0 / 3.0 * self.shear_at(k)) / rho
     }
 
     /// Elastic energy per unit volume (J/m³) of the stress with its σzz:
@@ -630,6 +635,9 @@ impl super::Constitutive for ModifiedCamClay {
     #[inline]
     fn wave_speed(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
         ModifiedCamClay::wave_speed(self, rho)
+    }
+    fn wave_speed_squared(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+        ModifiedCamClay::wave_speed_squared(self, rho)
     }
     #[inline]
     fn strain_energy_density(&self, s: &[f64; 3], _f: &super::DefGrad, q: &PlasticState) -> f64 {

@@ -124,6 +124,10 @@ impl Constitutive for NeoHookean {
         NeoHookean::wave_speed(self, rho)
     }
     #[inline]
+    fn wave_speed_squared(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+        (self.lame + 2.0 * self.shear) / rho
+    }
+    #[inline]
     fn strain_energy_density(&self, _s: &[f64; 3], f: &DefGrad, _q: &PlasticState) -> f64 {
         self.energy_density(f)
     }

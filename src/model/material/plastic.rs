@@ -176,6 +176,10 @@ macro_rules! elastoplastic_constitutive {
                 ((self.elastic.lame + 2.0 * self.elastic.shear) / rho).sqrt()
             }
             #[inline]
+            fn wave_speed_squared(&self, rho: f64, _s: &[f64; 3], _q: &PlasticState) -> f64 {
+                (self.elastic.lame + 2.0 * self.elastic.shear) / rho
+            }
+            #[inline]
             fn strain_energy_density(
                 &self,
                 s: &[f64; 3],

@@ -138,6 +138,15 @@ pub trait Constitutive: Sized {
     /// Speed of the fastest wave (m/s) at density `rho` and the particle's
     /// state, for the CFL condition.
     fn wave_speed(&self, rho: f64, stress: &[f64; 3], q: &PlasticState) -> f64;
+    /// `wave_speed` squared (m²/s²): the CFL condition takes the largest
+    /// over the particles and one square root. A model whose speed is a
+    /// square root gives its argument, so that the largest speed is the
+    /// same number either way (the square root keeps the order).
+    #[inline]
+    fn wave_speed_squared(&self, rho: f64, stress: &[f64; 3], q: &PlasticState) -> f64 {
+        let c = self.wave_speed(rho, stress, q);
+        c * c
+    }
     /// Stored energy per unit current volume (J/m³).
     fn strain_energy_density(&self, stress: &[f64; 3], f: &DefGrad, q: &PlasticState) -> f64;
     /// The GPU parameters, in `GPU_PARAMS` order.

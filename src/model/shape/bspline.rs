@@ -100,6 +100,80 @@ pub fn basis_of<const P: usize>(
     }
 }
 
+/// `basis_of` for L points at once, into `first[l]` and per basis r
+/// `nb[r][l]`, `dn[r][l]`: the interior's closed form in lanes,
+/// which the compiler vectorises, then the lanes near the grid's edge
+/// again by `basis`. The same numbers as `basis_of` per lane. Points
+/// outside [0, n − 1] give some numbers; the caller has refused them.
+#[inline(always)]
+// Lane l indexes several arrays at once: the form that vectorises.
+#[allow(clippy::needless_range_loop)]
+pub fn basis_lanes<const P: usize, const L: usize>(
+    u: &[f64; L],
+    n: usize,
+    e: f64,
+    first: &mut [u32; L],
+    nb: &mut [[f64; L]; MAX_DEGREE + 1],
+    dn: &mut [[f64; L]; MAX_DEGREE + 1],
+) {
+    let (lo, hi) = (P as f64, (n - 1) as f64);
+    let (inner_lo, inner_hi) = ((2 * P) as f64, n as f64 - (P + 2) as f64);
+    let mut span_f = [0.0; L];
+    // `basis_of`'s interior test, inner_lo < s ≤ inner_hi, as a bit mask
+    // of the lanes near the edge.
+    let mut edge = 0u32;
+    for l in 0..L {
+        // `span`: floor(u + (p + 1)/2) clamped to [p, n − 1], by truncation
+        // (u ≥ 0 inside the grid).
+        let s = (u[l] + 0.5 * (P as f64 + 1.0))
+            .max(0.0)
+            .trunc()
+            .clamp(lo, hi);
+        span_f[l] = s;
+        let interior = (s > inner_lo) & (s <= inner_hi);
+        edge |= (!interior as u32) << l;
+        // SAFETY: s is finite, in [p, n − 1].
+        first[l] = unsafe { s.to_int_unchecked::<i32>() } as u32 - P as u32;
+    }
+    for l in 0..L {
+        let fl = span_f[l] - P as f64;
+        if P == 2 {
+            let f = u[l] - fl;
+            let (a, b, c) = (1.5 - f, f - 1.0, f - 0.5);
+            nb[0][l] = 0.5 * a * a;
+            nb[1][l] = 0.75 - b * b;
+            nb[2][l] = 0.5 * c * c;
+            dn[0][l] = -a;
+            dn[1][l] = -2.0 * b;
+            dn[2][l] = c;
+        } else {
+            let t = u[l] - (fl + 1.0);
+            let (t2, r) = (t * t, 1.0 - t);
+            let t3 = t2 * t;
+            nb[0][l] = r * r * r / 6.0;
+            nb[1][l] = 0.5 * t3 - t2 + 2.0 / 3.0;
+            nb[2][l] = -0.5 * t3 + 0.5 * t2 + 0.5 * t + 1.0 / 6.0;
+            nb[3][l] = t3 / 6.0;
+            dn[0][l] = -0.5 * r * r;
+            dn[1][l] = 1.5 * t2 - 2.0 * t;
+            dn[2][l] = -1.5 * t2 + t + 0.5;
+            dn[3][l] = 0.5 * t2;
+        }
+    }
+    if edge != 0 {
+        for l in (0..L).filter(|&l| edge >> l & 1 != 0) {
+            // A lane the caller refuses may hold NaN.
+            let ul = if u[l].is_nan() { 0.0 } else { u[l] };
+            let (f, v, d) = edge_basis(ul, n, P, e);
+            first[l] = f as u32;
+            for r in 0..=P {
+                nb[r][l] = v[r];
+                dn[r][l] = d[r];
+            }
+        }
+    }
+}
+
 /// `basis` near the grid's edge, out of line (`basis_of`).
 #[inline(never)]
 fn edge_basis(

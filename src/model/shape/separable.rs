@@ -6,6 +6,7 @@
 //! stored cache and give the same result. Values only (`GRAD = false`) for
 //! the loops that need no ∇N (p2g, g2p).
 
+use super::bspline::MAX_DEGREE;
 use super::{Shape, ShapeFault, bspline, linear};
 use crate::model::Grid;
 
@@ -96,7 +97,8 @@ impl Separable {
     }
 
     /// `eval` for a shape of `class` with exactly K = its slots: the same
-    /// numbers in the same order, into arrays of that length.
+    /// numbers in the same order, into arrays of that length, through
+    /// `bases_lanes` and `each` (what the loops use).
     #[inline(always)]
     pub fn eval_fixed<const GRAD: bool, const K: usize>(
         &self,
@@ -104,20 +106,120 @@ impl Separable {
         nodes: &mut [u32; K],
         w: &mut [[f64; 3]; K],
     ) -> Result<(), ShapeFault> {
-        let q = self.lattice(x)?;
-        match (self.kind, K) {
-            (Kind::Linear, 4) => {
-                self.linear::<GRAD, K>(q, nodes, w);
-            }
-            (Kind::Bspline { p: 2, e }, 9) => {
-                self.bspline::<GRAD, 2, K>(q, e, nodes, w);
-            }
-            (Kind::Bspline { p: 3, e }, 16) => {
-                self.bspline::<GRAD, 3, K>(q, e, nodes, w);
-            }
-            (kind, k) => unreachable!("{kind:?} has no stencil of {k} slots"),
+        let mut b = Lanes::<K, 1>::default();
+        self.bases_lanes::<K, 1>(&[x], &mut b);
+        if let Some(e) = b.fault(0) {
+            return Err(e);
         }
+        let mut k = 0;
+        self.each(&b.lane(0), |node, wk| {
+            nodes[k] = node;
+            w[k][0] = wk[0];
+            if GRAD {
+                w[k][1] = wk[1];
+                w[k][2] = wk[2];
+            }
+            k += 1;
+        });
         Ok(())
+    }
+
+    /// The stencils of the first `x.len()` ≤ L points at once into
+    /// `out` (whose `each` gives `eval_fixed`'s numbers): the per-axis
+    /// work in lanes, which the compiler vectorises
+    /// (`bspline::basis_lanes`). A lane outside the grid gets its fault
+    /// and some stencil inside it.
+    #[inline(always)]
+    // Lane l indexes several arrays at once: the form that vectorises.
+    #[allow(clippy::needless_range_loop)]
+    pub fn bases_lanes<const K: usize, const L: usize>(
+        &self,
+        x: &[[f64; 2]],
+        out: &mut Lanes<K, L>,
+    ) {
+        let m = self.margin;
+        let (lo, hi) = (
+            [self.min[0] + m, self.min[1] + m],
+            [self.hi[0] - m, self.hi[1] - m],
+        );
+        // A full batch as it is, else the points padded with the first.
+        let mut padded = [x.first().copied().unwrap_or(self.min); L];
+        let x: &[[f64; 2]; L] = match x.try_into() {
+            Ok(full) => full,
+            Err(_) => {
+                padded[..x.len()].copy_from_slice(x);
+                &padded
+            }
+        };
+        let mut q = [[0.0; L]; 2];
+        let mut outside = 0u32;
+        for l in 0..L {
+            let p = x[l];
+            // Not inside (NaN is outside), lane by lane as a bit mask.
+            let inside = (p[0] >= lo[0]) & (p[0] <= hi[0]) & (p[1] >= lo[1]) & (p[1] <= hi[1]);
+            outside |= (!inside as u32) << l;
+            q[0][l] = (p[0] - self.min[0]) / self.h;
+            q[1][l] = (p[1] - self.min[1]) / self.h;
+        }
+        let mut first = [[0u32; L]; 2];
+        for ax in 0..2 {
+            let nodes = [self.nx, self.ny][ax];
+            let (n, d) = (&mut out.n[ax], &mut out.d[ax]);
+            match (self.kind, K) {
+                (Kind::Linear, 4) => {
+                    for l in 0..L {
+                        // `linear`'s cell: the floor, at least 0, at most
+                        // n − 2; the 1-D weights [1 − s, s] and their
+                        // derivatives [−1, 1], whose products are
+                        // `linear::q4_n` and `q4_dn` exactly.
+                        let c = q[ax][l].max(0.0).trunc().min((nodes - 2) as f64);
+                        // SAFETY: c is finite, in [0, n − 2].
+                        first[ax][l] = unsafe { c.to_int_unchecked::<i32>() } as u32;
+                        let s = q[ax][l] - c;
+                        n[0][l] = 1.0 - s;
+                        n[1][l] = s;
+                        d[0][l] = -1.0;
+                        d[1][l] = 1.0;
+                    }
+                }
+                (Kind::Bspline { p: 2, e }, 9) => {
+                    bspline::basis_lanes::<2, L>(&q[ax], nodes, e, &mut first[ax], n, d)
+                }
+                (Kind::Bspline { p: 3, e }, 16) => {
+                    bspline::basis_lanes::<3, L>(&q[ax], nodes, e, &mut first[ax], n, d)
+                }
+                (kind, k) => unreachable!("{kind:?} has no stencil of {k} slots"),
+            }
+        }
+        for l in 0..L {
+            out.node0[l] = first[1][l] * self.nx as u32 + first[0][l];
+        }
+        out.outside = outside;
+    }
+
+    /// A stencil's node and [N, ∂N/∂x, ∂N/∂y] slot by slot, in
+    /// `eval_fixed`'s order and arithmetic, through `f`.
+    #[inline(always)]
+    pub fn each<const K: usize>(&self, b: &Stencil1<K>, mut f: impl FnMut(u32, [f64; 3])) {
+        let side = Stencil1::<K>::SIDE;
+        for k in 0..K {
+            // Linear's corners run counter-clockwise from (i, j) (`linear`),
+            // the B-splines' x fastest (`bspline`).
+            let (i, j) = if K == 4 {
+                [(0, 0), (1, 0), (1, 1), (0, 1)][k]
+            } else {
+                (k % side, k / side)
+            };
+            let (nx, ny) = (b.n[0][i], b.n[1][j]);
+            f(
+                b.node0 + (j * self.nx + i) as u32,
+                [
+                    nx * ny,
+                    b.d[0][i] * ny * self.inv_h,
+                    nx * b.d[1][j] * self.inv_h,
+                ],
+            );
+        }
     }
 
     /// `x` in lattice units, or outside the grid (with the shape's margin).
@@ -190,6 +292,77 @@ impl Separable {
     }
 }
 
+/// The stencils of L points on a separable shape of K slots, lane by
+/// lane: each one's first node and, per axis, the 1-D values and
+/// derivatives (lattice units) whose products are N and ∇N
+/// (`Separable::each`): what a loop keeps of its particles' weights
+/// instead of the K products each.
+#[derive(Debug, Clone, Copy)]
+pub struct Lanes<const K: usize, const L: usize> {
+    pub node0: [u32; L],
+    /// Per axis and basis r (p + 1 of them; linear 2) the lanes' values.
+    pub n: [[[f64; L]; MAX_DEGREE + 1]; 2],
+    /// Their derivatives d/du.
+    pub d: [[[f64; L]; MAX_DEGREE + 1]; 2],
+    /// Bit l: lane l's point is outside the grid (`ShapeFault::OutsideGrid`).
+    pub outside: u32,
+}
+
+impl<const K: usize, const L: usize> Default for Lanes<K, L> {
+    fn default() -> Self {
+        Lanes {
+            node0: [0; L],
+            n: [[[0.0; L]; MAX_DEGREE + 1]; 2],
+            d: [[[0.0; L]; MAX_DEGREE + 1]; 2],
+            outside: 0,
+        }
+    }
+}
+
+impl<const K: usize, const L: usize> Lanes<K, L> {
+    /// Lane l's fault, if any.
+    #[inline(always)]
+    pub fn fault(&self, l: usize) -> Option<ShapeFault> {
+        (self.outside >> l & 1 != 0).then_some(ShapeFault::OutsideGrid)
+    }
+
+    /// Lane l's stencil.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> Stencil1<K> {
+        let mut s = Stencil1 {
+            node0: self.node0[l],
+            n: [[0.0; MAX_DEGREE + 1]; 2],
+            d: [[0.0; MAX_DEGREE + 1]; 2],
+        };
+        for ax in 0..2 {
+            for r in 0..Stencil1::<K>::SIDE {
+                s.n[ax][r] = self.n[ax][r][l];
+                s.d[ax][r] = self.d[ax][r][l];
+            }
+        }
+        s
+    }
+}
+
+/// One point's stencil on a separable shape of K slots: its first node
+/// and, per axis, the 1-D values and derivatives (`Lanes`' lane).
+#[derive(Debug, Clone, Copy)]
+pub struct Stencil1<const K: usize> {
+    pub node0: u32,
+    pub n: [[f64; MAX_DEGREE + 1]; 2],
+    pub d: [[f64; MAX_DEGREE + 1]; 2],
+}
+
+impl<const K: usize> Stencil1<K> {
+    /// Nodes per side of the stencil.
+    pub const SIDE: usize = match K {
+        4 => 2,
+        9 => 3,
+        16 => 4,
+        _ => panic!("no separable stencil has this many slots"),
+    };
+}
+
 /// The separable shapes by stencil (`Separable::class`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SeparableClass {
@@ -210,6 +383,68 @@ mod tests {
         let (mut n, mut w) = ([0u32; K], [[0.0; 3]; K]);
         sep.eval_fixed::<true, K>(x, &mut n, &mut w).unwrap();
         (n.to_vec(), w.to_vec())
+    }
+
+    /// The stencils of a batch in lanes (`bases_lanes`, what the loops
+    /// evaluate) equal `eval_fixed`'s point by point, bit for bit, with
+    /// the same faults: full and partial batches, points near every edge,
+    /// outside the grid and NaN among them.
+    #[test]
+    fn lanes_equal_the_points_one_by_one() {
+        let grid = Grid::regular(0.37, [-1.1, 0.4], 13, 11);
+        let hi = grid.max();
+        let mut points = Vec::new();
+        for a in -3..=100 {
+            for b in -3..=92 {
+                points.push([
+                    grid.min[0] + (hi[0] - grid.min[0]) * a as f64 / 97.0,
+                    grid.min[1] + (hi[1] - grid.min[1]) * b as f64 / 89.0,
+                ]);
+            }
+        }
+        points.insert(17, [f64::NAN, 1.0]);
+        points.insert(40, [0.5, f64::INFINITY]);
+        fn check<const K: usize>(sep: &Separable, points: &[[f64; 2]]) -> usize {
+            let mut faults = 0;
+            // Batches of 8, then a partial one of 5.
+            for chunk in points.chunks(8).chain([&points[..5]]) {
+                let mut lanes = Lanes::<K, 8>::default();
+                sep.bases_lanes::<K, 8>(chunk, &mut lanes);
+                for (l, &x) in chunk.iter().enumerate() {
+                    let (mut n, mut w) = ([0u32; K], [[0.0; 3]; K]);
+                    let want = sep.eval_fixed::<true, K>(x, &mut n, &mut w);
+                    assert_eq!(lanes.fault(l), want.err(), "{x:?}");
+                    if want.is_err() {
+                        faults += 1;
+                        continue;
+                    }
+                    let mut k = 0;
+                    sep.each(&lanes.lane(l), |node, wk| {
+                        assert_eq!((node, wk), (n[k], w[k]), "{x:?} slot {k}");
+                        k += 1;
+                    });
+                    assert_eq!(k, K);
+                }
+            }
+            faults
+        }
+        for shape in [
+            Shape::Linear,
+            Shape::Bspline(Bspline::midpoints(2)),
+            Shape::Bspline(Bspline {
+                degree: 2,
+                cells: true,
+            }),
+            Shape::Bspline(Bspline::midpoints(3)),
+        ] {
+            let sep = shape.separable(&grid).unwrap();
+            let faults = match sep.class() {
+                SeparableClass::Linear => check::<4>(&sep, &points),
+                SeparableClass::Bspline2 => check::<9>(&sep, &points),
+                SeparableClass::Bspline3 => check::<16>(&sep, &points),
+            };
+            assert!(faults > 100, "{shape:?}: {faults} points outside");
+        }
     }
 
     /// Every slot of the separable evaluation equals `Shape::eval`'s, bit
