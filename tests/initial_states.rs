@@ -6,7 +6,7 @@
 //! mix of FLIP and PIC; bad keys exit with the key named.
 
 use lme_mpm::backend::{Backend, Sample};
-use lme_mpm::cpu::{CpuBackend, Slots, Weights};
+use lme_mpm::cpu::{CpuBackend, ParticleWeights, Prepared, Slices, Weights};
 use lme_mpm::model::Model;
 use lme_mpm::scene::{Override, Scene};
 use lme_mpm::simulation::Simulation;
@@ -470,13 +470,13 @@ fn pic_blend_is_the_stated_mix() {
         // The step's weights: stored (MUSL) or evaluated at the start.
         let m = pic.model();
         let weights = Weights::of(&pic.cache, v_start.len(), &m.shape, &m.grid);
-        let mut slots = Slots::default();
+        let mut slots = Prepared::default();
         let mut worst: f64 = 0.0;
         let mut differ: f64 = 0.0;
         for (p, &x) in x_start.iter().enumerate() {
             // Σ N v_I with the step's weights; MUSL's nodes then hold the
             // remapped velocity, so take PIC from the α = 1 run's particles.
-            let (nodes, w) = weights.particle(p, x, &mut slots).unwrap();
+            let Slices(nodes, w) = weights.get::<true>(p, x, &mut slots).unwrap();
             let mut v_pic = [0.0; 2];
             for (&n, wk) in nodes.iter().zip(w) {
                 let node = pic.mv[n as usize];

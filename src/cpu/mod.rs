@@ -37,7 +37,7 @@ use crate::model::{Integrator, Model, Particles};
 use crate::step::{Pass, Stage, StepPlan};
 use scatter::Scatter;
 pub(crate) use stage_inputs::body_force;
-pub use stage_inputs::{ShapeCache, Slots, Weights};
+pub use stage_inputs::{ParticleWeights, Prepared, ShapeCache, Slices, Weights};
 use std::sync::atomic::AtomicBool;
 
 /// A pass's CPU twin (`CpuBackend::twin`).
