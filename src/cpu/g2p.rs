@@ -17,7 +17,7 @@ use super::stage_inputs::{ParticleWeights, Stencil, Weights, with_weights};
 use crate::model::contact::CONTACT_PIC_FRACTION;
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::shape::ShapeFault;
-use crate::model::{Grid, Integrator};
+use crate::model::{Grid, Integrator, inside};
 use crate::scene::NpcPosition;
 use rayon::prelude::*;
 
@@ -44,7 +44,8 @@ pub type Touched<'a> = Option<(&'a [bool], &'a [f64], &'a mut [[f64; 2]])>;
 pub struct Update<'a> {
     /// `nodal`'s per node.
     pub nodal: &'a [[f64; 4]],
-    pub grid: &'a Grid,
+    /// `Grid::bounds` at `prm.edge_margin`: where a particle must stay.
+    pub bounds: [[f64; 2]; 2],
     pub prm: G2pParams,
     /// Contact pairs: `Touched`'s flags per field node and the particles'
     /// masses; None and empty without.
@@ -66,8 +67,7 @@ impl Update<'_> {
         a: Option<&mut [f64; 2]>,
         dp: Option<&mut [f64; 2]>,
     ) -> Option<Fault> {
-        let (nodal, grid, prm, touched, mass) =
-            (self.nodal, self.grid, self.prm, self.touched, self.mass);
+        let (nodal, prm, touched, mass) = (self.nodal, self.prm, self.touched, self.mass);
         let dt = prm.dt;
         // Σ N f/m and Σ N v_I (nodes without mass hold zeros).
         let (mut acc, mut vel) = ([0.0; 2], [0.0; 2]);
@@ -142,7 +142,7 @@ impl Update<'_> {
                 },
             ));
         }
-        if !grid.contains(*x, prm.edge_margin) {
+        if !inside(self.bounds, *x) {
             return Some(Fault::at(p, FaultKind::Shape(ShapeFault::OutsideGrid)));
         }
         None
@@ -227,7 +227,7 @@ fn g2p_with<W: ParticleWeights>(
     };
     let update = Update {
         nodal,
-        grid,
+        bounds: grid.bounds(prm.edge_margin),
         prm,
         touched,
         mass,

@@ -70,7 +70,7 @@ fn run<W: ParticleWeights>(
     let len = Scatter::<5>::range_len(n);
     let update = g2p::Update {
         nodal,
-        grid,
+        bounds: grid.bounds(prm.edge_margin),
         prm,
         touched: None,
         mass: &[],

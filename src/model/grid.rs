@@ -104,11 +104,17 @@ impl Grid {
     /// True when `x` lies inside the grid with at least `margin` (m) to spare.
     #[inline]
     pub fn contains(&self, x: [f64; 2], margin: f64) -> bool {
+        inside(self.bounds(margin), x)
+    }
+
+    /// The corners [lo, hi] (m) of the part `margin` (m) inside the grid's
+    /// edge, for `inside`.
+    pub fn bounds(&self, margin: f64) -> [[f64; 2]; 2] {
         let hi = self.max();
-        x[0] >= self.min[0] + margin
-            && x[0] <= hi[0] - margin
-            && x[1] >= self.min[1] + margin
-            && x[1] <= hi[1] - margin
+        [
+            [self.min[0] + margin, self.min[1] + margin],
+            [hi[0] - margin, hi[1] - margin],
+        ]
     }
 
     /// Smallest distance two neighbouring nodes can have (m): the h that the
@@ -116,4 +122,11 @@ impl Grid {
     pub fn min_spacing(&self) -> f64 {
         self.h * (1.0 - 2.0 * self.perturb)
     }
+}
+
+/// Whether `x` lies in `bounds` (`Grid::bounds`), edges included; NaN does not.
+#[inline(always)]
+pub fn inside(bounds: [[f64; 2]; 2], x: [f64; 2]) -> bool {
+    let [lo, hi] = bounds;
+    x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1]
 }

@@ -19,7 +19,7 @@ pub mod walls;
 
 pub use constraint_points::ConstraintPoint;
 pub use contact::Contacts;
-pub use grid::Grid;
+pub use grid::{Grid, inside};
 pub use loads::{AlignedVibration, ExternalForces, Gravity};
 pub use particles::{Particles, node_force};
 pub use walls::{Wall, Walls};
