@@ -104,7 +104,8 @@ impl Wall {
 /// (`cpu::wall_contact`) asks it of forces (N), trial the force that
 /// stops the slip; the implicit one (`cpu::implicit::contact::
 /// natural_state`) of the gap's components (m; the penalty k of both
-/// forces cancels), trial the tangential increment. WGSL twin
+/// forces cancels), trial the tangential increment; its consistent start
+/// (`cpu::implicit`'s `initial_acceleration`) of accelerations. WGSL twin
 /// `coulomb_slip` in shaders/shared/wall_coulomb.wgsl.
 #[inline]
 pub fn coulomb_slip(trial: f64, normal: f64, mu: f64) -> Option<f64> {

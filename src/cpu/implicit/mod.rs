@@ -39,7 +39,7 @@ use crate::cpu::{ShapeCache, shape_eval};
 use crate::error::{Error, Result};
 use crate::model::fault::{Fault, FaultKind};
 use crate::model::material::increment::StepState;
-use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK};
+use crate::model::walls::{CONTACT_FRICTION, CONTACT_STICK, coulomb_slip};
 use crate::model::{ConstraintGroup, FIX_X, FIX_Y, ImplicitSettings, Integrator, Model, Particles};
 use assemble::{Dofs, Incidence, NO_DOF, Newmark, ParticleIterate, Pattern, StepInputs};
 use contact::{ContactPair, ContactState};
@@ -440,10 +440,16 @@ impl ImplicitBackend {
             }
             let t = [a[0] - an * nrm[0], a[1] - an * nrm[1]];
             let mag = t[0].hypot(t[1]);
-            let keep = match w.contact {
-                CONTACT_STICK => 0.0,
-                CONTACT_FRICTION if mag > 0.0 => (1.0 - w.mu * an.abs() / mag).max(0.0),
-                _ => 1.0,
+            // Coulomb's law on the accelerations: a stick wall holds all
+            // of the tangential part, a friction wall up to μ |a·n|.
+            let mu = match w.contact {
+                CONTACT_STICK => f64::INFINITY,
+                CONTACT_FRICTION => w.mu,
+                _ => 0.0,
+            };
+            let keep = match coulomb_slip(mag, an.abs(), mu) {
+                Some(cap) => 1.0 - cap / mag,
+                None => 0.0,
             };
             *a = [keep * t[0], keep * t[1]];
         }
