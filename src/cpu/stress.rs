@@ -170,7 +170,7 @@ struct StressInputs<'a> {
 
 impl StressInputs<'_> {
     /// Particle p's update, then its forces from the stress just
-    /// computed, from the weights `prepare` left in `slots`.
+    /// computed, from the weights `prepare` left in lane `j` of `batch`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn particle<W: ParticleWeights>(
