@@ -385,6 +385,24 @@ mod tests {
         (n.to_vec(), w.to_vec())
     }
 
+    /// Every separable shape: linear, and B-splines of degree 2 and 3 in
+    /// both knot layouts.
+    fn shapes() -> [Shape; 5] {
+        [
+            Shape::Linear,
+            Shape::Bspline(Bspline::midpoints(2)),
+            Shape::Bspline(Bspline {
+                degree: 2,
+                cells: true,
+            }),
+            Shape::Bspline(Bspline::midpoints(3)),
+            Shape::Bspline(Bspline {
+                degree: 3,
+                cells: true,
+            }),
+        ]
+    }
+
     /// The stencils of a batch in lanes (`bases_lanes`, what the loops
     /// evaluate) equal `eval_fixed`'s point by point, bit for bit, with
     /// the same faults: full and partial batches, points near every edge,
@@ -428,15 +446,7 @@ mod tests {
             }
             faults
         }
-        for shape in [
-            Shape::Linear,
-            Shape::Bspline(Bspline::midpoints(2)),
-            Shape::Bspline(Bspline {
-                degree: 2,
-                cells: true,
-            }),
-            Shape::Bspline(Bspline::midpoints(3)),
-        ] {
+        for shape in shapes() {
             let sep = shape.separable(&grid).unwrap();
             let faults = match sep.class() {
                 SeparableClass::Linear => check::<4>(&sep, &points),
@@ -453,20 +463,7 @@ mod tests {
     #[test]
     fn separable_eval_equals_shape_eval() {
         let grid = Grid::regular(0.37, [-1.1, 0.4], 13, 11);
-        let shapes = [
-            Shape::Linear,
-            Shape::Bspline(Bspline::midpoints(2)),
-            Shape::Bspline(Bspline {
-                degree: 2,
-                cells: true,
-            }),
-            Shape::Bspline(Bspline::midpoints(3)),
-            Shape::Bspline(Bspline {
-                degree: 3,
-                cells: true,
-            }),
-        ];
-        for shape in shapes {
+        for shape in shapes() {
             let sep = shape.separable(&grid).unwrap();
             let hi = grid.max();
             let mut checked = 0;
