@@ -26,30 +26,12 @@ pub const METHODS: [Method; 4] = [
 ];
 
 /// `lme-mpm study block`.
-pub struct BlockStudy;
-
-impl Study for BlockStudy {
-    fn slug(&self) -> &'static str {
-        "block"
-    }
-
-    fn help(&self) -> &'static str {
-        "Elastic block: linear, uGIMP, LME γ = 0.8 and 3 (NPC)"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+pub const STUDY: Study = Study {
+    slug: "block",
+    help: "Elastic block: linear, uGIMP, LME γ = 0.8 and 3 (NPC)",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(_quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     // The block is cheap (100 particles): the quick sweep is the full one.

@@ -62,32 +62,14 @@ pub const COLUMN: (f64, f64) = (2.0, 4.0);
 pub(crate) const PPC: f64 = 2.0;
 
 /// `lme-mpm study column`.
-pub struct ColumnStudy;
-
-impl Study for ColumnStudy {
-    fn slug(&self) -> &'static str {
-        "column"
-    }
-
-    fn help(&self) -> &'static str {
-        "Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both, profiles, run-out (1 h 40 \
+pub const STUDY: Study = Study {
+    slug: "column",
+    help: "Soil column collapse: 4 shapes × 2 meshes and GMM-LME on both, profiles, run-out (1 h 40 \
          min on 2 cores on 2026-11-29, GMM on mesh 2 the longest run, on one thread the whole \
-         time)"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         time)",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let mut out = Vec::new();

@@ -112,33 +112,15 @@ fn every(dt: f64, t_end: f64) -> Vec<f64> {
 }
 
 /// `lme-mpm study contact`.
-pub struct ContactStudy;
-
-impl Study for ContactStudy {
-    fn slug(&self) -> &'static str {
-        "contact"
-    }
-
-    fn help(&self) -> &'static str {
-        "Contact between bodies: block on a slab (μ = 0–0.7), two disks colliding head-on and \
+pub const STUDY: Study = Study {
+    slug: "contact",
+    help: "Contact between bodies: block on a slab (μ = 0–0.7), two disks colliding head-on and \
          off-centre, a disk rolling on an elastic slab (R/h = 10–40), each beside the single \
          shared field; a strip footing on a Tresca soil against Prandtl's 5.14 c, smooth and \
-         rough, three grids (full run only) (CPU; about 15 minutes, --quick about 1)"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         rough, three grids (full run only) (CPU; about 15 minutes, --quick about 1)",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let mut out = Vec::new();

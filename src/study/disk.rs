@@ -76,31 +76,13 @@ pub fn job(b: BackendChoice, method: Method, k: usize, dt: f64, t_end: f64) -> J
 }
 
 /// `lme-mpm study disk`.
-pub struct DiskStudy;
-
-impl Study for DiskStudy {
-    fn slug(&self) -> &'static str {
-        "disk"
-    }
-
-    fn help(&self) -> &'static str {
-        "Rolling disk: linear, uGIMP, LME γ = 2.8, bspline2 × 3 time steps; error against wall \
-         time beside the paper's Table 1"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+pub const STUDY: Study = Study {
+    slug: "disk",
+    help: "Rolling disk: linear, uGIMP, LME γ = 2.8, bspline2 × 3 time steps; error against wall \
+         time beside the paper's Table 1",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let t_end = t_end(quick);

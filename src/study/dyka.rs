@@ -85,30 +85,12 @@ pub fn bar_at(j: Job, h: f64) -> Job {
 }
 
 /// `lme-mpm study dyka`.
-pub struct DykaStudy;
-
-impl Study for DykaStudy {
-    fn slug(&self) -> &'static str {
-        "dyka"
-    }
-
-    fn help(&self) -> &'static str {
-        "Dyka's bar: 7 cell sizes × linear, uGIMP, LME γ = 2, 3, 4 × FE, NPC"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+pub const STUDY: Study = Study {
+    slug: "dyka",
+    help: "Dyka's bar: 7 cell sizes × linear, uGIMP, LME γ = 2, 3, 4 × FE, NPC",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let hs: &[f64] = if quick { &H_QUICK } else { &H_FULL };

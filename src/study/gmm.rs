@@ -17,39 +17,20 @@ use super::spec::Study;
 use super::{failure_text, image, sig, table};
 use crate::error::Result;
 use crate::exact::cantilever::PAPER_NONLINEAR;
-use crate::simulation::BackendChoice;
 use crate::sweep::report::{self, Curve};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// `lme-mpm study gmm`.
-pub struct GmmStudy;
-
-impl Study for GmmStudy {
-    fn slug(&self) -> &'static str {
-        "gmm"
-    }
-
-    fn help(&self) -> &'static str {
-        "The Galerkin meshfree method: the static cantilever (GMM-LME and GMM-MLS, h = 0.5 … \
+pub const STUDY: Study = Study {
+    slug: "gmm",
+    help: "The Galerkin meshfree method: the static cantilever (GMM-LME and GMM-MLS, h = 0.5 … \
          0.03125, self-convergence and Richardson) and the rolling disk (GMM-LME γ = 0.8, 1.8, \
          2.8, GMM-MLS and implicit MPM Q4 × 3 time steps), the implicit study's GMM rows alone \
-         (about 20 minutes on 2 cores; --quick: seconds)"
-    }
-
-    fn jobs(&self, quick: bool, _backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         (about 20 minutes on 2 cores; --quick: seconds)",
+    jobs: |quick, _| Ok(jobs(quick)),
+    report,
+};
 
 /// `lme-mpm study gmm`: GMM's cantilever runs, and implicit MPM with Q4
 /// on the same scenes for the cost per step (seconds in all); and the

@@ -41,32 +41,14 @@ pub const GRANULAR_H: f64 = 0.05;
 pub const QUICK: (f64, f64) = (1.0, 0.01);
 
 /// `lme-mpm study granular`.
-pub struct GranularStudy;
-
-impl Study for GranularStudy {
-    fn slug(&self) -> &'static str {
-        "granular"
-    }
-
-    fn help(&self) -> &'static str {
-        "Cohesionless column collapse from geostatic rest behind a gate: run-out against the \
+pub const STUDY: Study = Study {
+    slug: "granular",
+    help: "Cohesionless column collapse from geostatic rest behind a gate: run-out against the \
          experimental scaling 1.2 H/W for H/W = 0.5, 1 and 2, 4 shapes, pure FLIP and 1 % PIC \
-         (about 5 minutes on one core)"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         (about 5 minutes on one core)",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let mut out = Vec::new();

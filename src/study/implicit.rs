@@ -260,32 +260,14 @@ fn gmm_cantilever_job((label, keys): (&str, &[&str]), h: f64) -> Job {
 }
 
 /// `lme-mpm study implicit`.
-pub struct ImplicitStudy;
-
-impl Study for ImplicitStudy {
-    fn slug(&self) -> &'static str {
-        "implicit"
-    }
-
-    fn help(&self) -> &'static str {
-        "Implicit against explicit: the static cantilever (mesh study), Dyka's bar and the \
+pub const STUDY: Study = Study {
+    slug: "implicit",
+    help: "Implicit against explicit: the static cantilever (mesh study), Dyka's bar and the \
          rolling disk, error against wall time per case, and the Newton iteration's cost split \
-         (CPU only)"
-    }
-
-    fn jobs(&self, quick: bool, _backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         (CPU only)",
+    jobs: |quick, _| Ok(jobs(quick)),
+    report,
+};
 
 pub fn jobs(quick: bool) -> Vec<Job> {
     let b = BackendChoice::Cpu;

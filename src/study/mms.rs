@@ -234,32 +234,14 @@ pub fn job(
 }
 
 /// `lme-mpm study mms`.
-pub struct MmsStudy;
-
-impl Study for MmsStudy {
-    fn slug(&self) -> &'static str {
-        "mms"
-    }
-
-    fn help(&self) -> &'static str {
-        "Manufactured aligned vibration, the B-spline paper's study: 8–64 cells × linear, \
+pub const STUDY: Study = Study {
+    slug: "mms",
+    help: "Manufactured aligned vibration, the B-spline paper's study: 8–64 cells × linear, \
          bspline2/3 with and without MLS, the paper's update, E = 1e7 and 1e8 Pa (hours on 2 \
-         cores; `LME_MPM_MMS_CELLS` restricts it)"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        jobs(quick, backends)
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+         cores; `LME_MPM_MMS_CELLS` restricts it)",
+    jobs,
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
     let (cells, methods, readings) = (cells(quick)?, methods(quick)?, readings(quick)?);

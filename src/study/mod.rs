@@ -31,7 +31,7 @@ use crate::sweep::record::Record;
 use std::path::{Path, PathBuf};
 
 /// The studies, one line each: `StudyName`'s variant and the study (its
-/// file's `impl Study`), in the order of `lme-mpm study --help` and of
+/// file's `STUDY`), in the order of `lme-mpm study --help` and of
 /// `all`. The CLI's names and help, `all` and the dispatch of jobs and
 /// reports follow from this list; a new study is its file, its `pub mod`
 /// above and one line here.
@@ -46,7 +46,7 @@ macro_rules! studies {
         }
 
         /// Every study, in `StudyName`'s order (`all` aside).
-        pub const STUDIES: &[&dyn Study] = &[$(&$study),*];
+        pub const STUDIES: &[&Study] = &[$(&$study),*];
 
         impl StudyName {
             /// Every name the CLI takes, in its order, `all` last.
@@ -56,17 +56,17 @@ macro_rules! studies {
 }
 
 studies! {
-    Dyka => dyka::DykaStudy,
-    Block => block::BlockStudy,
-    PlateImpact => plate::PlateImpactStudy,
-    Stability => stability::StabilityStudy,
-    Mms => mms::MmsStudy,
-    Disk => disk::DiskStudy,
-    Column => column::ColumnStudy,
-    Granular => granular::GranularStudy,
-    Implicit => implicit::ImplicitStudy,
-    Contact => contact::ContactStudy,
-    Gmm => gmm::GmmStudy,
+    Dyka => dyka::STUDY,
+    Block => block::STUDY,
+    PlateImpact => plate::STUDY,
+    Stability => stability::STUDY,
+    Mms => mms::STUDY,
+    Disk => disk::STUDY,
+    Column => column::STUDY,
+    Granular => granular::STUDY,
+    Implicit => implicit::STUDY,
+    Contact => contact::STUDY,
+    Gmm => gmm::STUDY,
 }
 
 /// `all`'s line in `lme-mpm study --help`.
@@ -74,17 +74,17 @@ const ALL_HELP: &str = "All of them, in that order";
 
 impl StudyName {
     /// The study; None for `all`.
-    pub fn study(self) -> Option<&'static dyn Study> {
+    pub fn study(self) -> Option<&'static Study> {
         STUDIES.get(self as usize).copied()
     }
 
     pub fn slug(self) -> &'static str {
-        self.study().map_or("all", |s| s.slug())
+        self.study().map_or("all", |s| s.slug)
     }
 
     /// Its line in `lme-mpm study --help`.
     pub fn help(self) -> &'static str {
-        self.study().map_or(ALL_HELP, |s| s.help())
+        self.study().map_or(ALL_HELP, |s| s.help)
     }
 
     /// The studies it runs: itself, or every one for `all`.
@@ -176,7 +176,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
         let dir = opts.out.join(n.slug());
         std::fs::create_dir_all(&dir).map_err(|e| Error::io("cannot create", &dir, e))?;
         let study = n.study().expect("each names the studies, not all");
-        let jobs = study.jobs(opts.quick, &backends)?;
+        let jobs = (study.jobs)(opts.quick, &backends)?;
         if opts.progress || opts.progress_lines {
             crate::say!("study {}: {} runs on {:?}", n.slug(), jobs.len(), backends);
         }
@@ -192,7 +192,7 @@ pub fn run(name: StudyName, opts: &StudyOptions) -> Result<Vec<Report>> {
             &dir.join("results.csv"),
             crate::sweep::report::csv(&records).as_bytes(),
         )?;
-        let (markdown, charts) = study.report(&results, &dir, opts.quick)?;
+        let (markdown, charts) = (study.report)(&results, &dir, opts.quick)?;
         // The charts sit beside report.md; the markdown links them in
         // `charts/` as the docs keep them.
         let local = markdown.replace("](charts/", "](");
@@ -254,12 +254,12 @@ mod tests {
     /// its order, and the CLI's names its slugs then `all`.
     #[test]
     fn the_study_list_names_the_cli() {
-        let slugs: Vec<&str> = STUDIES.iter().map(|s| s.slug()).collect();
+        let slugs: Vec<&str> = STUDIES.iter().map(|s| s.slug).collect();
         let unique: std::collections::BTreeSet<&str> = slugs.iter().copied().collect();
         assert_eq!(unique.len(), slugs.len(), "{slugs:?}");
         assert!(!unique.contains("all"), "{slugs:?}");
         for (k, n) in StudyName::NAMES.iter().enumerate() {
-            assert_eq!(n.study().map(|s| s.slug()), slugs.get(k).copied(), "{n:?}");
+            assert_eq!(n.study().map(|s| s.slug), slugs.get(k).copied(), "{n:?}");
             assert_eq!(StudyName::from_str(n.slug(), false), Ok(*n));
             let help = n.help();
             assert!(!help.is_empty() && !help.ends_with('.'), "{n:?}: {help}");

@@ -51,30 +51,12 @@ fn job(b: BackendChoice, quick: bool, shape: &str, integrator: &str, perturbed: 
 }
 
 /// `lme-mpm study plate-impact`.
-pub struct PlateImpactStudy;
-
-impl Study for PlateImpactStudy {
-    fn slug(&self) -> &'static str {
-        "plate-impact"
-    }
-
-    fn help(&self) -> &'static str {
-        "2D plate impact: FE vs NPC fields; regular vs perturbed grids"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+pub const STUDY: Study = Study {
+    slug: "plate-impact",
+    help: "2D plate impact: FE vs NPC fields; regular vs perturbed grids",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let mut out = Vec::new();

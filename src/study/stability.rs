@@ -105,30 +105,12 @@ pub fn columns(quick: bool) -> Vec<Column> {
 }
 
 /// `lme-mpm study stability`.
-pub struct StabilityStudy;
-
-impl Study for StabilityStudy {
-    fn slug(&self) -> &'static str {
-        "stability"
-    }
-
-    fn help(&self) -> &'static str {
-        "Stability map: shape × integrator × case × resolution"
-    }
-
-    fn jobs(&self, quick: bool, backends: &[BackendChoice]) -> Result<Vec<Job>> {
-        Ok(jobs(quick, backends))
-    }
-
-    fn report(
-        &self,
-        results: &[JobResult],
-        dir: &Path,
-        quick: bool,
-    ) -> Result<(String, Vec<PathBuf>)> {
-        report(results, dir, quick)
-    }
-}
+pub const STUDY: Study = Study {
+    slug: "stability",
+    help: "Stability map: shape × integrator × case × resolution",
+    jobs: |quick, backends| Ok(jobs(quick, backends)),
+    report,
+};
 
 pub fn jobs(quick: bool, backends: &[BackendChoice]) -> Vec<Job> {
     let mut out = Vec::new();
