@@ -55,7 +55,7 @@ fn forces_with<W: ParticleWeights>(
                 let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
                 match weights.get::<true>(p, x[p], &mut slots) {
                     Ok(st) => add_particle_forces(&st, vol, s, [bx, by], acc),
-                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                    Err(e) => Fault::note(&mut fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
             }
             fault

@@ -104,7 +104,7 @@ fn run<W: ParticleWeights>(
                         Err(e) => Some(Fault::at(p, FaultKind::Shape(e))),
                     };
                     moved[j] = f.is_none();
-                    fault = Fault::first(fault, f);
+                    Fault::note(&mut fault, f);
                     next[j] = *x;
                 }
                 // Then at the positions reached, for the next p2g.
@@ -127,7 +127,7 @@ fn run<W: ParticleWeights>(
                             add_particle(&st, sp.mass[p], v, acc_p, acc);
                         }
                         Err(e) => {
-                            fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e))))
+                            Fault::note(&mut fault, Some(Fault::at(p, FaultKind::Shape(e))))
                         }
                     }
                 }

@@ -53,7 +53,7 @@ fn p2g_with<W: ParticleWeights>(
             for p in first..(first + len).min(n) {
                 match weights.get::<false>(p, x[p], &mut slots) {
                     Ok(st) => add_particle(&st, mass[p], v[p], accel(a, p), acc),
-                    Err(e) => fault = Fault::first(fault, Some(Fault::at(p, FaultKind::Shape(e)))),
+                    Err(e) => Fault::note(&mut fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                 }
             }
             fault

@@ -139,7 +139,7 @@ pub fn shape_eval_p2g(
                     .enumerate()
                 {
                     let f = particle(first + k, &mut [0.0; 2], c, nodes, w, acc);
-                    fault = Fault::first(fault, f);
+                    Fault::note(&mut fault, f);
                 }
                 fault
             },
@@ -161,7 +161,7 @@ pub fn shape_eval_p2g(
                     .enumerate()
                 {
                     let f = particle(first + k, lam, c, nodes, w, acc);
-                    fault = Fault::first(fault, f);
+                    Fault::note(&mut fault, f);
                 }
                 fault
             },

@@ -239,7 +239,7 @@ fn stress_forces_with<W: ParticleWeights>(
                         q.as_deref_mut().map(|q| &mut q[k]),
                     );
                     let f = inp.particle(weights, first + k, s, r, extra, &batch, j, acc);
-                    fault = Fault::first(fault, f);
+                    Fault::note(&mut fault, f);
                 }
             }
             fault

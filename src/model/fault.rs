@@ -80,6 +80,22 @@ impl Fault {
         }
     }
 
+    /// `first` for a loop's running fault: `*acc` changes only when `f`
+    /// holds one, so the hot path (no fault) moves nothing (an
+    /// `Option<Fault>` is tens of bytes, copied per particle otherwise).
+    #[inline(always)]
+    pub fn note(acc: &mut Option<Fault>, f: Option<Fault>) {
+        if f.is_some() {
+            Self::note_cold(acc, f);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn note_cold(acc: &mut Option<Fault>, f: Option<Fault>) {
+        *acc = Self::first(acc.take(), f);
+    }
+
     /// Short machine-friendly reason for `summary.json`.
     pub fn code(&self) -> &'static str {
         match self.kind {
