@@ -266,7 +266,13 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
     let mut c_key = String::from("solver.cfl");
     for (_, b) in scene.bodies() {
         let m = Material::from_spec(&b.material, &f.materials[&b.material])?;
-        let c = m.wave_speed(m.density(), &[0.0; 3], &[0.0; 4]);
+        let mut c = m.wave_speed(m.density(), &[0.0; 3], &[0.0; 4]);
+        // Saturated: the undrained wave, (M + K_w / n) / ρ.
+        if let Some(fl) =
+            crate::model::pore::Fluid::from_spec(&b.material, &f.materials[&b.material])?
+        {
+            c = (c * c + 1.0 / (fl.storage() * m.density())).sqrt();
+        }
         let v = b.velocity[0].hypot(b.velocity[1]);
         let s = c.max(v);
         if s > c_max || s.is_nan() {
@@ -282,13 +288,27 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         let v = m.amplitude * m.c * std::f64::consts::PI / m.length * std::f64::consts::SQRT_2;
         c_max = c_max.max(v);
     }
-    let (dt, dt_key) = match f.solver.dt {
+    let (mut dt, mut dt_key) = match f.solver.dt {
         Some(dt) => (dt, "solver.dt".to_string()),
         None => (
             f.solver.cfl * h * (1.0 - 2.0 * f.grid.perturb) / c_max,
             format!("grid.h` / `{c_key}"),
         ),
     };
+    // Saturated soil: the flow's own limit (`Pore::flow_dt`) where smaller.
+    if f.solver.dt.is_none() {
+        for (name, spec) in &f.materials {
+            if let Some(fl) =
+                crate::model::pore::Fluid::from_spec(name, spec)?.filter(|fl| fl.k > 0.0)
+            {
+                let flow =
+                    crate::model::pore::FLOW_SAFETY * h * h * fl.storage() / (4.0 * fl.mobility());
+                if flow < dt {
+                    (dt, dt_key) = (flow, format!("materials.{name}.permeability"));
+                }
+            }
+        }
+    }
     let t_end = f.solver.t_end;
     let steps = if dt > 0.0 {
         (t_end / dt).ceil()

@@ -770,7 +770,60 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let f = &scene.file;
     let backends = match model.integrator {
         crate::model::Integrator::Implicit(_) => "the CPU (implicit)",
+        _ if model.pore.is_some() => "the CPU (saturated soil)",
         _ => "the CPU and the GPU alike",
+    };
+    // Saturated soil: each fluid, the drains, the stabilisation, the Δt rule.
+    let pore = match &model.pore {
+        None => String::new(),
+        Some(pore) => {
+            let fluids = scene
+                .file
+                .materials
+                .keys()
+                .zip(&pore.fluid)
+                .filter_map(|(name, f)| {
+                    f.map(|f| {
+                        format!(
+                            "{name} (k = {:e} m/s, n = {}, K_w = {:e} Pa, rho_w = {} kg/m^3)",
+                            f.k, f.n, f.kw, f.rho_w
+                        )
+                    })
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            let drains = pore
+                .drains
+                .iter()
+                .map(|d| {
+                    format!(
+                        "{} (p = {} Pa; {} nodes)",
+                        d.name,
+                        d.pressure,
+                        d.nodes.len()
+                    )
+                })
+                .collect::<Vec<_>>();
+            let drains = if drains.is_empty() {
+                "none: undrained".to_string()
+            } else {
+                drains.join(", ")
+            };
+            let flow = pore.flow_dt(g.min_spacing());
+            format!(
+                "pore        saturated: {fluids}; drained {drains}; volumetric term {}; flow limit dt = {flow:.4e} s{}\n",
+                if pore.nodal_volumetric {
+                    "nodal (stabilised)"
+                } else {
+                    "per particle (equal order: oscillates)"
+                },
+                if model.fixed_dt.is_none() && flow <= dt {
+                    " (governs)"
+                } else {
+                    ""
+                }
+            )
+        }
     };
     // The nodes each backend holds: the grid's, once per contact field.
     let fields = model.contact.as_ref().map_or(1, |c| c.n_fields);
@@ -927,6 +980,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
          walls       {walls}\n\
          contact     {contact}\n\
          gravity     {gravity}\n\
+         {pore}\
          probes      {npr}\n\
          exact       {exact}\n",
         name = scene.name,

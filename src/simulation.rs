@@ -92,6 +92,27 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         };
     }
+    // Saturated soil has no WGSL twin yet: the CPU path steps it.
+    if model.pore.is_some() {
+        return match spec.choice() {
+            BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
+                "materials",
+                "a saturated material (`permeability`) runs on the CPU path only for now: \
+                 use --backend cpu or auto",
+            )
+            .into()),
+            BackendChoice::Cpu | BackendChoice::Auto => {
+                let b = CpuBackend::new(model);
+                if spec.verbose && spec.choice() == BackendChoice::Auto {
+                    crate::say!(
+                        "backend: {} (auto: saturated soil runs on the CPU only for now)",
+                        b.name()
+                    );
+                }
+                Ok(Box::new(b))
+            }
+        };
+    }
     match spec.choice() {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new(model))),
         BackendChoice::Gpu => {

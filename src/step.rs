@@ -255,6 +255,10 @@ passes! {
     /// replaces tr L by its slot's mean.
     CellAverageClear => gpu("cell_average.wgsl", Nodes, &["CLEAR"]), In(Pass::CellAverage);
     CellAverage => gpu("cell_average.wgsl", Particles, &[]), Twin;
+    /// Saturated soil, stage `stress`: the pore pressure's update from the
+    /// fluid's mass balance with Darcy flow on the grid (cpu/pore_flow.rs;
+    /// no WGSL twin yet: the GPU refuses saturated scenes).
+    PoreFlow => None, Twin;
     /// Walls only: the walls' forces at the contact points
     /// (wall_contact.wgsl), before `GridCorrect`.
     WallContact => gpu("wall_contact.wgsl", Particles, &[]), Twin;
@@ -381,6 +385,10 @@ pub struct PlanInputs {
     /// `CellAverageClear` and `CellAverage` passes), so it does not fuse
     /// with `forces`.
     pub cell_average: bool,
+    /// Saturated soil (`model::pore`): `stress` ends with the pore
+    /// pressure's update (`PoreFlow`, CPU only for now), so it does not
+    /// fuse with `forces`, which then takes the total stress.
+    pub pore: bool,
 }
 
 /// The step of one scene, for both backends: the stages' passes
@@ -452,6 +460,7 @@ impl StepPlan {
             contact: model.contact.is_some(),
             points: !model.constraints.points.is_empty(),
             cell_average: model.cell_average_volumetric,
+            pore: model.pore.is_some(),
         })
     }
 
@@ -494,10 +503,17 @@ impl StepPlan {
     /// step's `G2p` and the next `P2g`, and no shape cache is stored (the
     /// next P2G needs the weights at the new positions, the cache holds
     /// those of the old: `cpu::ShapeCache::needed`). Not with LME, MLS,
-    /// MUSL, walls, contact pairs or the cell average.
+    /// MUSL, walls, contact pairs, the cell average or saturated soil.
     pub fn primes(&self) -> bool {
         let i = &self.inputs;
-        !(i.lme || i.mls || i.mls_force || i.musl || i.walls || i.contact || i.cell_average)
+        !(i.lme
+            || i.mls
+            || i.mls_force
+            || i.musl
+            || i.walls
+            || i.contact
+            || i.cell_average
+            || i.pore)
     }
 
     /// The passes that do `stage` on its own on either backend, in order
@@ -566,6 +582,7 @@ impl StepPlan {
             contact,
             points: _,
             cell_average,
+            pore,
         } = self.inputs;
         let binned = gather || patch || contact;
         const SHAPES: Pass = Pass::ShapeEval;
@@ -631,9 +648,16 @@ impl StepPlan {
                 Pass::MlsStrain,
                 Pass::Stress,
             ],
+            Stage::Stress if cell_average && pore => &[
+                Pass::CellAverageClear,
+                Pass::CellAverage,
+                Pass::Stress,
+                Pass::PoreFlow,
+            ],
             Stage::Stress if cell_average => {
                 &[Pass::CellAverageClear, Pass::CellAverage, Pass::Stress]
             }
+            Stage::Stress if pore => &[Pass::Stress, Pass::PoreFlow],
             Stage::Stress => &[Pass::Stress],
             Stage::Forces => &[Pass::Forces],
             Stage::GridCorrect if walls && contact => &[
@@ -696,6 +720,7 @@ mod tests {
             contact: false,
             points: false,
             cell_average: false,
+            pore: false,
         })
     }
 
@@ -744,6 +769,7 @@ mod tests {
                 contact: false,
                 points: false,
                 cell_average: false,
+                pore: false,
             });
             assert_eq!(p.cpu_step[2], Pass::ShapeEvalP2g);
             assert!(!p.cpu_step.contains(&Pass::StressForces));
@@ -848,6 +874,7 @@ mod tests {
                     contact: false,
                     points: false,
                     cell_average: false,
+                    pore: false,
                 };
                 let without = StepPlan::new(base);
                 let with = StepPlan::new(PlanInputs {
@@ -899,6 +926,7 @@ mod tests {
                 contact: b(3),
                 points: false,
                 cell_average: false,
+                pore: false,
             };
             let without = StepPlan::new(base);
             let with = StepPlan::new(PlanInputs {

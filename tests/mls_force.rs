@@ -139,6 +139,7 @@ fn a_linear_stress_gives_the_exact_nodal_force_on_scattered_particles() {
             lme_mpm::cpu::Weights::Cache(&cache),
             &x,
             &stress,
+            &[],
             &mass,
             &rho,
             &lme_mpm::cpu::stage_inputs::BodyForce::uniform([0.0, 0.0]),

@@ -66,6 +66,7 @@ const CASES: &[(&str, &str, &str)] = &[
     ("rolling_disk", "0.02", "against ½ a t² ="),
     ("sliding_block", "0.05", "exact (a = g_t − μ g_n"),
     ("sliding_block_incline", "0.05", "exact (a = g_t − μ g_n"),
+    ("terzaghi", "0.2", "against Terzaghi's series"),
 ];
 
 #[test]

@@ -65,6 +65,8 @@ mod results;
 mod run_parity;
 #[path = "run_safety.rs"]
 mod run_safety;
+#[path = "saturated.rs"]
+mod saturated;
 #[path = "shape_functions.rs"]
 mod shape_functions;
 #[path = "stage_parity.rs"]

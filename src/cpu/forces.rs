@@ -1,5 +1,6 @@
 //! Stage `forces`: scatter internal and external nodal forces,
-//! f_I = Σ_p (−V_p σ_p ∇N_I + N_I m_p b) (paper eq. 14; V_p = m_p / ρ_p).
+//! f_I = Σ_p (−V_p σ_p ∇N_I + N_I m_p b) (paper eq. 14; V_p = m_p / ρ_p);
+//! in saturated soil σ_p is the total stress σ' − p I (`model::pore`).
 //! GPU twin: `shaders/forces.wgsl`.
 
 use super::scatter::Scatter;
@@ -10,12 +11,15 @@ use rayon::prelude::*;
 
 /// `body` gives particle p's body force per unit mass at this step (m/s²):
 /// gravity, plus a manufactured solution's source term when there is one.
-/// `x` is where `weights` are evaluated when not stored.
+/// `x` is where `weights` are evaluated when not stored. `pore` is the
+/// particles' pore pressure (Pa, compression positive; empty when dry):
+/// `stress` is then the effective stress.
 #[allow(clippy::too_many_arguments)]
 pub fn forces(
     weights: Weights<'_>,
     x: &[[f64; 2]],
     stress: &[[f64; 3]],
+    pore: &[f64],
     mass: &[f64],
     rho: &[f64],
     body: &BodyForce<'_>,
@@ -23,7 +27,7 @@ pub fn forces(
     scatter: &mut Scatter<2>,
 ) -> Result<(), Fault> {
     with_weights!(weights, |w| forces_with(
-        w, x, stress, mass, rho, body, force, scatter
+        w, x, stress, pore, mass, rho, body, force, scatter
     ))
 }
 
@@ -32,6 +36,7 @@ fn forces_with<W: ParticleWeights>(
     weights: &W,
     x: &[[f64; 2]],
     stress: &[[f64; 3]],
+    pore: &[f64],
     mass: &[f64],
     rho: &[f64],
     body: &BodyForce<'_>,
@@ -50,7 +55,11 @@ fn forces_with<W: ParticleWeights>(
             let mut fault = None;
             for p in first..(first + len).min(n) {
                 let vol = mass[p] / rho[p];
-                let s = stress[p];
+                let mut s = stress[p];
+                if let Some(pw) = pore.get(p) {
+                    s[0] -= pw;
+                    s[1] -= pw;
+                }
                 let g = body.at(p);
                 let (bx, by) = (mass[p] * g[0], mass[p] * g[1]);
                 match weights.get::<true>(p, x[p], &mut slots) {

@@ -126,9 +126,7 @@ fn run<W: ParticleWeights>(
                             let acc_p = a.as_deref().map_or([0.0; 2], |a| a[k0 + j]);
                             add_particle(&st, sp.mass[p], v, acc_p, acc);
                         }
-                        Err(e) => {
-                            Fault::note(&mut fault, Some(Fault::at(p, FaultKind::Shape(e))))
-                        }
+                        Err(e) => Fault::note(&mut fault, Some(Fault::at(p, FaultKind::Shape(e)))),
                     }
                 }
             }

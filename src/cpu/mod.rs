@@ -22,6 +22,7 @@ pub mod implicit;
 pub mod isa;
 pub mod mls;
 pub mod p2g;
+pub mod pore_flow;
 pub mod remap;
 pub mod scatter;
 pub mod shape_eval;
@@ -91,6 +92,9 @@ pub struct CpuBackend {
     /// `solver.volumetric_strain = "cell_average"`: the cells' mean
     /// volumetric strain rate (`cell_average`); None otherwise.
     cell_average: Option<cell_average::CellAverage>,
+    /// Saturated soil: the pore pressure's work space (`pore_flow`); None
+    /// in a dry scene.
+    pore_flow: Option<pore_flow::PoreFlow>,
     mass_eps: f64,
     t: f64,
     steps: u64,
@@ -191,6 +195,10 @@ impl CpuBackend {
             cell_average: model
                 .cell_average_volumetric
                 .then(|| cell_average::CellAverage::new(&model.grid, model.body_names.len(), n)),
+            pore_flow: model
+                .pore
+                .as_ref()
+                .map(|pore| pore_flow::PoreFlow::new(pore, model.grid.n_nodes())),
             mass_eps: grid_update::MASS_EPS_REL * min_mass,
             t: 0.0,
             steps: 0,
@@ -420,6 +428,7 @@ impl CpuBackend {
             Pass::MlsFitGauss => Self::mls_fit,
             Pass::MlsStrain => Self::mls_strain,
             Pass::CellAverage => Self::cell_average,
+            Pass::PoreFlow => Self::pore_flow,
             Pass::Stress => Self::stress,
             Pass::StressForces | Pass::StressForcesPatch => Self::stress_forces,
             Pass::Forces | Pass::ForcesGather | Pass::ForcesPatch => Self::forces,
@@ -723,6 +732,40 @@ impl CpuBackend {
         )
     }
 
+    /// Saturated soil: the pore pressure over the step (`pore_flow`), from
+    /// the velocities the stress took.
+    fn pore_flow(&mut self) -> std::result::Result<(), Fault> {
+        let t_load = self.t_load();
+        let m = &mut self.model;
+        let (Some(pore), Some(flow)) = (&m.pore, &mut self.pore_flow) else {
+            return Ok(());
+        };
+        let p = &mut m.particles;
+        let (materials, body_material, body) = (&pore.fluid, &m.body_material, &p.body);
+        let fluid = |i: usize| materials[body_material[body[i] as usize] as usize];
+        let dl = match &self.cell_average {
+            Some(ca) => &ca.dl[..],
+            None => &[],
+        };
+        let inp = pore_flow::PoreInputs {
+            x: &p.x,
+            mv: &self.mv,
+            mass: &p.mass,
+            rho: &p.rho,
+            fluid: &fluid,
+            dl,
+            g: m.gravity.map_or([0.0; 2], |g| g.at(t_load)),
+            dt: self.dt,
+        };
+        flow.update(
+            Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
+            &inp,
+            pore.nodal_volumetric,
+            &mut p.pore_pressure,
+        );
+        Ok(())
+    }
+
     /// Passes `stress` and `forces` fused (`stress::stress_forces`).
     fn stress_forces(&mut self) -> std::result::Result<(), Fault> {
         let m = &mut self.model;
@@ -785,6 +828,7 @@ impl CpuBackend {
                 Weights::of(&self.cache, p.len(), &m.shape, &m.grid),
                 &p.x,
                 &p.stress,
+                &p.pore_pressure,
                 &p.mass,
                 &p.rho,
                 &body,

@@ -13,6 +13,7 @@ pub mod footing;
 pub mod mms;
 pub mod rolling;
 pub mod sliding;
+pub mod terzaghi;
 
 use crate::backend::Sample;
 use crate::model::{Model, Particles};
@@ -37,6 +38,7 @@ pub enum Errors {
     ColumnCollapse(collapse::ColumnCollapseErrors),
     GranularCollapse(collapse::GranularCollapseErrors),
     Energy(energy::EnergyErrors),
+    Terzaghi(terzaghi::TerzaghiErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact
@@ -87,5 +89,9 @@ pub fn score(
             Errors::GranularCollapse(collapse::score_granular(scene, particles))
         }
         ExactKind::Energy => Errors::Energy(energy::score(samples)),
+        ExactKind::Terzaghi => {
+            let layer = terzaghi::Terzaghi::from_scene(scene);
+            Errors::Terzaghi(layer.score(particles, t))
+        }
     }
 }

@@ -71,6 +71,14 @@ impl GpuBackend {
             )
             .into());
         }
+        if model.pore.is_some() {
+            return Err(crate::error::SceneError::invalid(
+                "materials",
+                "a saturated material (`permeability`) runs on the CPU path only for now \
+                 (--backend cpu or auto)",
+            )
+            .into());
+        }
         // The points' tables mark freed nodes with a bit per group.
         if !model.constraints.points.is_empty() && model.constraints.groups.len() > 32 {
             return Err(crate::error::SceneError::invalid(

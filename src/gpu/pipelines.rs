@@ -154,6 +154,8 @@ impl Variant {
             contact: self.contact.is_some(),
             points: self.points.is_some(),
             cell_average: self.cell_average_bodies > 0,
+            // Saturated soil has no WGSL twin: `GpuBackend` refuses it.
+            pore: false,
         })
     }
 

@@ -80,6 +80,27 @@ impl Grid {
         ]
     }
 
+    /// The nodes (i, j) whose unperturbed lattice position lies in the
+    /// box [min, max] (m; `±inf` allowed), to 1e-9 h: a region of
+    /// `[constraints]` or `[drainage]` (a perturbed grid selects the
+    /// regular one's nodes). Row by row, x fastest.
+    pub fn region(
+        &self,
+        min: [f64; 2],
+        max: [f64; 2],
+    ) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let eps = 1e-9 * self.h;
+        (0..self.ny)
+            .flat_map(move |j| (0..self.nx).map(move |i| (i, j)))
+            .filter(move |&(i, j)| {
+                let p = self.lattice_pos(i, j);
+                p[0] >= min[0] - eps
+                    && p[0] <= max[0] + eps
+                    && p[1] >= min[1] - eps
+                    && p[1] <= max[1] + eps
+            })
+    }
+
     /// Actual position of node (i, j) (m).
     #[inline]
     pub fn node_pos(&self, i: usize, j: usize) -> [f64; 2] {

@@ -12,6 +12,7 @@ mod grid;
 pub mod loads;
 pub mod material;
 mod particles;
+pub mod pore;
 pub mod preload_fit;
 pub mod shape;
 pub mod time_step;
@@ -327,6 +328,9 @@ pub struct Model {
     /// volumetric strain rate is its cell's mean over its body
     /// (`cpu::cell_average`).
     pub cell_average_volumetric: bool,
+    /// Saturated soil: the pore fluid per material and the drained nodes
+    /// (`pore`); None in a dry scene.
+    pub pore: Option<pore::Pore>,
     pub probes: Vec<Probe>,
     /// A manufactured solution's body force, applied to every particle at
     /// its reference position each step.
@@ -411,6 +415,13 @@ impl Model {
             }
         }
         geostatic_start(scene, &materials, &body_material, &mut particles)?;
+        let pore = pore::Pore::from_scene(scene, &grid)?;
+        if let Some(pore) = &pore {
+            let saturated =
+                |i: usize| pore.fluid[body_material[particles.body[i] as usize] as usize].is_some();
+            pore.check_reached(&grid, &particles.x, saturated)?;
+            particles.pore_pressure = vec![0.0; particles.len()];
+        }
 
         let mut constraints = build_constraints(scene, &grid)?;
         let regions: Vec<(&[u32], u8)> = constraints
@@ -474,6 +485,7 @@ impl Model {
             local_damping: f.solver.local_damping,
             cell_average_volumetric: f.solver.volumetric_strain
                 == crate::scene::VolumetricStrain::CellAverage,
+            pore,
             probes,
             manufactured,
             outline: if f.solver.method == SolverMethod::Gmm {
@@ -527,7 +539,12 @@ impl Model {
     /// Material of particle `p`.
     #[inline]
     pub fn material_of(&self, p: usize) -> &Material {
-        &self.materials[self.body_material[self.particles.body[p] as usize] as usize]
+        &self.materials[self.material_index_of(p)]
+    }
+
+    /// The index in `materials` of particle p's material.
+    pub fn material_index_of(&self, p: usize) -> usize {
+        self.body_material[self.particles.body[p] as usize] as usize
     }
 }
 
@@ -799,9 +816,6 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         points: Vec::new(),
         freed: Vec::new(),
     };
-    // Membership is tested on the unperturbed lattice position, so a
-    // perturbed grid fixes the same nodes as the regular one.
-    let eps = 1e-9 * grid.h;
     for (name, spec) in &scene.file.constraints {
         let bits = match spec.fix {
             Fix::X => FIX_X,
@@ -810,25 +824,16 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         };
         let mut nodes = Vec::new();
         let mut cells = [usize::MAX, 0, usize::MAX, 0];
-        for j in 0..grid.ny {
-            for i in 0..grid.nx {
-                let p = grid.lattice_pos(i, j);
-                if p[0] >= spec.min[0] - eps
-                    && p[0] <= spec.max[0] + eps
-                    && p[1] >= spec.min[1] - eps
-                    && p[1] <= spec.max[1] + eps
-                {
-                    let n = grid.index(i, j);
-                    c.fix[n] |= bits;
-                    nodes.push(n as u32);
-                    cells = [
-                        cells[0].min(i),
-                        cells[1].max(i),
-                        cells[2].min(j),
-                        cells[3].max(j),
-                    ];
-                }
-            }
+        for (i, j) in grid.region(spec.min, spec.max) {
+            let n = grid.index(i, j);
+            c.fix[n] |= bits;
+            nodes.push(n as u32);
+            cells = [
+                cells[0].min(i),
+                cells[1].max(i),
+                cells[2].min(j),
+                cells[3].max(j),
+            ];
         }
         if nodes.is_empty() {
             return Err(SceneError::invalid(

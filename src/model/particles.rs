@@ -38,6 +38,9 @@ pub struct Particles {
     /// Plastic state [σzz (Pa), ε̄p, εp_v, last return's active surfaces]
     /// (`material::plastic`); only when a material is plastic, else empty.
     pub plastic: Vec<PlasticState>,
+    /// Pore pressure p (Pa, compression positive); saturated scenes only
+    /// (`model::pore`), else empty.
+    pub pore_pressure: Vec<f64>,
     /// Body index (scene order).
     pub body: Vec<u32>,
     /// Initial position (m).
@@ -84,6 +87,7 @@ impl Particles {
             } else {
                 Vec::new()
             },
+            pore_pressure: Vec::new(),
             body: seeds.iter().map(|s| s.body).collect(),
             x0: seeds.iter().map(|s| s.x).collect(),
         }

@@ -41,9 +41,14 @@ pub fn time_step(model: &Model, t: f64) -> (f64, bool) {
 
 /// Δt (s) and whether it is the last, given the largest signal speed `c` (m/s).
 pub fn step_of(model: &Model, c: f64, t: f64) -> (f64, bool) {
-    let dt = model
-        .fixed_dt
-        .unwrap_or(model.cfl * model.grid.min_spacing() / c);
+    let dt = model.fixed_dt.unwrap_or_else(|| {
+        let cfl = model.cfl * model.grid.min_spacing() / c;
+        // Saturated soil: the flow's own explicit limit, where smaller.
+        match &model.pore {
+            Some(pore) => cfl.min(pore.flow_dt(model.grid.min_spacing())),
+            None => cfl,
+        }
+    });
     let rem = model.t_end - t;
     if dt >= rem * (1.0 - LAST_STEP_REL) {
         (rem, true)
@@ -53,7 +58,8 @@ pub fn step_of(model: &Model, c: f64, t: f64) -> (f64, bool) {
 }
 
 /// Largest signal speed over all particles (m/s): |v_p| or the material's
-/// wave speed at the particle's density and state.
+/// wave speed at the particle's density and state (undrained where the
+/// material is saturated).
 pub fn max_speed(model: &Model) -> f64 {
     let p = &model.particles;
     (0..p.len())
@@ -61,11 +67,15 @@ pub fn max_speed(model: &Model) -> f64 {
         .with_min_len(1024)
         .map(|i| {
             let v = p.v[i];
-            let c2 = model.material_of(i).wave_speed_squared(
+            let mut c2 = model.material_of(i).wave_speed_squared(
                 p.rho[i],
                 &p.stress[i],
                 p.plastic.get(i).unwrap_or(&[0.0; 4]),
             );
+            // Saturated soil: the undrained wave, (M + K_w / n) / ρ.
+            if let Some(pore) = &model.pore {
+                c2 += pore.undrained_modulus(model.material_index_of(i)) / p.rho[i];
+            }
             (v[0] * v[0] + v[1] * v[1]).max(c2)
         })
         .reduce(|| 0.0, f64::max)

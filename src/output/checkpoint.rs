@@ -29,8 +29,8 @@ const MAGIC: &[u8; 8] = b"LMEMPMCK";
 /// Bumped whenever the payload changes (2: the plastic state; 3: the
 /// implicit integrator's Newton statistics and per-sample Newton figures;
 /// 4: its held wall contact states; 5: a GMM run's node cloud; 6: the
-/// Newton factorizations' count).
-pub const FORMAT: u32 = 6;
+/// Newton factorizations' count; 7: the pore pressure of saturated soil).
+pub const FORMAT: u32 = 7;
 
 /// A run's state at a step boundary.
 #[derive(Debug, Clone)]
@@ -88,6 +88,7 @@ impl Checkpoint {
         e.pairs(&p.lambda);
         e.list(&p.f, |e, f| f.iter().for_each(|v| e.f64(*v)));
         e.list(&p.plastic, |e, q| q.iter().for_each(|v| e.f64(*v)));
+        e.f64s(&p.pore_pressure);
         e.list(&p.body, |e, b| e.u32(*b));
         e.pairs(&p.x0);
         e.list(&self.samples, |e, s| {
@@ -182,6 +183,7 @@ impl Checkpoint {
             lambda: d.pairs()?,
             f: d.list(|d| Ok([d.f64()?, d.f64()?, d.f64()?, d.f64()?]))?,
             plastic: d.list(|d| Ok([d.f64()?, d.f64()?, d.f64()?, d.f64()?]))?,
+            pore_pressure: d.list(|d| d.f64())?,
             body: d.list(|d| d.u32())?,
             x0: d.pairs()?,
         };
@@ -246,6 +248,7 @@ impl Checkpoint {
         let optional_ok = [particles.a.len(), particles.lambda.len()]
             .into_iter()
             .chain([particles.f.len(), particles.plastic.len()])
+            .chain([particles.pore_pressure.len()])
             .all(|l| l == 0 || l == n);
         let fields_ok = optional_ok
             && [particles.v.len(), particles.mass.len(), particles.rho.len()]
@@ -422,6 +425,7 @@ mod tests {
             particles
                 .plastic
                 .push([-4.5e4, 0.0123 + i as f64, -1e-19, 5.0]);
+            particles.pore_pressure.push(1.5e4 - 1e-12 * i as f64);
             particles.body.push(i);
         }
         Checkpoint {
@@ -498,6 +502,7 @@ mod tests {
         assert_eq!(d.particles.a, c.particles.a);
         assert_eq!(d.particles.f, c.particles.f);
         assert_eq!(d.particles.plastic, c.particles.plastic);
+        assert_eq!(d.particles.pore_pressure, c.particles.pore_pressure);
         assert_eq!(d.particles.body, c.particles.body);
         assert!(d.particles.lambda.is_empty());
         assert_eq!((d.t, d.dt, d.steps), (c.t, c.dt, c.steps));

@@ -83,7 +83,9 @@ pub fn reactions(names: &[String], samples: &[Sample]) -> String {
 /// the columns the materials name (`StateLayout::columns`: `eps_p,eps_pv`
 /// for Mohr–Coulomb and Drucker–Prager, `p_c,v` for modified Cam-clay),
 /// and the surfaces active in the last step's return (bit mask, 0 =
-/// elastic; docs/outputs.md). `body_names` in scene order.
+/// elastic; docs/outputs.md); then in saturated soil `,pore_pressure`
+/// (Pa, compression positive; the stress columns are the effective
+/// stress σ' = σ + p I). `body_names` in scene order.
 pub fn particles(body_names: &[String], state: &StateLayout, p: &Particles) -> String {
     let plastic = !p.plastic.is_empty();
     let mut s = String::with_capacity(p.len() * if plastic { 240 } else { 160 } + 64);
@@ -95,6 +97,10 @@ pub fn particles(body_names: &[String], state: &StateLayout, p: &Particles) -> S
             s.push_str(c.column);
         }
         s.push_str(",plastic");
+    }
+    let saturated = !p.pore_pressure.is_empty();
+    if saturated {
+        s.push_str(",pore_pressure");
     }
     s.push('\n');
     for i in 0..p.len() {
@@ -122,6 +128,9 @@ pub fn particles(body_names: &[String], state: &StateLayout, p: &Particles) -> S
                 let _ = write!(s, ",{}", state.value(c, p, i));
             }
             let _ = write!(s, ",{}", q[3] as u32);
+        }
+        if saturated {
+            let _ = write!(s, ",{}", p.pore_pressure[i]);
         }
         s.push('\n');
     }

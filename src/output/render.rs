@@ -37,6 +37,8 @@ pub enum Field {
     State(StateColumn),
     /// |x − X|, the distance from the initial position (m).
     Displacement,
+    /// Saturated soil: the pore pressure p (Pa; positive in compression).
+    PorePressure,
 }
 
 impl clap::ValueEnum for Field {
@@ -48,6 +50,7 @@ impl clap::ValueEnum for Field {
             let mut all = vec![Field::Speed, Field::Stress, Field::Pressure];
             all.extend(state_columns().into_iter().map(Field::State));
             all.push(Field::Displacement);
+            all.push(Field::PorePressure);
             all
         })
     }
@@ -65,6 +68,7 @@ impl Field {
             Field::Pressure => "pressure",
             Field::State(c) => c.column,
             Field::Displacement => "displacement",
+            Field::PorePressure => "pore_pressure",
         }
     }
 
@@ -75,13 +79,14 @@ impl Field {
             Field::Pressure => "pressure (Pa)".into(),
             Field::State(c) => c.label(),
             Field::Displacement => "displacement (m)".into(),
+            Field::PorePressure => "pore pressure (Pa)".into(),
         }
     }
 
     /// Its colour scale starts at its least value, not at 0.
     fn scale_at_least(self) -> bool {
         match self {
-            Field::Pressure => true,
+            Field::Pressure | Field::PorePressure => true,
             Field::State(c) => !c.from_zero,
             _ => false,
         }
@@ -267,6 +272,16 @@ fn values(v: &Vtu, field: Field, path: &Path) -> Result<Vec<f32>> {
     };
     Ok(match field {
         Field::Speed => v.get("speed").ok_or_else(|| missing("speed"))?.0.to_vec(),
+        Field::PorePressure => v
+            .get("pore_pressure")
+            .ok_or_else(|| {
+                folder_error(format!(
+                    "{}: no `pore_pressure` array: the scene has no saturated material",
+                    path.display()
+                ))
+            })?
+            .0
+            .to_vec(),
         Field::Displacement => {
             let (d, _) = v
                 .get("displacement")

@@ -173,6 +173,22 @@ pub fn text(s: &Summary) -> Option<String> {
             pct(e.q_rel_error),
             num(e.q_end_over_c)
         ),
+        Errors::Terzaghi(e) => format!(
+            "pore pressure at T_v = {} against Terzaghi's series: RMS {} of the undrained p_start; \
+             degree of consolidation {} against {}; settlement {} mm against {} mm ({}{}).",
+            num(e.time_factor),
+            pct(e.pressure_rms),
+            pct(e.consolidation),
+            pct(e.consolidation_exact),
+            num(1e3 * e.settlement),
+            num(1e3 * e.settlement_exact),
+            if e.settlement_rel_error >= 0.0 {
+                "+"
+            } else {
+                ""
+            },
+            pct(e.settlement_rel_error)
+        ),
         Errors::CriticalState(e) => format!(
             "stress ratio q/p′ = {} (p′ = {} kPa, q = {} kPa) at {} axial strain against the \
              critical state's M = {}: {} of the way; drained plane strain reaches q = M p′ only \
@@ -272,6 +288,10 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
         Some(ExactKind::Cantilever) => return cantilever(scene, model),
         Some(ExactKind::PrandtlFooting) => return footing(scene, model, samples),
         Some(ExactKind::CriticalState) => return critical_state(scene, model),
+        Some(ExactKind::Terzaghi) => {
+            let t = samples.last().map_or(scene.file.solver.t_end, |s| s.t);
+            return terzaghi(scene, model, t);
+        }
         Some(k @ (ExactKind::ColumnCollapse | ExactKind::GranularCollapse)) => {
             return collapse(scene, model, k);
         }
@@ -514,6 +534,37 @@ fn critical_state(scene: &Scene, model: &Model) -> History {
                 3,
             )
             .dashed(),
+        ],
+    }
+}
+
+/// Saturated layer: the pore pressure over height at the end against
+/// Terzaghi's isochrone.
+fn terzaghi(scene: &Scene, model: &Model, t: f64) -> History {
+    let layer = crate::exact::terzaghi::Terzaghi::from_scene(scene);
+    let p = &model.particles;
+    let ps = layer.p_start();
+    let tv = layer.time_factor(t);
+    let pts: Vec<(f64, f64)> = (0..p.len())
+        .step_by((p.len() / 4000).max(1))
+        .map(|i| (p.pore_pressure[i] / ps, p.x[i][1]))
+        .collect();
+    let exact: Vec<(f64, f64)> = (0..=100)
+        .map(|k| {
+            let y = layer.base + layer.height() * k as f64 / 100.0;
+            (layer.pressure_ratio(y, tv), y)
+        })
+        .collect();
+    History {
+        title: format!(
+            "pore pressure at T_v = {} against Terzaghi's series",
+            num(tv)
+        ),
+        y_label: "y (m)".into(),
+        x_label: Some("p / p_start".into()),
+        series: vec![
+            Series::line("particles at the end", pts, 0).scatter(),
+            Series::line("Terzaghi's series", exact, 3).dashed(),
         ],
     }
 }

@@ -49,6 +49,11 @@ pub fn particles_vtu(p: &Particles, state: &StateLayout, t: f64) -> Vec<u8> {
             .collect();
         arrays.push(("plastic", "Int32", 1, ret));
     }
+    if !p.pore_pressure.is_empty() {
+        // Saturated soil: p (Pa, compression positive); `stress` is σ'.
+        let mut pw = p.pore_pressure.iter().copied();
+        arrays.push(("pore_pressure", "Float32", 1, f32s(&mut pw)));
+    }
     let mut rho = p.rho.iter().copied();
     arrays.push(("density", "Float32", 1, f32s(&mut rho)));
     let mut vol = (0..n).map(|i| p.mass[i] / p.rho[i]);

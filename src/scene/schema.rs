@@ -40,6 +40,10 @@ pub struct SceneFile {
     /// Concentrated loads by name.
     #[serde(default)]
     pub point_loads: BTreeMap<String, PointLoadSpec>,
+    /// Drained boundaries of saturated soil by name: the pore pressure
+    /// held on the nodes of a region (every other boundary is impermeable).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub drainage: BTreeMap<String, DrainageSpec>,
     pub gravity: Option<GravitySpec>,
     pub solver: SolverSpec,
     #[serde(default)]
@@ -251,6 +255,20 @@ pub struct ConstraintSpec {
     /// Linear ramp of `velocity` from 0 over this time (s); 0 = from the start. Default 0.
     #[serde(default)]
     pub ramp_time: f64,
+}
+
+/// A drained boundary (`[drainage.<name>]`): the nodes in the region
+/// hold the pore pressure `pressure`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrainageSpec {
+    /// Lower-left corner of the region (m); `-inf` allowed.
+    pub min: [f64; 2],
+    /// Upper-right corner of the region (m); `inf` allowed.
+    pub max: [f64; 2],
+    /// Pore pressure held there (Pa, compression positive). Default 0.
+    #[serde(default)]
+    pub pressure: f64,
 }
 
 /// How a wall treats the material on it.
@@ -601,6 +619,23 @@ pub struct SolverSpec {
     /// flow, Coombs et al. 2018). Explicit integrators, CPU path.
     #[serde(default)]
     pub volumetric_strain: VolumetricStrain,
+    /// Saturated soil: where the mass balance takes the volumetric strain
+    /// rate (`nodal`, the stabilised default, or `particle`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pore_volumetric: Option<PoreVolumetric>,
+}
+
+/// Where the pore fluid's mass balance takes −∇·v (`solver.pore_volumetric`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoreVolumetric {
+    /// On the nodes, with the flow, Σ_p V_p N_I tr L_p: the pressure is
+    /// one field on the grid (stable with equal-order interpolation).
+    #[default]
+    Nodal,
+    /// At each particle from its own tr L_p: equal-order u–p, which
+    /// oscillates from particle to particle; kept to show it.
+    Particle,
 }
 
 /// The volumetric strain rate a particle's stress update takes
@@ -792,6 +827,10 @@ pub enum ExactKind {
     GranularCollapse,
     /// Nothing does work: kinetic + strain energy at t_end against the start's.
     Energy,
+    /// Terzaghi's consolidation of a saturated layer drained at its top:
+    /// pore pressure, degree of consolidation and settlement at t_end
+    /// against the series (`exact::terzaghi`).
+    Terzaghi,
 }
 
 /// Manufactured solutions known to the code.

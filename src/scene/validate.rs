@@ -1282,6 +1282,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
             return check_collapse(file, kind);
         }
         ExactKind::Energy => return check_energy(file),
+        ExactKind::Terzaghi => return check_terzaghi(file),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -1333,7 +1334,8 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         | ExactKind::CriticalState
         | ExactKind::ColumnCollapse
         | ExactKind::GranularCollapse
-        | ExactKind::Energy => {}
+        | ExactKind::Energy
+        | ExactKind::Terzaghi => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(
@@ -1508,6 +1510,36 @@ fn check_pair_reference(file: &SceneFile, kind: ExactKind) -> Result<(), SceneEr
 }
 
 /// `exact = "critical_state"`: a modified Cam-clay material.
+/// `exact = "terzaghi"`: one body of one rect (the layer), one saturated
+/// linear-elastic material, one traction along the layer's top, normal to it.
+fn check_terzaghi(file: &SceneFile) -> Result<(), SceneError> {
+    let bad = |msg: &str| {
+        Err(SceneError::invalid(
+            "exact",
+            format!("= \"terzaghi\" {msg}"),
+        ))
+    };
+    let rect = match file.bodies.values().collect::<Vec<_>>().as_slice() {
+        [b] if b.rects.len() == 1 && b.disks.is_empty() && b.polygons.is_empty() => b.rects[0],
+        _ => return bad("needs one body made of one rect (the layer)"),
+    };
+    match file.materials.values().collect::<Vec<_>>().as_slice() {
+        [m] if m.model == "linear_elastic" && m.get("permeability").is_some() => {}
+        _ => return bad("needs one material, linear_elastic with `permeability` (saturated)"),
+    }
+    match file.tractions.values().collect::<Vec<_>>().as_slice() {
+        [t] if t.from[1] == rect[3]
+            && t.to[1] == rect[3]
+            && t.traction[0] == 0.0
+            && t.traction[1] < 0.0 => {}
+        _ => return bad("needs one traction [0, -p0] along the layer's top (y = its rect's ymax)"),
+    }
+    if file.drainage.is_empty() {
+        return bad("needs a [drainage.<name>] region at the layer's top");
+    }
+    Ok(())
+}
+
 fn check_critical_state(file: &SceneFile) -> Result<(), SceneError> {
     if !file
         .materials

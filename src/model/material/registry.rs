@@ -268,7 +268,14 @@ impl<'a> Keys<'a> {
     /// Refuses keys the model did not read.
     pub fn finish(&self) -> Result<(), SceneError> {
         let read = self.read.borrow();
-        if let Some(k) = self.spec.values.keys().find(|k| !read.contains(*k)) {
+        // The pore fluid's keys belong to every model (`model::pore`).
+        let pore = |k: &str| crate::model::pore::KEYS.iter().any(|(p, _)| *p == k);
+        if let Some(k) = self
+            .spec
+            .values
+            .keys()
+            .find(|k| !read.contains(*k) && !pore(k))
+        {
             let known: Vec<String> = self
                 .model_keys
                 .iter()
@@ -277,9 +284,14 @@ impl<'a> Keys<'a> {
             return Err(self.invalid(
                 k,
                 format!(
-                    "is not a key of model = \"{}\"; its keys: density (kg/m³), {}",
+                    "is not a key of model = \"{}\"; its keys: density (kg/m³), {}; and for saturated soil {}",
                     self.spec.model,
-                    known.join(", ")
+                    known.join(", "),
+                    crate::model::pore::KEYS
+                        .iter()
+                        .map(|(k, u)| format!("{k} ({u})"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             ));
         }
