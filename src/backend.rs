@@ -95,6 +95,8 @@ pub struct ProbeState {
     pub x: [f64; 2],
     pub v: [f64; 2],
     pub stress: [f64; 3],
+    /// Saturated soil: the pore pressure (Pa); None in a dry scene.
+    pub pore_pressure: Option<f64>,
 }
 
 /// Everything recorded at a sample time.
@@ -239,6 +241,7 @@ pub fn probe_states(model: &Model) -> Vec<ProbeState> {
             x: p.x[pr.particle],
             v: p.v[pr.particle],
             stress: p.stress[pr.particle],
+            pore_pressure: p.pore_pressure.get(pr.particle).copied(),
         })
         .collect()
 }

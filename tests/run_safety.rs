@@ -340,6 +340,31 @@ fn resume_from_a_periodic_checkpoint_gives_the_same_particles_on_the_block() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
+/// Saturated soil resumes too: the pore pressure is in the checkpoint
+/// (particles and probes), so the resumed run's files are the whole run's.
+#[test]
+fn a_saturated_run_resumes_from_its_checkpoint_bit_for_bit() {
+    let out = tmp("terzaghi");
+    let sets = &[
+        "solver.t_end=0.3",
+        "output.checkpoint_interval=0.12",
+        "output.final_checkpoint=false",
+    ];
+    let o = run("terzaghi.toml", &out, sets);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = read(&out.join("particles.csv"));
+    let probes = read(&out.join("probes.csv"));
+    assert!(whole.lines().next().unwrap().ends_with(",pore_pressure"));
+    assert!(probes.lines().next().unwrap().ends_with(",pore_pressure"));
+    let o = resume(&out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let from = summary(&out)["resumed_from"].as_f64().unwrap();
+    assert!((0.2..0.3).contains(&from), "resumed from {from}");
+    assert_eq!(read(&out.join("particles.csv")), whole);
+    assert_eq!(read(&out.join("probes.csv")), probes);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 #[test]
 fn a_resumed_implicit_run_reports_the_whole_runs_newton_statistics() {
     // The checkpoint carries the Newton counters and the per-sample Newton

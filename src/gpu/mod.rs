@@ -549,6 +549,8 @@ impl Backend for GpuBackend {
                     x: [o[0] as f64 + origin[0], o[1] as f64 + origin[1]],
                     v: [o[2] as f64, o[3] as f64],
                     stress: [o[4] as f64, o[5] as f64, o[6] as f64],
+                    // The GPU refuses saturated scenes.
+                    pore_pressure: None,
                 }
             })
             .collect();

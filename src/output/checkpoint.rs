@@ -29,7 +29,8 @@ const MAGIC: &[u8; 8] = b"LMEMPMCK";
 /// Bumped whenever the payload changes (2: the plastic state; 3: the
 /// implicit integrator's Newton statistics and per-sample Newton figures;
 /// 4: its held wall contact states; 5: a GMM run's node cloud; 6: the
-/// Newton factorizations' count; 7: the pore pressure of saturated soil).
+/// Newton factorizations' count; 7: the pore pressure of saturated soil,
+/// per particle and per probe).
 pub const FORMAT: u32 = 7;
 
 /// A run's state at a step boundary.
@@ -97,7 +98,8 @@ impl Checkpoint {
                 pr.x.iter()
                     .chain(&pr.v)
                     .chain(&pr.stress)
-                    .for_each(|v| e.f64(*v))
+                    .for_each(|v| e.f64(*v));
+                e.option(pr.pore_pressure.as_ref(), |e, p| e.f64(*p));
             });
             e.energy(&s.energy);
             e.pairs(&s.reactions);
@@ -195,6 +197,7 @@ impl Checkpoint {
                         x: [d.f64()?, d.f64()?],
                         v: [d.f64()?, d.f64()?],
                         stress: [d.f64()?, d.f64()?, d.f64()?],
+                        pore_pressure: d.option(|d| d.f64())?,
                     })
                 })?,
                 energy: d.energy()?,
@@ -453,6 +456,7 @@ mod tests {
                     x: [0.1, 0.2],
                     v: [0.0; 2],
                     stress: [0.0; 3],
+                    pore_pressure: Some(-1.5e3),
                 }],
                 energy: Energy::default(),
                 reactions: vec![[1.0, -1.0]],

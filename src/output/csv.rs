@@ -7,13 +7,20 @@ use crate::model::Particles;
 use crate::output::state::StateLayout;
 use std::fmt::Write;
 
-/// `t,probe,x,y,vx,vy,sxx,syy,sxy` (s, m, m/s, Pa), and for the implicit
+/// `t,probe,x,y,vx,vy,sxx,syy,sxy` (s, m, m/s, Pa), in saturated soil
+/// `,pore_pressure` (Pa; the stress is then the effective one), and for the implicit
 /// integrator `newton_iterations,newton_residual,dt` of the step before
 /// the sample (empty for samples read back from a checkpoint).
 /// `names` in `Model::probes` order.
 pub fn probes(names: &[String], samples: &[Sample]) -> String {
     let implicit = samples.iter().any(|s| s.newton.is_some());
+    let saturated = samples
+        .iter()
+        .any(|s| s.probes.iter().any(|p| p.pore_pressure.is_some()));
     let mut s = String::from("t,probe,x,y,vx,vy,sxx,syy,sxy");
+    if saturated {
+        s.push_str(",pore_pressure");
+    }
     s.push_str(if implicit {
         ",newton_iterations,newton_residual,dt\n"
     } else {
@@ -34,6 +41,9 @@ pub fn probes(names: &[String], samples: &[Sample]) -> String {
                 st.stress[1],
                 st.stress[2]
             );
+            if saturated {
+                let _ = write!(s, ",{}", st.pore_pressure.unwrap_or(0.0));
+            }
             match (implicit, smp.newton) {
                 (false, _) => {}
                 (true, Some(n)) => {

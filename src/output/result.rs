@@ -865,6 +865,7 @@ mod tests {
                         x: model.particles.x0[p.particle],
                         v: [0.0; 2],
                         stress: [0.0; 3],
+                        pore_pressure: None,
                     })
                     .collect(),
                 energy: Energy {
