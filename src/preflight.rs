@@ -271,7 +271,7 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
         if let Some(fl) =
             crate::model::pore::Fluid::from_spec(&b.material, &f.materials[&b.material])?
         {
-            c = (c * c + 1.0 / (fl.storage() * m.density())).sqrt();
+            c = (c * c + fl.undrained_modulus() / m.density()).sqrt();
         }
         let v = b.velocity[0].hypot(b.velocity[1]);
         let s = c.max(v);
@@ -298,11 +298,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> Result<Estimate, SceneError> {
     // Saturated soil: the flow's own limit (`Pore::flow_dt`) where smaller.
     if f.solver.dt.is_none() {
         for (name, spec) in &f.materials {
-            if let Some(fl) =
-                crate::model::pore::Fluid::from_spec(name, spec)?.filter(|fl| fl.k > 0.0)
-            {
-                let flow =
-                    crate::model::pore::FLOW_SAFETY * h * h * fl.storage() / (4.0 * fl.mobility());
+            if let Some(fl) = crate::model::pore::Fluid::from_spec(name, spec)? {
+                let flow = fl.flow_dt(h);
                 if flow < dt {
                     (dt, dt_key) = (flow, format!("materials.{name}.permeability"));
                 }

@@ -60,7 +60,8 @@ impl Terzaghi {
             .ok()
             .flatten()
             .expect("validated: saturated");
-        let (e, nu) = (m.get("E").unwrap_or(f64::NAN), m.get("nu").unwrap_or(0.0));
+        let (lambda, mu) = crate::model::material::Material::from_spec(name, m)
+            .map_or((f64::NAN, f64::NAN), |m| m.lame_shear());
         let p0 = -f
             .tractions
             .values()
@@ -71,7 +72,7 @@ impl Terzaghi {
             base: rect[1],
             top: rect[3],
             p0,
-            m: e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+            m: lambda + 2.0 * mu,
             fluid,
         }
     }

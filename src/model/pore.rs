@@ -60,6 +60,22 @@ impl Fluid {
         self.n / self.kw
     }
 
+    /// K_w / n (Pa): the fluid's share of the undrained P-wave modulus,
+    /// c² = (M + K_w / n) / ρ.
+    pub fn undrained_modulus(&self) -> f64 {
+        1.0 / self.storage()
+    }
+
+    /// The flow's explicit time-step limit (s) on spacing `h` (m):
+    /// `FLOW_SAFETY` · h² S / (4 κ); ∞ where impermeable.
+    pub fn flow_dt(&self, h: f64) -> f64 {
+        if self.k > 0.0 {
+            FLOW_SAFETY * h * h * self.storage() / (4.0 * self.mobility())
+        } else {
+            f64::INFINITY
+        }
+    }
+
     /// The pore fluid of material `name`, or None for a dry one; bad
     /// values exit 2 naming the key.
     pub fn from_spec(name: &str, spec: &MaterialSpec) -> Result<Option<Fluid>, SceneError> {
@@ -187,21 +203,17 @@ impl Pore {
         }))
     }
 
-    /// The fluid's share of the undrained P-wave modulus, K_w / n (Pa), of
-    /// material `m` (0 where it is dry): c² = (M + K_w / n) / ρ.
+    /// `Fluid::undrained_modulus` of material `m` (0 where it is dry).
     pub fn undrained_modulus(&self, m: usize) -> f64 {
-        self.fluid[m].map_or(0.0, |f| 1.0 / f.storage())
+        self.fluid[m].map_or(0.0, |f| f.undrained_modulus())
     }
 
-    /// The flow's explicit time-step limit (s) on spacing `h` (m):
-    /// `FLOW_SAFETY` · h² S / (4 κ) over the saturated materials (∞ where
-    /// every one is impermeable).
+    /// The smallest `Fluid::flow_dt` over the saturated materials (s).
     pub fn flow_dt(&self, h: f64) -> f64 {
         self.fluid
             .iter()
             .flatten()
-            .filter(|f| f.k > 0.0)
-            .map(|f| FLOW_SAFETY * h * h * f.storage() / (4.0 * f.mobility()))
+            .map(|f| f.flow_dt(h))
             .fold(f64::INFINITY, f64::min)
     }
 
@@ -215,8 +227,8 @@ impl Pore {
         saturated: impl Fn(usize) -> bool,
     ) -> Result<(), SceneError> {
         let mut near = vec![false; grid.n_nodes()];
-        for (_, q) in x.iter().enumerate().filter(|&(p, _)| saturated(p)) {
-            let l = grid.logical(*q);
+        for p in (0..x.len()).filter(|&p| saturated(p)) {
+            let l = grid.logical(x[p]);
             let (ci, cj) = (l[0].floor() as i64, l[1].floor() as i64);
             for j in cj - 1..=cj + 2 {
                 for i in ci - 1..=ci + 2 {
