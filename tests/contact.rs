@@ -127,19 +127,24 @@ fn block_rests_on_a_slab_above_the_friction_angle() {
 /// centre moves less than one cell (0.05 m) along it. Pure FLIP let the
 /// soft block creep at 0.057 m/s at 0.5 s and 0.083 m/s at 0.95 s, 50 mm
 /// by then (2026-12-01); on a grid twice as coarse it held even so (5.1
-/// mm, 1e-3 m/s at 1 s), so the test runs the case's grid (about 60 s
-/// each on 2 cores). With the interface's PIC share
-/// (`CONTACT_PIC_FRACTION`, 2026-12-02): the soft block at most 4.1e-3
-/// m/s from 0.2 s and 2.8 mm in all, the stiff one 7.8e-4 m/s and 0.6 mm.
+/// mm, 1e-3 m/s at 1 s), so the soft block runs the case's grid (about
+/// 60 s on 2 cores). The stiff block runs one twice as coarse (h = 0.1, a
+/// sixth of the time: on the case's grid the pair took 147 s of CI, the
+/// suite's longest test); its start to 0.2 s on the case's grid is
+/// `block_rests_on_a_slab_above_the_friction_angle`. With the interface's
+/// PIC share (`CONTACT_PIC_FRACTION`, 2026-12-02): the soft block at most
+/// 4.1e-3 m/s from 0.2 s and 2.8 mm in all; the stiff one 7.8e-4 m/s and
+/// 0.6 mm on the case's grid, 4.0e-4 m/s and 0.4 mm on h = 0.1.
 #[test]
 fn soft_and_stiff_blocks_hold_on_the_slab_for_a_second() {
-    for e in ["1e6", "1e7"] {
+    for (e, h) in [("1e6", "0.05"), ("1e7", "0.1")] {
         let scene = common::scene(
             "contact_block.toml",
             &[
                 "contact.interface.friction=0.7",
                 "solver.t_end=1",
                 &format!("materials.soft.E={e}"),
+                &format!("grid.h={h}"),
             ],
         );
         let model = Model::new(&scene).unwrap();
@@ -159,7 +164,7 @@ fn soft_and_stiff_blocks_hold_on_the_slab_for_a_second() {
         // Along the slab (x): the slip; the normal settling is elastic.
         let slip = (m[0].displacement[0] - m[1].displacement[0]).abs();
         println!(
-            "E = {e} Pa, mu 0.7: fastest relative speed from 0.2 s {fastest:.2e} m/s, slip {slip:.2e} m"
+            "E = {e} Pa, h = {h} m, mu 0.7: fastest relative speed from 0.2 s {fastest:.2e} m/s, slip {slip:.2e} m"
         );
         assert!(fastest < 0.02, "E = {e}: relative speed {fastest} m/s");
         assert!(slip < 0.05, "E = {e}: slipped {slip} m");
