@@ -741,8 +741,11 @@ impl CpuBackend {
             return Ok(());
         };
         let p = &mut m.particles;
-        let (materials, body_material, body) = (&pore.fluid, &m.body_material, &p.body);
-        let fluid = |i: usize| materials[body_material[body[i] as usize] as usize];
+        let (body_material, body, x0) = (&m.body_material, &p.body, &p.x0);
+        let fluid = |i: usize| {
+            let b = body[i] as usize;
+            pore.particle_fluid(body_material[b] as usize, b, x0[i][1])
+        };
         let dl = match &self.cell_average {
             Some(ca) => &ca.dl[..],
             None => &[],

@@ -414,14 +414,23 @@ impl Model {
                 *p = q;
             }
         }
-        geostatic_start(scene, &materials, &body_material, &mut particles)?;
         let pore = pore::Pore::from_scene(scene, &grid)?;
         if let Some(pore) = &pore {
-            let saturated =
-                |i: usize| pore.fluid[body_material[particles.body[i] as usize] as usize].is_some();
+            let saturated = |i: usize| {
+                let b = particles.body[i] as usize;
+                pore.particle_fluid(body_material[b] as usize, b, particles.x0[i][1])
+                    .is_some()
+            };
             pore.check_reached(&grid, &particles.x, saturated)?;
             particles.pore_pressure = vec![0.0; particles.len()];
         }
+        geostatic_start(
+            scene,
+            &materials,
+            &body_material,
+            pore.as_ref(),
+            &mut particles,
+        )?;
 
         let mut constraints = build_constraints(scene, &grid)?;
         let regions: Vec<(&[u32], u8)> = constraints
@@ -898,12 +907,16 @@ fn moving_points(scene: &Scene, grid: &Grid, c: &Constraints) -> Result<(), Scen
 }
 
 /// Bodies with `initial_stress = "geostatic"`: σ_v from the overburden
-/// above each particle, σ_h = σ_zz = k0 σ_v (`geostatic`). Refused, naming
-/// the key, for a material that keeps F or starts at a state of its own.
+/// above each particle, σ_h = σ_zz = k0 σ_v (`geostatic`); with a
+/// `water_table`, the saturated particles below it start at the
+/// hydrostatic p = ρ_w g (table − y) and the effective stress σ'_v = σ_v +
+/// p, σ'_h = σ'_zz = k0 σ'_v. Refused, naming the key, for a material that
+/// keeps F or starts at a state of its own.
 fn geostatic_start(
     scene: &Scene,
     materials: &[Material],
     body_material: &[u32],
+    pore: Option<&pore::Pore>,
     particles: &mut Particles,
 ) -> Result<(), SceneError> {
     use crate::scene::InitialStress;
@@ -951,7 +964,17 @@ fn geostatic_start(
         if bodies[b].1.initial_stress != InitialStress::Geostatic {
             continue;
         }
-        let sv = -g * geostatic::overburden(scene, &density, particles.x[i]);
+        let mut sv = -g * geostatic::overburden(scene, &density, particles.x[i]);
+        let y = particles.x[i][1];
+        let fluid = pore.and_then(|pore| {
+            let table = pore.tables[b]?;
+            Some((pore.particle_fluid(body_material[b] as usize, b, y)?, table))
+        });
+        if let Some((f, table)) = fluid {
+            let p = f.rho_w * g * (table - y);
+            particles.pore_pressure[i] = p;
+            sv += p;
+        }
         particles.stress[i] = [k0[b] * sv, sv, 0.0];
         if let Some(q) = particles.plastic.get_mut(i) {
             q[material::plastic::SZZ] = k0[b] * sv;

@@ -139,6 +139,9 @@ pub struct Drain {
 pub struct Pore {
     pub fluid: Vec<Option<Fluid>>,
     pub drains: Vec<Drain>,
+    /// Per body (`Scene::bodies()` order): its `water_table` (m), above
+    /// which its particles (by their start) are dry.
+    pub tables: Vec<Option<f64>>,
     /// The volumetric term of the mass balance on the nodes with the
     /// flow (`solver.pore_volumetric = "nodal"`, the stabilised default),
     /// or at each particle (`"particle"`: equal-order, which oscillates).
@@ -155,6 +158,24 @@ impl Pore {
             .iter()
             .map(|(name, spec)| Fluid::from_spec(name, spec))
             .collect::<Result<Vec<_>, _>>()?;
+        let needs_fluid = |key: String| {
+            Err(SceneError::invalid(
+                key,
+                "needs a saturated material (one with `permeability`)",
+            ))
+        };
+        let mut tables = Vec::new();
+        for (name, b) in scene.bodies() {
+            let saturated = f
+                .materials
+                .keys()
+                .position(|m| *m == b.material)
+                .is_some_and(|m| fluid[m].is_some());
+            if b.water_table.is_some() && !saturated {
+                return needs_fluid(format!("bodies.{name}.water_table"));
+            }
+            tables.push(b.water_table);
+        }
         if fluid.iter().all(Option::is_none) {
             if let Some(name) = f.drainage.keys().next() {
                 return Err(SceneError::invalid(
@@ -198,9 +219,22 @@ impl Pore {
         Ok(Some(Pore {
             fluid,
             drains,
+            tables,
             nodal_volumetric: f.solver.pore_volumetric.unwrap_or_default()
                 == crate::scene::PoreVolumetric::Nodal,
         }))
+    }
+
+    /// The fluid of a particle of material `material` and body `body` that
+    /// started at height `y0` (m): its material's, unless the body has a
+    /// water table at or below y0 (then it is dry).
+    #[inline]
+    pub fn particle_fluid(&self, material: usize, body: usize, y0: f64) -> Option<Fluid> {
+        let f = self.fluid[material]?;
+        match self.tables[body] {
+            Some(table) if y0 >= table => None,
+            _ => Some(f),
+        }
     }
 
     /// `Fluid::undrained_modulus` of material `m` (0 where it is dry).

@@ -212,6 +212,12 @@ pub struct BodySpec {
     /// With `initial_stress = "geostatic"`: σ_h / σ_v (> 0). Default
     /// 1 − sin φ for a material with a friction angle, ν/(1 − ν) otherwise.
     pub k0: Option<f64>,
+    /// Saturated soil with `initial_stress = "geostatic"`: the y (m) of
+    /// the phreatic level. Below it the pore pressure starts hydrostatic,
+    /// p = ρ_w g (water_table − y), and the effective stress geostatic
+    /// (σ'_v = σ_v + p, σ'_h = k0 σ'_v); the body's particles that start
+    /// above it are dry (`model::pore`).
+    pub water_table: Option<f64>,
 }
 
 /// A body's initial stress.

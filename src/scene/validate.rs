@@ -626,6 +626,15 @@ fn check_initial_stress(file: &SceneFile, bname: &str, b: &BodySpec) -> Result<(
             ));
         }
     }
+    if let Some(wt) = b.water_table {
+        finite(&key("water_table"), wt)?;
+        if b.initial_stress != InitialStress::Geostatic {
+            return Err(SceneError::invalid(
+                key("water_table"),
+                "applies only with initial_stress = \"geostatic\" (the hydrostatic start below the table)",
+            ));
+        }
+    }
     if b.initial_stress == InitialStress::Geostatic {
         let ok = file
             .gravity
