@@ -97,6 +97,7 @@ mod tests {
             polygons,
             initial_stress: Default::default(),
             k0: None,
+            water_table: None,
         }
     }
 
