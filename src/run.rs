@@ -771,6 +771,7 @@ pub fn describe(scene: &Scene, model: &Model) -> String {
     let backends = match model.integrator {
         crate::model::Integrator::Implicit(_) => "the CPU (implicit)",
         _ if model.pore.is_some() => "the CPU (saturated soil)",
+        _ if !model.constraints.platens.is_empty() => "the CPU (a loaded platen)",
         _ => "the CPU and the GPU alike",
     };
     // Saturated soil: each fluid, the drains, the stabilisation, the Δt rule.

@@ -92,20 +92,35 @@ pub fn open_backend(spec: &BackendSpec, model: Model) -> Result<Box<dyn Backend>
             }
         };
     }
-    // Saturated soil has no WGSL twin yet: the CPU path steps it.
-    if model.pore.is_some() {
+    // Saturated soil and loaded platens have no WGSL twin yet: the CPU
+    // path steps them.
+    let cpu_only = if model.pore.is_some() {
+        Some((
+            "materials".to_string(),
+            "a saturated material (`permeability`)",
+            "saturated soil",
+        ))
+    } else {
+        model.constraints.platens.first().map(|p| {
+            (
+                format!("platens.{}", p.name),
+                "a loaded platen",
+                "a loaded platen",
+            )
+        })
+    };
+    if let Some((key, what, short)) = cpu_only {
         return match spec.choice() {
             BackendChoice::Gpu => Err(crate::error::SceneError::invalid(
-                "materials",
-                "a saturated material (`permeability`) runs on the CPU path only for now: \
-                 use --backend cpu or auto",
+                key,
+                format!("{what} runs on the CPU path only for now: use --backend cpu or auto"),
             )
             .into()),
             BackendChoice::Cpu | BackendChoice::Auto => {
                 let b = CpuBackend::new(model);
                 if spec.verbose && spec.choice() == BackendChoice::Auto {
                     crate::say!(
-                        "backend: {} (auto: saturated soil runs on the CPU only for now)",
+                        "backend: {} (auto: {short} runs on the CPU only for now)",
                         b.name()
                     );
                 }

@@ -148,14 +148,16 @@ pub fn drive_from(
             let floor = energy_floor(backend);
             // A manufactured body force supplies (and takes back) the exact field's energy.
             // A constraint that drives the material (a prescribed velocity)
-            // can supply any energy: no bound, so no runaway check.
+            // or a loaded platen (its work is not tracked) can supply any
+            // energy: no bound, so no runaway check.
             let supplied = {
                 let m = backend.model();
                 let driven = m
                     .constraints
                     .groups
                     .iter()
-                    .any(|g| g.velocity != [0.0, 0.0]);
+                    .any(|g| g.velocity != [0.0, 0.0])
+                    || m.constraints.platens.iter().any(|p| p.force != 0.0);
                 if driven {
                     f64::INFINITY
                 } else {

@@ -62,6 +62,7 @@ const CASES: &[(&str, &str, &str)] = &[
         "0.01",
         "against the experiments' 1.2 a = 2.40",
     ),
+    ("mandel", "0.2", "against Mandel's"),
     ("plate_impact", "0.04", "J/m at the start"),
     ("rolling_disk", "0.02", "against ½ a t² ="),
     ("sliding_block", "0.05", "exact (a = g_t − μ g_n"),

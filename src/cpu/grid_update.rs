@@ -14,10 +14,18 @@
 //! the nodes and the particles' FLIP update (`g2p`) feel the damped force.
 //! The walls' passes around them are `wall_touch` (before `predict`) and
 //! `wall_contact` (before `correct`).
+//! Loaded platens (`[platens]`) follow each of the two: `platens` gives
+//! their nodes one velocity along the axis, the mass-weighted mean. After
+//! `predict` that is Σ q / Σ m, after `correct` the predicted one plus
+//! γ Δt Σ f / Σ m (`platen_totals`, `platens_correct`, the damping taken
+//! on the summed force), with the force on each node made m_I Σ f / Σ m
+//! (one acceleration, which `g2p` reads): the rigid plate's momentum
+//! balance under the summed force (the load and the material's
+//! reaction), exact for a lumped mass.
 //! GPU twin: `shaders/grid_update.wgsl` (built without and with
-//! `CORRECT`).
+//! `CORRECT`); the GPU path has no platens yet and refuses them.
 
-use crate::model::{ConstraintGroup, FIX_X, FIX_Y};
+use crate::model::{ConstraintGroup, FIX_X, FIX_Y, Platen};
 use rayon::prelude::*;
 
 pub use crate::model::MASS_EPS_REL;
@@ -156,6 +164,92 @@ pub fn correct(
     }
 }
 
+/// After `predict`: each platen's nodes with mass take one velocity along
+/// its axis, the mass-weighted mean of theirs (`mv` as `[m, vx, vy]`, one
+/// field).
+pub fn platens(mv: &mut [[f64; 3]], platens: &[Platen], mass_eps: f64) {
+    for p in platens {
+        let k = 1 + p.axis;
+        let (mut m, mut q) = (0.0, 0.0);
+        for &n in &p.nodes {
+            let node = &mv[n as usize];
+            if node[0] > mass_eps {
+                m += node[0];
+                q += node[0] * node[k];
+            }
+        }
+        if m > 0.0 {
+            for &n in &p.nodes {
+                let node = &mut mv[n as usize];
+                if node[0] > mass_eps {
+                    node[k] = q / m;
+                }
+            }
+        }
+    }
+}
+
+/// Before `correct`: each platen's one velocity along its axis (the
+/// predicted, tied one) and its acceleration, the summed force on its
+/// nodes (the walls' included) and its load at `t` (the step's end, as
+/// for the other loads) over their summed mass, with Cundall's
+/// damping taken on the plate as one body: damped node by node, the
+/// large and opposed forces on a plate's nodes (the load on one, the
+/// material's reaction on the next) would each be damped and hold the
+/// plate up. Into `totals[k] = [v, a]`.
+#[allow(clippy::too_many_arguments)]
+pub fn platen_totals(
+    mv: &[[f64; 3]],
+    force: &[[f64; 2]],
+    wall_force: &[[f64; 2]],
+    platens: &[Platen],
+    t: f64,
+    damping: f64,
+    mass_eps: f64,
+    totals: &mut [[f64; 2]],
+) {
+    for (p, total) in platens.iter().zip(totals.iter_mut()) {
+        let k = p.axis;
+        let (mut m, mut q, mut f) = (0.0, 0.0, 0.0);
+        for &n in &p.nodes {
+            let n = n as usize;
+            if mv[n][0] > mass_eps {
+                m += mv[n][0];
+                q += mv[n][0] * mv[n][1 + k];
+                f += force[n][k] + wall_force.get(n).map_or(0.0, |w| w[k]);
+            }
+        }
+        let v = if m > 0.0 { q / m } else { 0.0 };
+        f += p.force_at(t);
+        if damping > 0.0 {
+            f = local_damping([f, 0.0], [v, 0.0], damping)[0];
+        }
+        *total = [v, if m > 0.0 { f / m } else { 0.0 }];
+    }
+}
+
+/// After `correct`: each platen's nodes with mass move as one, v + γ Δt a
+/// along the axis (`platen_totals`), with the force m_I a there, one
+/// acceleration, which `g2p` reads.
+pub fn platens_correct(
+    mv: &mut [[f64; 3]],
+    force: &mut [[f64; 2]],
+    platens: &[Platen],
+    totals: &[[f64; 2]],
+    gamma_dt: f64,
+    mass_eps: f64,
+) {
+    for (p, &[v, a]) in platens.iter().zip(totals) {
+        for &n in &p.nodes {
+            let n = n as usize;
+            if mv[n][0] > mass_eps {
+                mv[n][1 + p.axis] = v + gamma_dt * a;
+                force[n][p.axis] = mv[n][0] * a;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,5 +261,42 @@ mod tests {
         assert_eq!(local_damping([2.0, -2.0], [1.0, 1.0], 0.5), [1.0, -3.0]);
         assert_eq!(local_damping([2.0, -2.0], [0.0, 0.0], 0.5), [2.0, -2.0]);
         assert_eq!(local_damping([2.0, 0.0], [-1.0, 3.0], 0.5), [3.0, 0.0]);
+    }
+
+    #[test]
+    fn a_platen_moves_its_nodes_as_one_and_keeps_their_momentum() {
+        // Masses 1 and 3 at v_y 4 and 0: one v_y = 1 (momentum 4 kept);
+        // x and the massless node untouched.
+        let mut mv = [[1.0, 2.0, 4.0], [3.0, -1.0, 0.0], [0.0, 0.0, 0.0]];
+        let p = [Platen {
+            name: "plate".into(),
+            nodes: vec![0, 1, 2],
+            axis: 1,
+            force: 0.0,
+            ramp_time: 0.0,
+        }];
+        platens(&mut mv, &p, 1e-12);
+        assert_eq!(mv, [[1.0, 2.0, 1.0], [3.0, -1.0, 1.0], [0.0, 0.0, 0.0]]);
+        // Forces +6 and −2 along y: Σ f / Σ m = 1, one acceleration
+        // (f_y = m); the plate's velocity 1 + 0.5 · 1; x untouched. With
+        // α = 0.5 the plate as one body keeps 4 − 0.5 · 4 = 2 of its 4.
+        let mut f = [[5.0, 6.0], [7.0, -2.0], [0.0, 9.0]];
+        let mut totals = [[0.0; 2]];
+        platen_totals(&mv, &f, &[], &p, 0.0, 0.0, 1e-12, &mut totals);
+        assert_eq!(totals, [[1.0, 1.0]]);
+        platens_correct(&mut mv, &mut f, &p, &totals, 0.5, 1e-12);
+        assert_eq!(mv, [[1.0, 2.0, 1.5], [3.0, -1.0, 1.5], [0.0, 0.0, 0.0]]);
+        assert_eq!(f, [[5.0, 1.0], [7.0, 3.0], [0.0, 9.0]]);
+        let f = [[0.0, 6.0], [0.0, -2.0], [0.0; 2]];
+        platen_totals(&mv, &f, &[], &p, 0.0, 0.5, 1e-12, &mut totals);
+        assert_eq!(totals, [[1.5, 0.5]]);
+        // A load of −8 N/m ramped over 2 s, at 1 s: 4 − 4 = 0 on the plate.
+        let p = [Platen {
+            force: -8.0,
+            ramp_time: 2.0,
+            ..p[0].clone()
+        }];
+        platen_totals(&mv, &f, &[], &p, 1.0, 0.0, 1e-12, &mut totals);
+        assert_eq!(totals, [[1.5, 0.0]]);
     }
 }

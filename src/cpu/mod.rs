@@ -77,6 +77,9 @@ pub struct CpuBackend {
     /// Per node: the walls' preloads this step (`wall_touch::wall_touch`);
     /// empty unless some particle starts with one (`Walls::preload`).
     pub wall_pre_force: Vec<[f64; 2]>,
+    /// Per loaded platen: its velocity and acceleration this step
+    /// (`grid_update::platen_totals`).
+    platen_totals: Vec<[f64; 2]>,
     /// Contact pairs' normals and gaps this step; None without pairs.
     pub contact: Option<contact_detect::ContactState>,
     /// `p2g`'s (and `G2pP2g`'s) per-thread node sums.
@@ -166,6 +169,7 @@ impl CpuBackend {
             } else {
                 vec![[0.0; 2]; nodes]
             },
+            platen_totals: vec![[0.0; 2]; model.constraints.platens.len()],
             wall_pre_force: if model.walls.preload.is_empty() {
                 Vec::new()
             } else {
@@ -626,6 +630,7 @@ impl CpuBackend {
             self.t + self.dt,
             self.mass_eps,
         );
+        grid_update::platens(&mut self.mv, &c.platens, self.mass_eps);
         Ok(())
     }
 
@@ -903,6 +908,17 @@ impl CpuBackend {
         let groups = self.model.constraints.groups.len();
         let group_r = &mut self.reactions[..groups];
         let m = &self.model;
+        let platens = &m.constraints.platens;
+        grid_update::platen_totals(
+            &self.mv,
+            &self.force,
+            &self.wall_force,
+            platens,
+            self.t + self.dt,
+            m.local_damping,
+            self.mass_eps,
+            &mut self.platen_totals,
+        );
         grid_update::correct(
             &mut self.mv,
             &mut self.force,
@@ -912,6 +928,14 @@ impl CpuBackend {
             group_r,
             gamma_dt,
             m.local_damping,
+            self.mass_eps,
+        );
+        grid_update::platens_correct(
+            &mut self.mv,
+            &mut self.force,
+            platens,
+            &self.platen_totals,
+            gamma_dt,
             self.mass_eps,
         );
         Ok(())

@@ -10,6 +10,7 @@ pub mod critical_state;
 pub mod dyka;
 pub mod energy;
 pub mod footing;
+pub mod mandel;
 pub mod mms;
 pub mod rolling;
 pub mod sliding;
@@ -39,6 +40,7 @@ pub enum Errors {
     GranularCollapse(collapse::GranularCollapseErrors),
     Energy(energy::EnergyErrors),
     Terzaghi(terzaghi::TerzaghiErrors),
+    Mandel(mandel::MandelErrors),
 }
 
 /// Scores the particle state at time `t` against the scene's exact
@@ -93,5 +95,6 @@ pub fn score(
             let layer = terzaghi::Terzaghi::from_scene(scene);
             Errors::Terzaghi(layer.score(particles, t))
         }
+        ExactKind::Mandel => Errors::Mandel(mandel::Mandel::from_scene(scene).score(particles, t)),
     }
 }

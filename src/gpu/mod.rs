@@ -79,6 +79,13 @@ impl GpuBackend {
             )
             .into());
         }
+        if let Some(p) = model.constraints.platens.first() {
+            return Err(crate::error::SceneError::invalid(
+                format!("platens.{}", p.name),
+                "a loaded platen runs on the CPU path only for now (--backend cpu or auto)",
+            )
+            .into());
+        }
         // The points' tables mark freed nodes with a bit per group.
         if !model.constraints.points.is_empty() && model.constraints.groups.len() > 32 {
             return Err(crate::error::SceneError::invalid(

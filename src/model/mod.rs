@@ -143,6 +143,28 @@ pub struct Constraints {
     /// without points). The GPU keeps each group as its region's box of
     /// nodes less these (`gpu::buffers::constraint_boxes`).
     pub freed: Vec<Vec<u32>>,
+    /// Loaded rigid platens (`[platens]`), each tying its nodes' velocity
+    /// along an axis (`cpu::grid_update::platens`).
+    pub platens: Vec<Platen>,
+}
+
+/// One `[platens.<name>]`: the nodes that move as one along `axis`.
+#[derive(Debug, Clone)]
+pub struct Platen {
+    pub name: String,
+    pub nodes: Vec<u32>,
+    /// 0 = x, 1 = y.
+    pub axis: usize,
+    /// The load along the axis (N/m) at full value, and its ramp time (s).
+    pub force: f64,
+    pub ramp_time: f64,
+}
+
+impl Platen {
+    /// The load (N/m) at time `t` (s).
+    pub fn force_at(&self, t: f64) -> f64 {
+        loads::ramp_factor(t, self.ramp_time) * self.force
+    }
 }
 
 impl Constraints {
@@ -824,6 +846,7 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
         groups: Vec::new(),
         points: Vec::new(),
         freed: Vec::new(),
+        platens: Vec::new(),
     };
     for (name, spec) in &scene.file.constraints {
         let bits = match spec.fix {
@@ -865,6 +888,43 @@ fn build_constraints(scene: &Scene, grid: &Grid) -> Result<Constraints, SceneErr
             ramp_time: spec.ramp_time,
             cells,
             shifted: [0, 0],
+        });
+    }
+    for (name, spec) in &scene.file.platens {
+        let axis = spec.axis.index();
+        let bit = if axis == 0 { FIX_X } else { FIX_Y };
+        let nodes: Vec<u32> = grid
+            .region(spec.min, spec.max)
+            .map(|(i, j)| grid.index(i, j) as u32)
+            .collect();
+        if nodes.is_empty() {
+            return Err(SceneError::invalid(
+                format!("platens.{name}"),
+                format!(
+                    "matches no node: the grid spans ({:.6}, {:.6}) to ({:.6}, {:.6}) with spacing {}",
+                    grid.min[0],
+                    grid.min[1],
+                    grid.max()[0],
+                    grid.max()[1],
+                    grid.h
+                ),
+            ));
+        }
+        if let Some(&n) = nodes.iter().find(|&&n| c.fix[n as usize] & bit != 0) {
+            return Err(SceneError::invalid(
+                format!("platens.{name}"),
+                format!(
+                    "holds node {n}, which a [constraints] region fixes along the platen's axis: \
+                     a platen moves, a fixed node does not (shrink one of the two regions)"
+                ),
+            ));
+        }
+        c.platens.push(Platen {
+            name: name.clone(),
+            nodes,
+            axis,
+            force: spec.force,
+            ramp_time: spec.ramp_time,
         });
     }
     Ok(c)

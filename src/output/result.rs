@@ -189,6 +189,16 @@ pub fn text(s: &Summary) -> Option<String> {
             },
             pct(e.settlement_rel_error)
         ),
+        Errors::Mandel(e) => format!(
+            "centre pore pressure at t c/a² = {}: {} p_start against Mandel's {} ({}{} of \
+             p_start; the Mandel–Cryer rise peaks near 0.1); RMS over the specimen {} of p_start.",
+            num(e.time_factor),
+            num(e.centre),
+            num(e.centre_exact),
+            if e.centre_error >= 0.0 { "+" } else { "" },
+            pct(e.centre_error),
+            pct(e.pressure_rms)
+        ),
         Errors::CriticalState(e) => format!(
             "stress ratio q/p′ = {} (p′ = {} kPa, q = {} kPa) at {} axial strain against the \
              critical state's M = {}: {} of the way; drained plane strain reaches q = M p′ only \
@@ -434,6 +444,23 @@ fn history(scene: &Scene, model: &Model, samples: &[Sample]) -> History {
             (
                 "velocity along the contact tangent at the probes",
                 "velocity (m/s)",
+            )
+        }
+        Some(ExactKind::Mandel) => {
+            let m = crate::exact::mandel::Mandel::from_scene(scene);
+            let (ps, ts) = (m.p_start(), m.time_scale());
+            for (k, p) in probes.iter().enumerate() {
+                let n = samples
+                    .iter()
+                    .map(|s| (s.t, s.probes[k].pore_pressure.unwrap_or(0.0) / ps))
+                    .collect();
+                let x = x0(k)[0];
+                let e = dense(samples, |t| m.pressure_ratio(x, t / ts));
+                add(p.name.clone(), n, Some(e), Style::Solid);
+            }
+            (
+                "pore pressure at the probes against Mandel's closed form",
+                "p / p_start",
             )
         }
         Some(ExactKind::Energy) => {

@@ -44,6 +44,10 @@ pub struct SceneFile {
     /// held on the nodes of a region (every other boundary is impermeable).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub drainage: BTreeMap<String, DrainageSpec>,
+    /// Loaded rigid platens by name: the nodes of a region move as one
+    /// along an axis under the forces on them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub platens: BTreeMap<String, PlatenSpec>,
     pub gravity: Option<GravitySpec>,
     pub solver: SolverSpec,
     #[serde(default)]
@@ -275,6 +279,55 @@ pub struct DrainageSpec {
     /// Pore pressure held there (Pa, compression positive). Default 0.
     #[serde(default)]
     pub pressure: f64,
+}
+
+/// A loaded rigid platen (`[platens.<name>]`): the nodes in the region
+/// move as one rigid, frictionless plate along `axis`, their velocity
+/// component there the mass-weighted mean of theirs, driven by the forces
+/// on them (its `force`, the material's reaction); across the axis they
+/// stay free. A constraint with a
+/// `velocity` is the displacement-driven platen; this is the
+/// force-driven one (Mandel's plates).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlatenSpec {
+    /// Lower-left corner of the region (m); `-inf` allowed.
+    pub min: [f64; 2],
+    /// Upper-right corner of the region (m); `inf` allowed.
+    pub max: [f64; 2],
+    /// The direction the platen moves in, `x` or `y`. Default `y`.
+    #[serde(default = "default_platen_axis")]
+    pub axis: Axis,
+    /// The load on the plate along `axis` (N per unit thickness, i.e.
+    /// N/m; positive along +axis): a dead load spread over its nodes by
+    /// their mass. Default 0 (a free plate).
+    #[serde(default)]
+    pub force: f64,
+    /// Linear ramp of `force` from 0 over this time (s); 0 = sudden. Default 0.
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+/// A coordinate direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Axis {
+    X,
+    Y,
+}
+
+impl Axis {
+    /// 0 for x, 1 for y.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+        }
+    }
+}
+
+fn default_platen_axis() -> Axis {
+    Axis::Y
 }
 
 /// How a wall treats the material on it.
@@ -837,6 +890,11 @@ pub enum ExactKind {
     /// pore pressure, degree of consolidation and settlement at t_end
     /// against the series (`exact::terzaghi`).
     Terzaghi,
+    /// Mandel's problem: a saturated quarter specimen under a loaded
+    /// platen, drained at its side: the centre's pore pressure at t_end
+    /// against the closed form, with its Mandel–Cryer rise
+    /// (`exact::mandel`).
+    Mandel,
 }
 
 /// Manufactured solutions known to the code.

@@ -67,6 +67,7 @@ pub(super) fn check(mut file: SceneFile, default_name: &str) -> Result<Scene, Sc
     check_constraints(&file)?;
     check_walls(&file)?;
     check_contact(&file)?;
+    check_platens(&file)?;
     check_loads(&file)?;
     check_gravity(&file)?;
     let sample_interval = check_output(&file)?;
@@ -812,6 +813,38 @@ fn check_contact(file: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// `[platens.NAME]`: a region (min ≤ max), on the explicit integrators
+/// of one velocity field (the implicit step's Newton and GMM's cloud do
+/// not tie nodes; contact pairs have a field per body). That it holds
+/// nodes, none of them fixed along its axis, is `Model::new`'s check.
+fn check_platens(file: &SceneFile) -> Result<(), SceneError> {
+    for (name, p) in &file.platens {
+        let key = format!("platens.{name}");
+        for k in 0..2 {
+            if p.min[k].is_nan() || p.max[k].is_nan() || p.min[k] > p.max[k] {
+                return Err(SceneError::invalid(
+                    format!("{key}.min"),
+                    format!("{:?} to {:?} is not a region (min ≤ max)", p.min, p.max),
+                ));
+            }
+        }
+        finite(&format!("{key}.force"), p.force)?;
+        ramp_time(&format!("{key}.ramp_time"), p.ramp_time)?;
+        let refuse = |why: &str| Err(SceneError::invalid(key.clone(), why.to_string()));
+        if file.solver.integrator == IntegratorKind::Implicit {
+            return refuse(
+                "is read by the explicit integrators only (fe, npc, musl); the implicit step ties no nodes",
+            );
+        }
+        if !file.contact.is_empty() {
+            return refuse(
+                "does not combine with [contact] pairs yet (a platen ties one velocity field)",
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A wall's `appear_at` and `remove_at` (s): finite, ≥ 0, and the wall
 /// acts for appear_at ≤ t < remove_at, so appear_at < remove_at. The
 /// implicit step holds its walls' contact states through Newton and does
@@ -1292,6 +1325,7 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         }
         ExactKind::Energy => return check_energy(file),
         ExactKind::Terzaghi => return check_terzaghi(file),
+        ExactKind::Mandel => return check_mandel(file),
     };
     if file.materials.len() != 1 {
         return Err(SceneError::invalid(
@@ -1344,7 +1378,8 @@ fn check_exact(file: &SceneFile, kind: ExactKind) -> Result<(), SceneError> {
         | ExactKind::ColumnCollapse
         | ExactKind::GranularCollapse
         | ExactKind::Energy
-        | ExactKind::Terzaghi => {}
+        | ExactKind::Terzaghi
+        | ExactKind::Mandel => {}
         ExactKind::DykaBar => {
             if file.gravity.as_ref().is_some_and(|g| g.g != [0.0, 0.0]) {
                 return Err(SceneError::invalid(
@@ -1549,6 +1584,42 @@ fn check_terzaghi(file: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// `exact = "mandel"`: the quarter specimen, one rect from [0, 0] (the
+/// symmetry planes), one saturated linear-elastic material, one platen
+/// on its top loaded by −F, no other load, and a drained region.
+fn check_mandel(file: &SceneFile) -> Result<(), SceneError> {
+    let bad = |msg: &str| Err(SceneError::invalid("exact", format!("= \"mandel\" {msg}")));
+    let rect = match file.bodies.values().collect::<Vec<_>>().as_slice() {
+        [b] if b.rects.len() == 1 && b.disks.is_empty() && b.polygons.is_empty() => b.rects[0],
+        _ => return bad("needs one body made of one rect (the quarter specimen)"),
+    };
+    if rect[0] != 0.0 || rect[1] != 0.0 {
+        return bad(
+            "models the quarter x >= 0, y >= 0: the rect must start at [0, 0] (the symmetry planes)",
+        );
+    }
+    match file.materials.values().collect::<Vec<_>>().as_slice() {
+        [m] if m.model == "linear_elastic" && m.get("permeability").is_some() => {}
+        _ => return bad("needs one material, linear_elastic with `permeability` (saturated)"),
+    }
+    match file.platens.values().collect::<Vec<_>>().as_slice() {
+        [p] if p.axis == Axis::Y && p.force < 0.0 && p.ramp_time == 0.0 && p.min[1] >= rect[3] => {}
+        _ => {
+            return bad(
+                "needs one [platens.<name>] along y at the specimen's top (min y >= its rect's ymax), \
+                 loaded by a sudden force < 0 (-F, N/m, on the half-width a)",
+            );
+        }
+    }
+    if !file.tractions.is_empty() || !file.point_loads.is_empty() {
+        return bad("loads the specimen through its platen only (no [tractions] or [point_loads])");
+    }
+    if file.drainage.is_empty() {
+        return bad("needs a [drainage.<name>] region at the side x = a");
+    }
+    Ok(())
+}
+
 fn check_critical_state(file: &SceneFile) -> Result<(), SceneError> {
     if !file
         .materials
@@ -1616,6 +1687,9 @@ fn check_energy(file: &SceneFile) -> Result<(), SceneError> {
     }
     if !file.walls.is_empty() {
         return bad("the walls (their contact forces do work)");
+    }
+    if file.platens.values().any(|p| p.force != 0.0) {
+        return bad("the platens' loads");
     }
     if file.manufactured.is_some() {
         return bad("[manufactured] (its body force does work)");
