@@ -217,9 +217,8 @@ fn npc_position_readings_agree_on_dyka() {
 /// then 1.0, and over the paper's ten periods the fit's smoothing and the
 /// particle-scale modes it cannot see take over (docs/verification.md,
 /// `lme-mpm study mms`).
-#[test]
-fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
-    let errors: Vec<f64> = [8.0, 16.0, 32.0]
+fn bspline2_mls_orders(cells: &[f64]) {
+    let errors: Vec<f64> = cells
         .iter()
         .map(|n| {
             let h = format!("grid.h={}", 1.0 / n);
@@ -245,6 +244,21 @@ fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
     for o in orders {
         assert!(o >= 1.8, "order {o} below 1.8: errors {errors:?}");
     }
+}
+
+/// 8 to 16 cells in the suite; the 32-cell run was three quarters of the
+/// whole (about 70 s of 96 on 2 cores, 2026-12-02) and is the ignored
+/// acceptance run below.
+#[test]
+fn aligned_vibration_bspline2_mls_converges_at_second_order_over_one_period() {
+    bspline2_mls_orders(&[8.0, 16.0]);
+}
+
+///   cargo test --release --test suite -- --ignored benchmarks::aligned_vibration_bspline2_mls_converges_to_32_cells
+#[test]
+#[ignore]
+fn aligned_vibration_bspline2_mls_converges_to_32_cells() {
+    bspline2_mls_orders(&[8.0, 16.0, 32.0]);
 }
 
 /// The B-spline paper's method as printed (bspline2 + MLS with its MUSL

@@ -408,13 +408,14 @@ fn free_energy(cells: usize, sets: &[&str], t_end: f64) -> (f64, f64, bool) {
 /// The band, ±0.5 % of E0.
 const ENERGY_BAND: f64 = 0.005;
 
-/// Checks one mode's free vibration against the band; the two modes are two
-/// tests so that the harness runs them side by side (the force correction's
-/// 20000 steps are the suite's longest test: 150 s on 2 cores shared with
-/// a 2-thread run, plain bspline2's 42 s, 2026-11-27).
-fn keeps_energy(name: &str, sets: &[&str]) {
-    let (lo, hi, done) = free_energy(8, sets, 0.2);
-    println!("{name}: E/E0 in [{lo:.5}, {hi:.5}], completed {done}");
+/// Checks one mode's free vibration to `t_end` against the band. The
+/// suite holds two periods (0.04 s); the ten (0.2 s, the force
+/// correction's 20000 steps take about 70 s alone on 2 cores, 2026-12-02)
+/// are the ignored `…_over_ten_periods` acceptance runs:
+///   cargo test --release --test suite -- --ignored mls_force::
+fn keeps_energy(name: &str, sets: &[&str], t_end: f64) {
+    let (lo, hi, done) = free_energy(8, sets, t_end);
+    println!("{name} to {t_end} s: E/E0 in [{lo:.5}, {hi:.5}], completed {done}");
     assert!(done, "{name} completes");
     assert!(
         lo > 1.0 - ENERGY_BAND && hi < 1.0 + ENERGY_BAND,
@@ -422,16 +423,27 @@ fn keeps_energy(name: &str, sets: &[&str]) {
     );
 }
 
+const FORCE: &[&str] = &["solver.mls=true", "solver.mls_scope=force"];
+
 #[test]
 fn the_force_correction_keeps_a_free_vibrations_energy() {
-    keeps_energy(
-        "force correction",
-        &["solver.mls=true", "solver.mls_scope=force"],
-    );
+    keeps_energy("force correction", FORCE, 0.04);
 }
 
 /// Plain bspline2 beside it, the reference for the band.
 #[test]
 fn plain_bspline2_keeps_a_free_vibrations_energy() {
-    keeps_energy("plain bspline2", &["solver.mls=false"]);
+    keeps_energy("plain bspline2", &["solver.mls=false"], 0.04);
+}
+
+#[test]
+#[ignore]
+fn the_force_correction_keeps_a_free_vibrations_energy_over_ten_periods() {
+    keeps_energy("force correction", FORCE, 0.2);
+}
+
+#[test]
+#[ignore]
+fn plain_bspline2_keeps_a_free_vibrations_energy_over_ten_periods() {
+    keeps_energy("plain bspline2", &["solver.mls=false"], 0.2);
 }
