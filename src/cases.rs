@@ -14,6 +14,8 @@ pub const CONTACT_BLOCK: &str = include_str!("../cases/contact_block.toml");
 pub const CONTACT_DISKS: &str = include_str!("../cases/contact_disks.toml");
 pub const CONTACT_ROLLING: &str = include_str!("../cases/contact_rolling.toml");
 pub const FOOTING: &str = include_str!("../cases/footing.toml");
+pub const TERZAGHI: &str = include_str!("../cases/terzaghi.toml");
+pub const MANDEL: &str = include_str!("../cases/mandel.toml");
 
 /// The cohesionless case for shape `shape`: its `bspline_knots` line
 /// (which only B-splines accept) dropped for the other shapes.

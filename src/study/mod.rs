@@ -5,6 +5,7 @@
 
 pub mod block;
 pub mod column;
+pub mod consolidation;
 pub mod contact;
 pub mod disk;
 pub mod dyka;
@@ -67,6 +68,7 @@ studies! {
     Implicit => implicit::STUDY,
     Contact => contact::STUDY,
     Gmm => gmm::STUDY,
+    Consolidation => consolidation::STUDY,
 }
 
 /// `all`'s line in `lme-mpm study --help`.
