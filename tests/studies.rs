@@ -679,11 +679,21 @@ fn consolidation_quick_scores_terzaghi_and_mandel() {
     use lme_mpm::exact::mandel::Mandel;
     use lme_mpm::exact::terzaghi::Terzaghi;
     let (results, md, _) = run(StudyName::Consolidation);
-    assert_eq!(results.len(), 3, "Terzaghi, Mandel and Mandel's early run");
+    assert_eq!(
+        results.len(),
+        4,
+        "Terzaghi, its particle-term run, Mandel and Mandel's early run"
+    );
     for r in &results {
         assert!(r.completed(), "{}: {:?}", r.job.label, r.outcome);
     }
-    for chart in ["isochrones", "degree", "mandel", "error-time"] {
+    for chart in [
+        "isochrones",
+        "oscillation",
+        "degree",
+        "mandel",
+        "error-time",
+    ] {
         assert!(
             md.contains(&format!("study-consolidation-{chart}.png")),
             "{chart}"
@@ -713,6 +723,19 @@ fn consolidation_quick_scores_terzaghi_and_mandel() {
         let bound = if tv >= 0.1 || scored { 0.02 } else { 0.05 };
         assert!(e.pressure_rms < bound, "T_v {tv}: {e:?}");
     }
+    // Equal-order u–p (the particle's own volumetric term) oscillates at
+    // every scored isochrone; the nodal term does not (bound above).
+    let bad = get(lme_mpm::study::consolidation::PARTICLE_TERM);
+    for (time, p) in &bad.data().unwrap().snapshots {
+        let e = layer.score(p, *time);
+        if [0.05, 0.1, 0.2]
+            .iter()
+            .any(|s| (e.time_factor / s - 1.0).abs() < 5e-3)
+        {
+            assert!(e.pressure_rms > 0.2, "{e:?}");
+        }
+    }
+    assert!(md.contains("particle term"));
     for problem in ["mandel", "mandel-early"] {
         let m = get(problem);
         let spec = Mandel::from_scene(&scene(m));

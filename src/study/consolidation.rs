@@ -2,7 +2,10 @@
 //! solutions, explicit NPC on the CPU. Terzaghi's layer
 //! (`cases/terzaghi.toml`): isochrones p/p_start over depth against the
 //! series at T_v = 0.05, 0.1, 0.2, 0.5 and 1, and the degree of
-//! consolidation U against T_v on a log axis; Mandel's specimen
+//! consolidation U against T_v on a log axis, and the first method again
+//! with the particle's own volumetric term (equal-order u–p), every
+//! particle's pressure at T_v 0.1 charted against the nodal term's, to show
+//! the oscillation the default removes; Mandel's specimen
 //! (`cases/mandel.toml`): the centre's pressure against t c / a², the
 //! Mandel–Cryer rise; and each method's error against its wall time. The
 //! GPU path and the implicit u–p step have no pore pressure yet, so every
@@ -41,8 +44,8 @@ pub const QUICK_END: f64 = 0.2;
 pub const STUDY: Study = Study {
     slug: "consolidation",
     help: "Saturated soil: Terzaghi's isochrones and degree of consolidation, Mandel's centre \
-         pressure (the Mandel-Cryer rise), error against wall time for linear, bspline2 and LME \
-         (CPU, explicit; about 3 minutes on 2 cores)",
+         pressure (the Mandel-Cryer rise), error against wall time for linear, bspline2 and LME, \
+         and the oscillation of equal-order u-p (CPU, explicit; about 3 minutes on 2 cores)",
     jobs: |quick, _backends| Ok(jobs(quick)),
     report,
 };
@@ -80,6 +83,14 @@ pub fn jobs(quick: bool) -> Vec<Job> {
         .tag("problem", "terzaghi")
         .method(m);
         j.snapshot_times = times(end, &listed).iter().map(|f| f * scale).collect();
+        if m.1 == METHODS[0].1 {
+            // The equal-order u–p run beside it (the particle's own −tr L
+            // term), whose pressure oscillates from particle to particle.
+            let mut k = j.clone().set("solver.pore_volumetric=particle");
+            k.label = format!("cpu-terzaghi-particle-{}", m.1);
+            k.tags.retain(|(key, _)| *key != "problem");
+            out.push(k.tag("problem", PARTICLE_TERM));
+        }
         out.push(j);
         // Mandel: t c / a² = t / 10 s on the case's specimen.
         let spec = mandel_of(crate::cases::MANDEL);
@@ -122,6 +133,13 @@ pub fn jobs(quick: bool) -> Vec<Job> {
     }
     out
 }
+
+/// The tag of Terzaghi's run with the particle's own volumetric term
+/// (`solver.pore_volumetric = "particle"`), first method only.
+pub const PARTICLE_TERM: &str = "terzaghi-particle";
+
+/// The isochrone the oscillation chart shows (T_v).
+pub const OSCILLATION_TV: f64 = 0.1;
 
 /// How much slower Mandel's early run consolidates (k / this).
 pub const EARLY_SLOWER: f64 = 10.0;
@@ -189,11 +207,18 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
     header.extend(ISOCHRONES.iter().map(|tv| format!("RMS at T_v {tv}")));
     header.extend(CLASSIC_TV.iter().map(|tv| format!("U at {tv} (exact)")));
     header.extend(["settlement at 0.197".into(), "wall (s)".into()]);
+    let particle = runs(results, PARTICLE_TERM);
     let rows: Vec<Vec<String>> = terz
         .iter()
+        .chain(&particle)
         .map(|r| {
+            let method = r.job.tag_value("method").unwrap_or("");
             let mut row = vec![
-                r.job.tag_value("method").unwrap_or("").to_string(),
+                if r.job.tag_value("problem") == Some(PARTICLE_TERM) {
+                    format!("{method}, particle term")
+                } else {
+                    method.to_string()
+                },
                 super::failure_text(r),
             ];
             for &tv in &ISOCHRONES {
@@ -220,6 +245,26 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         .collect();
     md.push_str(&table(&header, &rows));
     md.push('\n');
+    let worst = |r: &JobResult| {
+        ISOCHRONES
+            .iter()
+            .filter_map(|&tv| at(r, tv, t_scale))
+            .map(|(t, p)| layer.score(p, *t).pressure_rms)
+            .fold(0.0, f64::max)
+    };
+    if let Some(r) = particle.first() {
+        let nodal = terz.iter().map(|r| worst(r)).fold(0.0, f64::max);
+        let _ = writeln!(
+            md,
+            "The row \"particle term\" is equal-order u–p (`solver.pore_volumetric = \
+             \"particle\"`: each particle's pressure takes its own −tr L_p / S): its pressure \
+             oscillates from particle to particle, worst RMS {} % of p_start, against at most \
+             {} % for the nodal term (the default, the rows above); the oscillation chart shows \
+             every particle at T_v {OSCILLATION_TV}.\n",
+            sig(100.0 * worst(r)),
+            sig(100.0 * nodal)
+        );
+    }
     // Mandel's table.
     let mut header: Vec<String> = vec!["method".into(), "status".into()];
     header.extend(
@@ -277,6 +322,13 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         &mut isochrones(&layer, &terz, t_scale),
         "study-consolidation-isochrones",
         "Terzaghi's isochrones: the particles' pressure over depth against the series",
+        &mut md,
+    )?;
+    save(
+        &mut oscillation(&layer, &terz, &particle, t_scale),
+        "study-consolidation-oscillation",
+        "Terzaghi at T_v 0.1: every particle's pressure, the particle term's oscillating about \
+         the series, the nodal term's on it",
         &mut md,
     )?;
     save(
@@ -342,6 +394,49 @@ fn isochrones(layer: &Terzaghi, terz: &[&JobResult], scale: f64) -> LineChart {
             .collect();
         c.series.push(Series::line("", exact, k).dashed());
     }
+    c
+}
+
+/// Every particle's p / p_start over depth at `OSCILLATION_TV`: the first
+/// method's nodal run and its particle-term run, beside the series.
+fn oscillation(
+    layer: &Terzaghi,
+    terz: &[&JobResult],
+    particle: &[&JobResult],
+    scale: f64,
+) -> LineChart {
+    let tv = OSCILLATION_TV;
+    let mut c = LineChart::new(
+        format!("Terzaghi at T_v {tv}: every particle, nodal against particle volumetric term"),
+        "p / p_start",
+        "depth / H",
+    );
+    let ps = layer.p_start();
+    let depth = |y: f64| (layer.top - y) / layer.height();
+    for (k, (r, what)) in particle
+        .first()
+        .map(|r| (*r, "particle term"))
+        .into_iter()
+        .chain(terz.first().map(|r| (*r, "nodal term")))
+        .enumerate()
+    {
+        let Some((_, p)) = at(r, tv, scale) else {
+            continue;
+        };
+        let pts = (0..p.len())
+            .map(|i| (p.pore_pressure[i] / ps, depth(p.x0[i][1])))
+            .collect();
+        let label = format!("{}, {what}", r.job.tag_value("method").unwrap_or(""));
+        c.series.push(Series::line(label, pts, [3, 0][k]).scatter());
+    }
+    let exact = (0..=50)
+        .map(|j| {
+            let y = layer.base + layer.height() * j as f64 / 50.0;
+            (layer.pressure_ratio(y, tv), depth(y))
+        })
+        .collect();
+    c.series
+        .push(Series::line("Terzaghi's series", exact, 7).dashed());
     c
 }
 
