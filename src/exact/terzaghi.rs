@@ -62,12 +62,15 @@ impl Terzaghi {
             .expect("validated: saturated");
         let (lambda, mu) = crate::model::material::Material::from_spec(name, m)
             .map_or((f64::NAN, f64::NAN), |m| m.lame_shear());
-        let p0 = -f
-            .tractions
-            .values()
-            .next()
-            .expect("validated: one traction")
-            .traction[1];
+        // The load: one traction [0, −p0] on the top, or one platen there
+        // loaded by −F (N/m) over the layer's width.
+        let p0 = match f.tractions.values().next() {
+            Some(t) => -t.traction[1],
+            None => {
+                let platen = f.platens.values().next().expect("validated: one platen");
+                -platen.force / (rect[2] - rect[0])
+            }
+        };
         Terzaghi {
             base: rect[1],
             top: rect[3],

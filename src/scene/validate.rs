@@ -1571,12 +1571,34 @@ fn check_terzaghi(file: &SceneFile) -> Result<(), SceneError> {
         [m] if m.model == "linear_elastic" && m.get("permeability").is_some() => {}
         _ => return bad("needs one material, linear_elastic with `permeability` (saturated)"),
     }
-    match file.tractions.values().collect::<Vec<_>>().as_slice() {
+    let traction = match file.tractions.values().collect::<Vec<_>>().as_slice() {
+        [] => false,
         [t] if t.from[1] == rect[3]
             && t.to[1] == rect[3]
             && t.traction[0] == 0.0
-            && t.traction[1] < 0.0 => {}
+            && t.traction[1] < 0.0 =>
+        {
+            true
+        }
         _ => return bad("needs one traction [0, -p0] along the layer's top (y = its rect's ymax)"),
+    };
+    let platen = match file.platens.values().collect::<Vec<_>>().as_slice() {
+        [] => false,
+        [p] if p.axis == Axis::Y && p.force < 0.0 && p.ramp_time == 0.0 && p.min[1] >= rect[3] => {
+            true
+        }
+        _ => {
+            return bad(
+                "takes one [platens.<name>] along y at the layer's top (min y >= its rect's ymax), \
+                 loaded by a sudden force < 0 (-p0 times the layer's width, N/m)",
+            );
+        }
+    };
+    if traction == platen || !file.point_loads.is_empty() {
+        return bad(
+            "is loaded once: by one traction [0, -p0] along its top or by one platen there \
+             (no [point_loads])",
+        );
     }
     if file.drainage.is_empty() {
         return bad("needs a [drainage.<name>] region at the layer's top");
