@@ -28,6 +28,9 @@ pub struct PoreFlow {
     p: Vec<f64>,
     /// Per node: the pressure a drained node holds.
     drained: Vec<Option<f64>>,
+    /// Drained nodes beyond a half-plane's face row, with their mirror
+    /// node and the face's pressure (`Drain::ghosts`).
+    ghosts: Vec<(usize, usize, f64)>,
     sums_scatter: Scatter<4>,
     flux_scatter: Scatter<1>,
 }
@@ -56,7 +59,17 @@ impl PoreFlow {
                 drained[n as usize] = Some(d.pressure);
             }
         }
+        let ghosts = pore
+            .drains
+            .iter()
+            .flat_map(|d| {
+                d.ghosts
+                    .iter()
+                    .map(|&(g, m)| (g as usize, m as usize, d.pressure))
+            })
+            .collect();
         PoreFlow {
+            ghosts,
             sums: vec![[0.0; 4]; n_nodes],
             flux: vec![[0.0; 1]; n_nodes],
             p: vec![0.0; n_nodes],
@@ -105,6 +118,13 @@ impl PoreFlow {
                 None => 0.0,
             };
         }
+        // A ghost beyond a drained face: the antisymmetric image of its
+        // mirror (which has soil), so the face row interpolates p_D.
+        for &(g, m, pd) in &self.ghosts {
+            if self.sums[m][0] > 0.0 {
+                self.p[g] = 2.0 * pd - self.p[m];
+            }
+        }
         // 3. Σ V ∇N · w, w = −κ (∇p − ρ_w b).
         self.flux.iter_mut().for_each(|f| *f = [0.0]);
         let p_nodes = &self.p;
@@ -145,6 +165,11 @@ impl PoreFlow {
                 }
                 None => 0.0,
             };
+        }
+        for &(g, m, _) in &self.ghosts {
+            if self.sums[m][0] > 0.0 {
+                self.p[g] = -self.p[m];
+            }
         }
         // 5. Each saturated particle takes its share.
         let dp_nodes = &self.p;

@@ -132,6 +132,62 @@ pub struct Drain {
     pub nodes: Vec<u32>,
     /// Pa.
     pub pressure: f64,
+    /// Where the region is a half-plane (one finite bound): its nodes
+    /// beyond the face row (the drained nodes nearest the soil), each
+    /// with its mirror image across that row, an undrained node. The flow
+    /// gives a ghost 2 p_D − p_mirror (and −Δp_mirror), so the pressure a
+    /// B-spline or LME stencil interpolates on the face row is p_D, as a
+    /// linear stencil's is (`cpu::pore_flow`).
+    pub ghosts: Vec<(u32, u32)>,
+}
+
+/// `Drain::ghosts` of the region [min, max] whose nodes are `drained`
+/// (every drain's, by node): none unless exactly one bound is finite.
+fn ghosts(
+    grid: &Grid,
+    min: [f64; 2],
+    max: [f64; 2],
+    nodes: &[u32],
+    drained: &[bool],
+) -> Vec<(u32, u32)> {
+    let finite: Vec<(usize, bool)> = (0..2)
+        .flat_map(|a| [(a, true, min[a]), (a, false, max[a])])
+        .filter(|b| b.2.is_finite())
+        .map(|b| (b.0, b.1))
+        .collect();
+    let [(axis, lower)] = finite[..] else {
+        return Vec::new();
+    };
+    let ij = |n: u32| {
+        let n = n as usize;
+        [n % grid.nx, n / grid.nx]
+    };
+    let along = nodes.iter().map(|&n| ij(n)[axis]);
+    // The face row: the drained nodes nearest the soil.
+    let face = if lower { along.min() } else { along.max() };
+    let Some(face) = face else { return Vec::new() };
+    let len = [grid.nx, grid.ny][axis];
+    nodes
+        .iter()
+        .filter_map(|&n| {
+            let mut c = ij(n);
+            let k = c[axis].abs_diff(face);
+            if k == 0 {
+                return None;
+            }
+            let m = if lower {
+                face.checked_sub(k)?
+            } else {
+                face + k
+            };
+            if m >= len {
+                return None;
+            }
+            c[axis] = m;
+            let mirror = grid.index(c[0], c[1]);
+            (!drained[mirror]).then_some((n, mirror as u32))
+        })
+        .collect()
 }
 
 /// The scene's pore fluid: per material (None: dry) and the drained nodes.
@@ -214,7 +270,17 @@ impl Pore {
                 name: name.clone(),
                 nodes,
                 pressure: d.pressure,
+                ghosts: Vec::new(),
             });
+        }
+        let mut drained = vec![false; grid.n_nodes()];
+        for d in &drains {
+            for &n in &d.nodes {
+                drained[n as usize] = true;
+            }
+        }
+        for (d, spec) in drains.iter_mut().zip(f.drainage.values()) {
+            d.ghosts = ghosts(grid, spec.min, spec.max, &d.nodes, &drained);
         }
         Ok(Some(Pore {
             fluid,
@@ -310,4 +376,49 @@ fn refuse_unsupported(scene: &Scene) -> Result<(), SceneError> {
         return why("contact", "without contact pairs (not yet)");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn drained_of(grid: &Grid, min: [f64; 2], max: [f64; 2]) -> (Vec<u32>, Vec<bool>) {
+        let nodes: Vec<u32> = grid
+            .region(min, max)
+            .map(|(i, j)| grid.index(i, j) as u32)
+            .collect();
+        let mut drained = vec![false; grid.n_nodes()];
+        nodes.iter().for_each(|&n| drained[n as usize] = true);
+        (nodes, drained)
+    }
+
+    /// A half-plane's nodes beyond its face row mirror across it; a box
+    /// (two finite bounds) has no ghosts.
+    #[test]
+    fn ghosts_mirror_a_half_plane_across_its_face_row() {
+        let grid = Grid::regular(0.5, [0.0, 0.0], 4, 6); // y = 0 … 2.5
+        let (min, max) = ([f64::NEG_INFINITY, 1.5], [f64::INFINITY; 2]);
+        let (nodes, drained) = drained_of(&grid, min, max);
+        let g = ghosts(&grid, min, max, &nodes, &drained);
+        // Rows 4 and 5 (y = 2, 2.5) mirror rows 2 and 1 across row 3.
+        assert_eq!(g.len(), 2 * grid.nx);
+        for (ghost, mirror) in g {
+            let (gi, gj) = (ghost as usize % grid.nx, ghost as usize / grid.nx);
+            let (mi, mj) = (mirror as usize % grid.nx, mirror as usize / grid.nx);
+            assert_eq!(gi, mi);
+            assert_eq!(gj - 3, 3 - mj);
+        }
+        // Drained for x ≥ 1: column 3 mirrors column 1 across column 2.
+        let (min, max) = ([1.0, f64::NEG_INFINITY], [f64::INFINITY; 2]);
+        let (nodes, drained) = drained_of(&grid, min, max);
+        let g = ghosts(&grid, min, max, &nodes, &drained);
+        assert_eq!(g.len(), grid.ny);
+        assert!(
+            g.iter()
+                .all(|&(a, b)| a as usize % grid.nx == 3 && b as usize % grid.nx == 1)
+        );
+        let (min, max) = ([1.0, 1.0], [f64::INFINITY, 2.0]);
+        let (nodes, drained) = drained_of(&grid, min, max);
+        assert!(ghosts(&grid, min, max, &nodes, &drained).is_empty());
+    }
 }
