@@ -5,8 +5,10 @@
 //!   C_I ṗ_I = −Σ_p V_p N_I tr L_p + Σ_p V_p ∇N_I · w_p,  C_I = Σ_p V_p N_I S_p,
 //! S = n / K_w, κ = k / γ_w, w_p from the nodal pressure
 //! p_I = Σ V N p / Σ V N (saturated particles only), ∇p_p = Σ ∇N_I p_I.
-//! Drained nodes hold their pressure (`[drainage]`); every other boundary
-//! is impermeable (no flux term). Each particle then takes Δp_p =
+//! Drained nodes hold their pressure (`[drainage]`), except the ghosts
+//! beyond a half-plane's face row, which take the antisymmetric image of
+//! their mirror (`Drain::ghosts`); every other boundary is impermeable (no
+//! flux term). Each particle then takes Δp_p =
 //! Σ N_I Δp_I. With `solver.pore_volumetric = "particle"` the −tr L term
 //! is the particle's own, −Δt tr L_p / S_p, instead of the nodes':
 //! equal-order u–p, whose pressure oscillates from particle to particle
