@@ -711,7 +711,7 @@ fn consolidation_quick_scores_terzaghi_and_mandel() {
     let snaps = &t.data().unwrap().snapshots;
     assert!(snaps.len() > 10, "{} snapshots", snaps.len());
     // The sudden load still rings early on (at T_v 0.057 the RMS is
-    // 4.4 %, at 0.088 0.5 %), so the bound is 5 % from T_v 0.05 and 2 %
+    // 3.8 %, at 0.088 0.6 %), so the bound is 5 % from T_v 0.05 and 2 %
     // from 0.1 and at the scored isochrones the tables print.
     for (time, p) in snaps
         .iter()

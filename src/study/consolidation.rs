@@ -66,69 +66,75 @@ fn times(end: f64, listed: &[f64]) -> Vec<f64> {
 pub fn jobs(quick: bool) -> Vec<Job> {
     let end = if quick { QUICK_END } else { 1.0 };
     let methods: &[Method] = if quick { &METHODS[..1] } else { &METHODS };
+    // Terzaghi: T_v = c_v t / H²; Mandel: t c / a² (both t / 10 s here).
+    let layer = terzaghi_of(crate::cases::TERZAGHI);
+    let t_scale = layer.height() * layer.height() / layer.cv();
+    let spec = mandel_of(crate::cases::MANDEL);
+    let m_scale = spec.time_scale();
+    let tv_listed: Vec<f64> = ISOCHRONES.iter().chain(&CLASSIC_TV).copied().collect();
+    // One run of a shipped case on the CPU to `t_end` (s), tagged with its
+    // problem.
+    let job = |label: &str, case: &'static str, name: &'static str, problem: &str, t_end: f64| {
+        Job::new(label, case, name)
+            .set(format!("solver.t_end={t_end}"))
+            .set("output.vtk_interval=1e9")
+            .on(BackendChoice::Cpu)
+            .tag("problem", problem)
+    };
     let mut out = Vec::new();
     for &m in methods {
-        // Terzaghi: T_v = c_v t / H² = t / 10 s on the case's layer.
-        let layer = terzaghi_of(crate::cases::TERZAGHI);
-        let scale = layer.height() * layer.height() / layer.cv();
-        let listed: Vec<f64> = ISOCHRONES.iter().chain(&CLASSIC_TV).copied().collect();
-        let mut j = Job::new(
-            format!("cpu-terzaghi-{}", m.1),
-            crate::cases::TERZAGHI,
-            "terzaghi",
-        )
-        .set(format!("solver.t_end={}", end * scale))
-        .set("output.vtk_interval=1e9")
-        .on(BackendChoice::Cpu)
-        .tag("problem", "terzaghi")
-        .method(m);
-        j.snapshot_times = times(end, &listed).iter().map(|f| f * scale).collect();
+        let snaps = |f: &[f64], scale: f64| f.iter().map(|f| f * scale).collect();
+        let terzaghi = |label: String, problem: &str| {
+            let mut j = job(
+                &label,
+                crate::cases::TERZAGHI,
+                "terzaghi",
+                problem,
+                end * t_scale,
+            );
+            j.snapshot_times = snaps(&times(end, &tv_listed), t_scale);
+            j
+        };
         if m.1 == METHODS[0].1 {
             // The equal-order u–p run beside it (the particle's own −tr L
             // term), whose pressure oscillates from particle to particle.
-            let mut k = j.clone().set("solver.pore_volumetric=particle");
-            k.label = format!("cpu-terzaghi-particle-{}", m.1);
-            k.tags.retain(|(key, _)| *key != "problem");
-            out.push(k.tag("problem", PARTICLE_TERM));
+            let label = format!("cpu-terzaghi-particle-{}", m.1);
+            out.push(
+                terzaghi(label, PARTICLE_TERM)
+                    .set("solver.pore_volumetric=particle")
+                    .method(m),
+            );
         }
-        out.push(j);
-        // Mandel: t c / a² = t / 10 s on the case's specimen.
-        let spec = mandel_of(crate::cases::MANDEL);
-        let scale = spec.time_scale();
-        let mut j = Job::new(
-            format!("cpu-mandel-{}", m.1),
+        out.push(terzaghi(format!("cpu-terzaghi-{}", m.1), "terzaghi").method(m));
+        let label = format!("cpu-mandel-{}", m.1);
+        let mut j = job(
+            &label,
             crate::cases::MANDEL,
             "mandel",
+            "mandel",
+            end * m_scale,
         )
-        .set(format!("solver.t_end={}", end * scale))
-        .set("output.vtk_interval=1e9")
-        .on(BackendChoice::Cpu)
-        .tag("problem", "mandel")
         .method(m);
-        j.snapshot_times = times(end, &MANDEL_TIMES)
-            .iter()
-            .map(|f| f * scale)
-            .collect();
+        j.snapshot_times = snaps(&times(end, &MANDEL_TIMES), m_scale);
         out.push(j);
         // Its first time on the specimen with k / 10: the case reaches
         // t c/a² = 0.01 at 0.1 s, within the sudden load's shear ringing
         // (period 0.25 s); with c / 10 it is 1 s, four periods later.
-        let slow = scale * EARLY_SLOWER;
-        let mut j = Job::new(
-            format!("cpu-mandel-early-{}", m.1),
+        let t_early = MANDEL_TIMES[0] * m_scale * EARLY_SLOWER;
+        let label = format!("cpu-mandel-early-{}", m.1);
+        let mut j = job(
+            &label,
             crate::cases::MANDEL,
             "mandel",
+            "mandel-early",
+            t_early,
         )
         .set(format!(
             "materials.soil.permeability={}",
             spec.fluid.k / EARLY_SLOWER
         ))
-        .set(format!("solver.t_end={}", MANDEL_TIMES[0] * slow))
-        .set("output.vtk_interval=1e9")
-        .on(BackendChoice::Cpu)
-        .tag("problem", "mandel-early")
         .method(m);
-        j.snapshot_times = vec![MANDEL_TIMES[0] * slow];
+        j.snapshot_times = vec![t_early];
         out.push(j);
     }
     out
@@ -164,7 +170,16 @@ fn runs<'a>(results: &'a [JobResult], problem: &str) -> Vec<&'a JobResult> {
         .collect()
 }
 
-/// The snapshot nearest the factor `f` of `scale` (within 2 %), with its
+/// Terzaghi's largest pressure RMS over the isochrones run `r` reached.
+fn worst_rms(layer: &Terzaghi, r: &JobResult, t_scale: f64) -> f64 {
+    ISOCHRONES
+        .iter()
+        .filter_map(|&tv| at(r, tv, t_scale))
+        .map(|(t, p)| layer.score(p, *t).pressure_rms)
+        .fold(0.0, f64::max)
+}
+
+/// The snapshot at the factor `f` of `scale` (within 0.5 %), with its
 /// time.
 fn at(r: &JobResult, f: f64, scale: f64) -> Option<&(f64, crate::model::Particles)> {
     r.data()?
@@ -245,13 +260,7 @@ pub fn report(results: &[JobResult], dir: &Path, quick: bool) -> Result<(String,
         .collect();
     md.push_str(&table(&header, &rows));
     md.push('\n');
-    let worst = |r: &JobResult| {
-        ISOCHRONES
-            .iter()
-            .filter_map(|&tv| at(r, tv, t_scale))
-            .map(|(t, p)| layer.score(p, *t).pressure_rms)
-            .fold(0.0, f64::max)
-    };
+    let worst = |r: &JobResult| worst_rms(&layer, r, t_scale);
     if let Some(r) = particle.first() {
         let nodal = terz.iter().map(|r| worst(r)).fold(0.0, f64::max);
         let _ = writeln!(
@@ -517,11 +526,7 @@ fn error_time(
     .log_log();
     for (k, r) in terz.iter().enumerate() {
         let Some(d) = r.data() else { continue };
-        let worst = ISOCHRONES
-            .iter()
-            .filter_map(|&tv| at(r, tv, t_scale))
-            .map(|(t, p)| layer.score(p, *t).pressure_rms)
-            .fold(0.0, f64::max);
+        let worst = worst_rms(layer, r, t_scale);
         if worst > 0.0 {
             let label = format!("{}, Terzaghi RMS", r.job.tag_value("method").unwrap_or(""));
             c.series
